@@ -1,0 +1,44 @@
+// Shared vocabulary of the pure C++ core: index type and the parallel-loop hook through
+// which the VTK layer injects vtkSMPTools (the core itself never includes VTK).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+namespace topospline
+{
+// 32-bit ids: a 2D triangulation with 2^31 edges (~700M vertices) is far beyond what fits
+// in memory anyway, and halving the id size halves the memory traffic of every pass.
+using Index = std::int32_t;
+constexpr Index InvalidIndex = -1;
+
+// ParallelFor(begin, end, body) must call body(b, e) on disjoint sub-ranges covering
+// [begin, end). Every core loop that uses it writes only to slots owned by its index, so
+// the result does not depend on how the range is split (Sequential == STDThread).
+using RangeBody = std::function<void(Index, Index)>;
+using ParallelFor = std::function<void(Index, Index, const RangeBody&)>;
+
+inline void SequentialFor(Index begin, Index end, const RangeBody& body)
+{
+  if (begin < end)
+  {
+    body(begin, end);
+  }
+}
+
+// Cooperative cancellation and progress, also injected by the VTK layer.
+struct ProgressHooks
+{
+  std::function<void(double)> Progress;   // fraction in [0,1] of the current algorithm
+  std::function<bool()> AbortRequested;   // polled between passes
+
+  void Report(double fraction) const
+  {
+    if (this->Progress)
+    {
+      this->Progress(fraction);
+    }
+  }
+  bool Aborted() const { return this->AbortRequested && this->AbortRequested(); }
+};
+} // namespace topospline

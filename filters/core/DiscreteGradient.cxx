@@ -1,0 +1,274 @@
+#include "DiscreteGradient.h"
+
+#include <algorithm>
+#include <array>
+
+namespace topospline
+{
+namespace
+{
+// A cell of the lower star of vertex v, described by its other vertices sorted from high to
+// low: the key ProcessLowerStars orders its queues by (lexicographic, shorter first).
+struct StarCell
+{
+  Index Id;
+  std::array<Index, 2> Key; // Key[1] == InvalidIndex for edges
+  bool IsEdge;
+  bool Boundary;          // edges only
+  std::array<int, 2> Faces; // triangles only: local indices of its two lower-star edges
+  bool Paired = false;
+};
+
+struct LowerStarProcessor
+{
+  const TriangleMeshTopology& Mesh;
+  VertexOrder Order;
+  DiscreteGradient& Gradient;
+  std::vector<StarCell> Edges;
+  std::vector<StarCell> Triangles;
+  std::vector<int> QueueZero; // local ids: edges as i, triangles as ~i
+  std::vector<int> QueueOne;  // triangles (local ids)
+
+  bool KeyLess(const std::array<Index, 2>& a, const std::array<Index, 2>& b) const
+  {
+    if (a[0] != b[0])
+    {
+      return this->Order.Lower(a[0], b[0]);
+    }
+    if (a[1] == b[1])
+    {
+      return false;
+    }
+    if (a[1] == InvalidIndex)
+    {
+      return true;
+    }
+    if (b[1] == InvalidIndex)
+    {
+      return false;
+    }
+    return this->Order.Lower(a[1], b[1]);
+  }
+  const StarCell& Cell(int local) const { return local >= 0 ? this->Edges[local] : this->Triangles[~local]; }
+
+  // Triangles pair only with interior edges: boundary faces are not candidates.
+  int UnpairedInteriorFaces(const StarCell& tri, int* lastFace) const
+  {
+    int count = 0;
+    for (int f : tri.Faces)
+    {
+      const StarCell& edge = this->Edges[f];
+      if (!edge.Paired && !edge.Boundary)
+      {
+        ++count;
+        *lastFace = f;
+      }
+    }
+    return count;
+  }
+
+  int PopMin(std::vector<int>& queue) const
+  {
+    auto best = queue.begin();
+    for (auto it = queue.begin() + 1; it < queue.end(); ++it)
+    {
+      if (this->KeyLess(this->Cell(*it).Key, this->Cell(*best).Key))
+      {
+        best = it;
+      }
+    }
+    const int local = *best;
+    queue.erase(best);
+    return local;
+  }
+
+  void PushReadyCofaces(int edgeLocal)
+  {
+    for (int t = 0; t < static_cast<int>(this->Triangles.size()); ++t)
+    {
+      const StarCell& tri = this->Triangles[t];
+      if (tri.Paired || (tri.Faces[0] != edgeLocal && tri.Faces[1] != edgeLocal))
+      {
+        continue;
+      }
+      int face;
+      if (this->UnpairedInteriorFaces(tri, &face) == 1 &&
+        std::find(this->QueueOne.begin(), this->QueueOne.end(), t) == this->QueueOne.end())
+      {
+        this->QueueOne.push_back(t);
+      }
+    }
+  }
+
+  void Process(Index v)
+  {
+    const TriangleMeshTopology& mesh = this->Mesh;
+    this->Edges.clear();
+    this->Triangles.clear();
+    auto localEdge = [&](Index e, Index other) {
+      for (int i = 0; i < static_cast<int>(this->Edges.size()); ++i)
+      {
+        if (this->Edges[i].Id == e)
+        {
+          return i;
+        }
+      }
+      StarCell c;
+      c.Id = e;
+      c.Key = { other, InvalidIndex };
+      c.IsEdge = true;
+      c.Boundary = mesh.IsBoundaryEdge(e);
+      this->Edges.push_back(c);
+      return static_cast<int>(this->Edges.size()) - 1;
+    };
+    for (Index i = mesh.VertexTriangleBegin(v); i < mesh.VertexTriangleEnd(v); ++i)
+    {
+      const Index t = mesh.VertexTriangle(i);
+      const auto& tv = mesh.TriangleVertices[t];
+      const auto& te = mesh.TriangleEdges[t];
+      std::array<int, 2> faces{ -1, -1 };
+      std::array<Index, 2> others{};
+      int n = 0;
+      for (int k = 0; k < 3; ++k)
+      {
+        const Index a = tv[k], b = tv[(k + 1) % 3];
+        if (a != v && b != v)
+        {
+          continue;
+        }
+        const Index other = a == v ? b : a;
+        if (this->Order.Lower(other, v))
+        {
+          faces[n] = localEdge(te[k], other);
+        }
+        others[n++] = other;
+      }
+      if (faces[0] >= 0 && faces[1] >= 0)
+      {
+        StarCell c;
+        c.Id = t;
+        c.Key = this->Order.Lower(others[0], others[1]) ? std::array<Index, 2>{ others[1], others[0] } : others;
+        c.IsEdge = false;
+        c.Boundary = false;
+        c.Faces = faces;
+        this->Triangles.push_back(c);
+      }
+    }
+
+    // 1. The vertex pairs with its steepest admissible lower edge (same boundary flag).
+    const bool boundaryVertex = mesh.IsBoundaryVertex(v);
+    int steepest = -1;
+    for (int i = 0; i < static_cast<int>(this->Edges.size()); ++i)
+    {
+      if (this->Edges[i].Boundary == boundaryVertex &&
+        (steepest < 0 || this->KeyLess(this->Edges[i].Key, this->Edges[steepest].Key)))
+      {
+        steepest = i;
+      }
+    }
+    if (steepest >= 0)
+    {
+      this->Edges[steepest].Paired = true;
+      this->Gradient.VertexEdge[v] = this->Edges[steepest].Id;
+      this->Gradient.EdgeVertex[this->Edges[steepest].Id] = v;
+    }
+
+    // 2. Boundary edges cannot pair with triangles: the ones left are boundary saddles.
+    //    Interior edges and triangles go through the two queues of ProcessLowerStars.
+    this->QueueZero.clear();
+    this->QueueOne.clear();
+    for (int i = 0; i < static_cast<int>(this->Edges.size()); ++i)
+    {
+      if (!this->Edges[i].Paired && !this->Edges[i].Boundary)
+      {
+        this->QueueZero.push_back(i);
+      }
+    }
+    for (int t = 0; t < static_cast<int>(this->Triangles.size()); ++t)
+    {
+      int face;
+      const int unpaired = this->UnpairedInteriorFaces(this->Triangles[t], &face);
+      if (unpaired == 1)
+      {
+        this->QueueOne.push_back(t);
+      }
+      else if (unpaired == 0)
+      {
+        this->QueueZero.push_back(~t);
+      }
+    }
+    while (!this->QueueOne.empty() || !this->QueueZero.empty())
+    {
+      while (!this->QueueOne.empty())
+      {
+        const int t = this->PopMin(this->QueueOne);
+        StarCell& tri = this->Triangles[t];
+        int face;
+        if (this->UnpairedInteriorFaces(tri, &face) == 0)
+        {
+          this->QueueZero.push_back(~t);
+          continue;
+        }
+        StarCell& edge = this->Edges[face];
+        edge.Paired = true;
+        tri.Paired = true;
+        this->Gradient.EdgeTriangle[edge.Id] = tri.Id;
+        this->Gradient.TriangleEdge[tri.Id] = edge.Id;
+        this->QueueZero.erase(std::remove(this->QueueZero.begin(), this->QueueZero.end(), face), this->QueueZero.end());
+        this->PushReadyCofaces(face);
+      }
+      if (!this->QueueZero.empty())
+      {
+        const int critical = this->PopMin(this->QueueZero);
+        if (critical >= 0)
+        {
+          // A critical (saddle) edge: stays unpaired; its cofaces may now be ready.
+          this->Edges[critical].Paired = true;
+          this->PushReadyCofaces(critical);
+        }
+        else
+        {
+          this->Triangles[~critical].Paired = true; // a maximum
+        }
+      }
+    }
+  }
+};
+} // namespace
+
+Index DiscreteGradient::EdgeOwner(const TriangleMeshTopology& mesh, const VertexOrder& order, Index e)
+{
+  const auto& ev = mesh.EdgeVertices[e];
+  return order.Lower(ev[0], ev[1]) ? ev[1] : ev[0];
+}
+
+Index DiscreteGradient::TriangleOwner(const TriangleMeshTopology& mesh, const VertexOrder& order, Index t)
+{
+  const auto& tv = mesh.TriangleVertices[t];
+  Index best = tv[0];
+  for (int k = 1; k < 3; ++k)
+  {
+    if (order.Lower(best, tv[k]))
+    {
+      best = tv[k];
+    }
+  }
+  return best;
+}
+
+void DiscreteGradient::Compute(const TriangleMeshTopology& mesh, const double* values, const ParallelFor& parallelFor)
+{
+  this->VertexEdge.assign(mesh.NumberOfVertices(), InvalidIndex);
+  this->EdgeVertex.assign(mesh.NumberOfEdges(), InvalidIndex);
+  this->EdgeTriangle.assign(mesh.NumberOfEdges(), InvalidIndex);
+  this->TriangleEdge.assign(mesh.NumberOfTriangles(), InvalidIndex);
+  // Each lower star owns its cells, so the per-vertex tasks write disjoint slots.
+  parallelFor(0, mesh.NumberOfVertices(), [&](Index begin, Index end) {
+    LowerStarProcessor processor{ mesh, VertexOrder{ values }, *this, {}, {}, {}, {} };
+    for (Index v = begin; v < end; ++v)
+    {
+      processor.Process(v);
+    }
+  });
+}
+} // namespace topospline

@@ -1,0 +1,56 @@
+// Forman discrete gradient of a PL scalar field on a planar triangulation, by Robins, Wood and
+// Sheppard's ProcessLowerStars (PAMI 2011), one independent lower star per vertex.
+//
+// Domain boundary rule (Shivashankar et al.): boundary cells pair only with boundary cells.
+// A boundary vertex pairs only with a boundary edge, and a triangle never pairs with a
+// boundary edge. Consequences, which the rest of the pipeline relies on:
+//  * every V-path that starts on the boundary curve stays on it, so the domain boundary is a
+//    union of descending 1-cells (boundary saddle -> boundary minimum);
+//  * no ascending V-path (triangle -> edge -> triangle) can leave the domain, so every
+//    triangle reaches a maximum inside and every 2-cell is closed by 1-cells.
+// The price: every local extremum of the field restricted to the boundary curve is a
+// critical point of the complex (see docs/ for the discussion of the paper's trig example).
+#pragma once
+
+#include "CoreTypes.h"
+#include "TriangleMeshTopology.h"
+
+#include <vector>
+
+namespace topospline
+{
+// Strict total order on vertices: by value, ties broken by vertex id (simulation of
+// simplicity), so plateaus are handled consistently.
+struct VertexOrder
+{
+  const double* Values;
+  bool Lower(Index a, Index b) const
+  {
+    return this->Values[a] < this->Values[b] || (this->Values[a] == this->Values[b] && a < b);
+  }
+};
+
+class DiscreteGradient
+{
+public:
+  void Compute(const TriangleMeshTopology& mesh, const double* values, const ParallelFor& parallelFor);
+
+  // Pairings; InvalidIndex means "not paired by this relation".
+  std::vector<Index> VertexEdge;   // vertex -> paired edge
+  std::vector<Index> EdgeVertex;   // edge -> paired vertex
+  std::vector<Index> EdgeTriangle; // edge -> paired triangle
+  std::vector<Index> TriangleEdge; // triangle -> paired edge
+
+  bool IsCriticalVertex(Index v) const { return this->VertexEdge[v] == InvalidIndex; }
+  bool IsCriticalEdge(Index e) const
+  {
+    return this->EdgeVertex[e] == InvalidIndex && this->EdgeTriangle[e] == InvalidIndex;
+  }
+  bool IsCriticalTriangle(Index t) const { return this->TriangleEdge[t] == InvalidIndex; }
+
+  // The vertex whose lower star holds the cell (its highest vertex): where a critical cell
+  // is placed in the domain.
+  static Index EdgeOwner(const TriangleMeshTopology& mesh, const VertexOrder& order, Index e);
+  static Index TriangleOwner(const TriangleMeshTopology& mesh, const VertexOrder& order, Index t);
+};
+} // namespace topospline

@@ -1,0 +1,599 @@
+#include "MorseSmaleComplexExtraction.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace topospline
+{
+namespace
+{
+struct UnionFind
+{
+  std::vector<Index> Parent;
+  explicit UnionFind(Index n)
+    : Parent(n)
+  {
+    std::iota(this->Parent.begin(), this->Parent.end(), 0);
+  }
+  Index Find(Index x)
+  {
+    while (this->Parent[x] != x)
+    {
+      this->Parent[x] = this->Parent[this->Parent[x]];
+      x = this->Parent[x];
+    }
+    return x;
+  }
+  void Union(Index a, Index b)
+  {
+    a = this->Find(a);
+    b = this->Find(b);
+    if (a != b)
+    {
+      // The smaller root wins: the result does not depend on the order of the unions.
+      this->Parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+};
+
+// Follows a deterministic successor function until a fixed point, labelling every visited
+// element with the label of the fixed point. Linear overall; `limit` guards against a cycle,
+// which a valid gradient cannot have.
+template <typename Next, typename Terminal>
+bool LabelByFlow(Index n, std::vector<Index>& label, Next next, Terminal terminalLabel)
+{
+  label.assign(n, InvalidIndex);
+  std::vector<Index> path;
+  for (Index start = 0; start < n; ++start)
+  {
+    path.clear();
+    Index x = start;
+    while (label[x] == InvalidIndex)
+    {
+      const Index y = next(x);
+      if (y == InvalidIndex)
+      {
+        label[x] = terminalLabel(x);
+        break;
+      }
+      path.push_back(x);
+      if (static_cast<Index>(path.size()) > n)
+      {
+        return false;
+      }
+      x = y;
+    }
+    for (Index p : path)
+    {
+      label[p] = label[x];
+    }
+  }
+  return true;
+}
+} // namespace
+
+std::array<Index, 3> MorseSmaleComplex::CountByIndex() const
+{
+  std::array<Index, 3> counts{ 0, 0, 0 };
+  for (const auto& cp : this->CriticalPoints)
+  {
+    ++counts[cp.MorseIndex];
+  }
+  return counts;
+}
+
+bool MorseSmaleComplexExtraction::Extract(
+  const PlanarScalarField& field, MorseSmaleComplex& complex, std::string& error)
+{
+  complex = MorseSmaleComplex();
+  const Index nV = static_cast<Index>(field.Values.size());
+  if (nV == 0 || field.Triangles.empty())
+  {
+    error = "the input has no triangles";
+    return false;
+  }
+  if (field.Points.size() != 2 * field.Values.size())
+  {
+    error = "expected one scalar value per point";
+    return false;
+  }
+  for (Index v = 0; v < nV; ++v)
+  {
+    if (!std::isfinite(field.Values[v]))
+    {
+      error = "the scalar field has a non-finite value (NaN or Inf) at point " + std::to_string(v);
+      return false;
+    }
+  }
+  if (!this->Mesh.Build(nV, field.Triangles, this->Parallel, error))
+  {
+    return false;
+  }
+  for (Index v = 0; v < nV; ++v)
+  {
+    if (this->Mesh.VertexTriangleBegin(v) == this->Mesh.VertexTriangleEnd(v))
+    {
+      error = "point " + std::to_string(v) + " is not used by any triangle";
+      return false;
+    }
+  }
+  const TriangleMeshTopology& mesh = this->Mesh;
+  this->Hooks.Report(0.2);
+  if (this->Hooks.Aborted())
+  {
+    error = "aborted";
+    return false;
+  }
+
+  const double* f = field.Values.data();
+  const VertexOrder order{ f };
+  this->Gradient.Compute(mesh, f, this->Parallel);
+  const DiscreteGradient& grad = this->Gradient;
+  this->Hooks.Report(0.5);
+  if (this->Hooks.Aborted())
+  {
+    error = "aborted";
+    return false;
+  }
+
+  // Critical points, in an order that depends only on the data (stable ids).
+  auto& cps = complex.CriticalPoints;
+  for (Index v = 0; v < nV; ++v)
+  {
+    if (grad.IsCriticalVertex(v))
+    {
+      cps.push_back({ InvalidIndex, 0, v, v, f[v], mesh.IsBoundaryVertex(v) });
+    }
+  }
+  for (Index e = 0; e < mesh.NumberOfEdges(); ++e)
+  {
+    if (grad.IsCriticalEdge(e))
+    {
+      const Index o = DiscreteGradient::EdgeOwner(mesh, order, e);
+      cps.push_back({ InvalidIndex, 1, o, e, f[o], mesh.IsBoundaryEdge(e) });
+    }
+  }
+  for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
+  {
+    if (grad.IsCriticalTriangle(t))
+    {
+      const Index o = DiscreteGradient::TriangleOwner(mesh, order, t);
+      // A maximum lies on the boundary when its triangle touches it.
+      bool onBoundary = false;
+      for (Index e : mesh.TriangleEdges[t])
+      {
+        onBoundary = onBoundary || mesh.IsBoundaryEdge(e);
+      }
+      cps.push_back({ InvalidIndex, 2, o, t, f[o], onBoundary });
+    }
+  }
+  std::sort(cps.begin(), cps.end(), [](const CriticalPoint& a, const CriticalPoint& b) {
+    if (a.MorseIndex != b.MorseIndex)
+    {
+      return a.MorseIndex < b.MorseIndex;
+    }
+    return a.Vertex != b.Vertex ? a.Vertex < b.Vertex : a.Cell < b.Cell;
+  });
+  std::vector<Index> minimumOfVertex(nV, InvalidIndex);
+  std::vector<Index> maximumOfTriangle(mesh.NumberOfTriangles(), InvalidIndex);
+  std::vector<Index> saddles;
+  for (Index id = 0; id < static_cast<Index>(cps.size()); ++id)
+  {
+    cps[id].Id = id;
+    if (cps[id].MorseIndex == 0)
+    {
+      minimumOfVertex[cps[id].Cell] = id;
+    }
+    else if (cps[id].MorseIndex == 1)
+    {
+      saddles.push_back(id);
+    }
+    else
+    {
+      maximumOfTriangle[cps[id].Cell] = id;
+    }
+  }
+
+  // Ascending manifolds (per vertex: the minimum its V-path reaches) and descending manifolds
+  // (per triangle: the maximum its dual V-path reaches).
+  auto nextVertex = [&](Index v) {
+    const Index e = grad.VertexEdge[v];
+    return e == InvalidIndex ? InvalidIndex : mesh.OtherEdgeVertex(e, v);
+  };
+  auto nextTriangle = [&](Index t) {
+    const Index e = grad.TriangleEdge[t];
+    return e == InvalidIndex ? InvalidIndex : mesh.OtherEdgeTriangle(e, t);
+  };
+  std::vector<Index> triangleMaximum;
+  if (!LabelByFlow(nV, complex.AscendingManifold, nextVertex, [&](Index v) { return minimumOfVertex[v]; }) ||
+    !LabelByFlow(mesh.NumberOfTriangles(), triangleMaximum, nextTriangle,
+      [&](Index t) { return maximumOfTriangle[t]; }))
+  {
+    error = "internal error: the discrete gradient has a cycle";
+    return false;
+  }
+  this->Hooks.Report(0.65);
+
+  // Separatrices: two descending and up to two ascending V-paths per saddle. Slots are fixed
+  // per saddle so the parallel tracing writes disjoint entries.
+  const Index nS = static_cast<Index>(saddles.size());
+  std::vector<Separatrix> slots(4 * static_cast<size_t>(nS));
+  std::vector<unsigned char> traced(4 * static_cast<size_t>(nS), 0);
+  auto point = [&](Index v, std::vector<double>& pts) {
+    pts.push_back(field.Points[2 * v]);
+    pts.push_back(field.Points[2 * v + 1]);
+  };
+  bool cycle = false;
+  this->Parallel(0, nS, [&](Index begin, Index end) {
+    for (Index k = begin; k < end; ++k)
+    {
+      const CriticalPoint& saddle = cps[saddles[k]];
+      const Index e = saddle.Cell;
+      const Index owner = saddle.Vertex;
+      for (int side = 0; side < 2; ++side)
+      {
+        Separatrix& arc = slots[4 * k + side];
+        arc.Type = Separatrix::Descending;
+        arc.Destination = saddles[k];
+        std::vector<Index> cells{ owner };
+        Index u = mesh.EdgeVertices[e][side];
+        if (u != owner)
+        {
+          cells.push_back(u);
+        }
+        while (nextVertex(u) != InvalidIndex && static_cast<Index>(cells.size()) <= nV)
+        {
+          u = nextVertex(u);
+          cells.push_back(u);
+        }
+        cycle = cycle || nextVertex(u) != InvalidIndex;
+        arc.Source = minimumOfVertex[u];
+        arc.MeshCells.assign(cells.rbegin(), cells.rend());
+        for (Index v : arc.MeshCells)
+        {
+          point(v, arc.Points);
+          arc.Values.push_back(f[v]);
+        }
+        traced[4 * k + side] = 1;
+      }
+      for (int side = 0; side < 2; ++side)
+      {
+        Index t = mesh.EdgeTriangles[e][side];
+        if (t == InvalidIndex)
+        {
+          continue;
+        }
+        Separatrix& arc = slots[4 * k + 2 + side];
+        arc.Type = Separatrix::Ascending;
+        arc.Source = saddles[k];
+        point(owner, arc.Points);
+        arc.Values.push_back(f[owner]);
+        arc.MeshCells.push_back(t);
+        while (nextTriangle(t) != InvalidIndex && static_cast<Index>(arc.MeshCells.size()) <= mesh.NumberOfTriangles())
+        {
+          t = nextTriangle(t);
+          arc.MeshCells.push_back(t);
+        }
+        cycle = cycle || nextTriangle(t) != InvalidIndex;
+        for (Index cell : arc.MeshCells)
+        {
+          const auto& tv = mesh.TriangleVertices[cell];
+          double c[2] = { 0, 0 };
+          double value = 0;
+          for (Index v : tv)
+          {
+            c[0] += field.Points[2 * v] / 3;
+            c[1] += field.Points[2 * v + 1] / 3;
+            value += f[v] / 3;
+          }
+          arc.Points.push_back(c[0]);
+          arc.Points.push_back(c[1]);
+          arc.Values.push_back(value);
+        }
+        arc.Destination = maximumOfTriangle[t];
+        const Index top = cps[arc.Destination].Vertex;
+        point(top, arc.Points);
+        arc.Values.push_back(f[top]);
+        traced[4 * k + 2 + side] = 1;
+      }
+    }
+  });
+  if (cycle)
+  {
+    error = "internal error: the discrete gradient has a cycle";
+    return false;
+  }
+  std::vector<Index> arcOfSlot(slots.size(), InvalidIndex);
+  for (size_t s = 0; s < slots.size(); ++s)
+  {
+    if (traced[s])
+    {
+      arcOfSlot[s] = static_cast<Index>(complex.Separatrices.size());
+      complex.Separatrices.push_back(std::move(slots[s]));
+    }
+  }
+  this->Hooks.Report(0.8);
+
+  // 2-cells. A 2-cell is a region of vertices that no separatrix crosses. Cut the mesh along
+  // the separatrices: vertices of descending 1-cells and of maximum triangles join no region
+  // directly, and edges that an ascending 1-cell crosses join nothing. Descending 1-cells
+  // bound the descending manifolds, so each region lies in one of them; its maximum is read
+  // from the sectors. (Per-vertex labels alone are not enough: both sides of a 1-cell can
+  // flow to the same extrema, e.g. next to a saddle whose descending 1-cells share a minimum.)
+  std::vector<unsigned char> onSeparatrix(nV, 0);
+  std::vector<unsigned char> crossed(mesh.NumberOfEdges(), 0);
+  for (const Separatrix& arc : complex.Separatrices)
+  {
+    if (arc.Type == Separatrix::Descending)
+    {
+      for (Index v : arc.MeshCells)
+      {
+        onSeparatrix[v] = 1;
+      }
+    }
+    else
+    {
+      crossed[cps[arc.Source].Cell] = 1;
+      for (size_t i = 0; i + 1 < arc.MeshCells.size(); ++i)
+      {
+        crossed[grad.TriangleEdge[arc.MeshCells[i]]] = 1;
+      }
+    }
+  }
+  for (const CriticalPoint& cp : cps)
+  {
+    if (cp.MorseIndex == 2)
+    {
+      for (Index v : mesh.TriangleVertices[cp.Cell])
+      {
+        onSeparatrix[v] = 1;
+      }
+    }
+  }
+  auto sameLabels = [&](Index a, Index b) {
+    return complex.AscendingManifold[a] == complex.AscendingManifold[b];
+  };
+  UnionFind components(nV);
+  for (Index e = 0; e < mesh.NumberOfEdges(); ++e)
+  {
+    const Index a = mesh.EdgeVertices[e][0], b = mesh.EdgeVertices[e][1];
+    if (!crossed[e] && !onSeparatrix[a] && !onSeparatrix[b] && sameLabels(a, b))
+    {
+      components.Union(a, b);
+    }
+  }
+
+  // Each saddle opens into 4 sectors (2 on the boundary), each between one descending and
+  // one ascending separatrix: a corner of one 2-cell. That 2-cell runs along the whole
+  // ascending separatrix on the side of the descending one, so walk the ascending path,
+  // tracking which endpoint of each crossed edge is on that side, and take the region of the
+  // first such vertex that is off the separatrices and carries the sector's labels.
+  struct Sector
+  {
+    Index Saddle, Descending, Ascending, Component;
+  };
+  std::vector<Sector> sectors;
+  for (Index k = 0; k < nS; ++k)
+  {
+    const CriticalPoint& saddle = cps[saddles[k]];
+    const Index e = saddle.Cell;
+    for (int tside = 0; tside < 2; ++tside)
+    {
+      const Index ascending = arcOfSlot[4 * k + 2 + tside];
+      if (ascending == InvalidIndex)
+      {
+        continue;
+      }
+      const Separatrix& up = complex.Separatrices[ascending];
+      for (int dside = 0; dside < 2; ++dside)
+      {
+        Sector sector{ saddles[k], arcOfSlot[4 * k + dside], ascending, InvalidIndex };
+        const Index m = complex.Separatrices[sector.Descending].Source;
+        auto accept = [&](Index w) {
+          if (!onSeparatrix[w] && complex.AscendingManifold[w] == m)
+          {
+            sector.Component = components.Find(w);
+            return true;
+          }
+          return false;
+        };
+        Index near = mesh.EdgeVertices[e][dside], far = mesh.EdgeVertices[e][1 - dside];
+        bool found = accept(near);
+        for (size_t i = 0; !found && i + 1 < up.MeshCells.size(); ++i)
+        {
+          const Index crossing = grad.TriangleEdge[up.MeshCells[i]];
+          const Index p = mesh.EdgeVertices[crossing][0], q = mesh.EdgeVertices[crossing][1];
+          if (p == near || q == near)
+          {
+            far = p == near ? q : p;
+          }
+          else
+          {
+            near = p == far ? q : p;
+            found = accept(near);
+          }
+        }
+        sectors.push_back(sector);
+      }
+    }
+  }
+
+  // Pair sectors into 2-cells. Two sectors form a 2-cell when they share (minimum, maximum)
+  // and open into the same region. A cell thinner than the mesh may have no region (no vertex
+  // off its separatrices) or fall apart into two: within a (minimum, maximum) group, the
+  // sectors left over after pairing by region pair up when exactly two are left.
+  std::vector<Index> bySector(sectors.size());
+  std::iota(bySector.begin(), bySector.end(), 0);
+  auto groupKey = [&](Index i) {
+    return std::make_pair(complex.Separatrices[sectors[i].Descending].Source,
+      complex.Separatrices[sectors[i].Ascending].Destination);
+  };
+  std::stable_sort(bySector.begin(), bySector.end(), [&](Index a, Index b) {
+    const auto ka = groupKey(a), kb = groupKey(b);
+    if (ka != kb)
+    {
+      return ka < kb;
+    }
+    return sectors[a].Component < sectors[b].Component;
+  });
+  std::vector<std::array<Index, 2>> cellSectors;
+  std::vector<Index> unpairedSectors;
+  for (size_t i = 0; i < bySector.size();)
+  {
+    size_t j = i;
+    while (j < bySector.size() && groupKey(bySector[j]) == groupKey(bySector[i]))
+    {
+      ++j;
+    }
+    std::vector<Index> leftover;
+    for (size_t k = i; k < j;)
+    {
+      size_t l = k;
+      while (l < j && sectors[bySector[l]].Component == sectors[bySector[k]].Component)
+      {
+        ++l;
+      }
+      if (l - k == 2 && sectors[bySector[k]].Component != InvalidIndex)
+      {
+        cellSectors.push_back({ bySector[k], bySector[k + 1] });
+      }
+      else
+      {
+        leftover.insert(leftover.end(), bySector.begin() + k, bySector.begin() + l);
+      }
+      k = l;
+    }
+    if (leftover.size() == 2)
+    {
+      cellSectors.push_back({ leftover[0], leftover[1] });
+    }
+    else
+    {
+      unpairedSectors.insert(unpairedSectors.end(), leftover.begin(), leftover.end());
+    }
+    i = j;
+  }
+  // Cells in the order of their first sector: an order fixed by the saddles' ids.
+  for (auto& pair : cellSectors)
+  {
+    if (pair[1] < pair[0])
+    {
+      std::swap(pair[0], pair[1]);
+    }
+  }
+  std::sort(cellSectors.begin(), cellSectors.end());
+  std::vector<Index> cellOfRoot(nV, InvalidIndex);
+  for (const auto& pair : cellSectors)
+  {
+    TwoCell cell;
+    for (int k = 0; k < 2; ++k)
+    {
+      const Sector& sector = sectors[pair[k]];
+      cell.Saddles[k] = sector.Saddle;
+      cell.Arcs[2 * k] = sector.Descending;
+      cell.Arcs[2 * k + 1] = sector.Ascending;
+      if (sector.Component != InvalidIndex)
+      {
+        cellOfRoot[sector.Component] = static_cast<Index>(complex.TwoCells.size());
+      }
+    }
+    cell.Sectors = 2;
+    cell.Minimum = complex.Separatrices[cell.Arcs[0]].Source;
+    cell.Maximum = complex.Separatrices[cell.Arcs[1]].Destination;
+    cell.Pouch = cell.Saddles[0] == cell.Saddles[1];
+    complex.TwoCells.push_back(cell);
+  }
+  // A sector that found no partner still bounds a region of the domain: keep it as a cell
+  // with one sector, so that nothing is silently dropped (tests flag such cells).
+  for (Index i : unpairedSectors)
+  {
+    const Sector& sector = sectors[i];
+    TwoCell cell;
+    cell.Saddles[0] = sector.Saddle;
+    cell.Arcs[0] = sector.Descending;
+    cell.Arcs[1] = sector.Ascending;
+    cell.Sectors = 1;
+    cell.Minimum = complex.Separatrices[sector.Descending].Source;
+    cell.Maximum = complex.Separatrices[sector.Ascending].Destination;
+    if (sector.Component != InvalidIndex && cellOfRoot[sector.Component] == InvalidIndex)
+    {
+      cellOfRoot[sector.Component] = static_cast<Index>(complex.TwoCells.size());
+    }
+    complex.TwoCells.push_back(cell);
+  }
+
+  // Every vertex joins a 2-cell: vertices of regions get their cell; the rest (separatrix
+  // vertices, slivers) join a neighbouring cell, first through neighbours flowing to the same
+  // minimum, then through any neighbour.
+  complex.TwoCellId.assign(nV, InvalidIndex);
+  std::vector<Index> queue;
+  queue.reserve(nV);
+  for (Index v = 0; v < nV; ++v)
+  {
+    complex.TwoCellId[v] = cellOfRoot[components.Find(v)];
+    if (complex.TwoCellId[v] != InvalidIndex)
+    {
+      queue.push_back(v);
+    }
+  }
+  for (int pass = 0; pass < 2; ++pass)
+  {
+    if (pass == 1)
+    {
+      queue.clear();
+      for (Index v = 0; v < nV; ++v)
+      {
+        if (complex.TwoCellId[v] != InvalidIndex)
+        {
+          queue.push_back(v);
+        }
+      }
+    }
+    for (size_t head = 0; head < queue.size(); ++head)
+    {
+      const Index u = queue[head];
+      for (Index i = mesh.VertexTriangleBegin(u); i < mesh.VertexTriangleEnd(u); ++i)
+      {
+        for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
+        {
+          if (complex.TwoCellId[w] == InvalidIndex && (pass == 1 || sameLabels(u, w)))
+          {
+            complex.TwoCellId[w] = complex.TwoCellId[u];
+            queue.push_back(w);
+          }
+        }
+      }
+    }
+  }
+  for (Index v = 0; v < nV; ++v)
+  {
+    TwoCell& cell = complex.TwoCells[complex.TwoCellId[v]];
+    ++cell.NumberOfVertices;
+    cell.Centroid[0] += field.Points[2 * v];
+    cell.Centroid[1] += field.Points[2 * v + 1];
+  }
+  complex.DescendingManifold.resize(nV);
+  for (Index v = 0; v < nV; ++v)
+  {
+    complex.DescendingManifold[v] = complex.TwoCells[complex.TwoCellId[v]].Maximum;
+  }
+  for (TwoCell& cell : complex.TwoCells)
+  {
+    if (cell.NumberOfVertices > 0)
+    {
+      cell.Centroid[0] /= cell.NumberOfVertices;
+      cell.Centroid[1] /= cell.NumberOfVertices;
+    }
+    else
+    {
+      // A cell with no vertex of its own: place it at its first saddle.
+      const Index v = cps[cell.Saddles[0]].Vertex;
+      cell.Centroid[0] = field.Points[2 * v];
+      cell.Centroid[1] = field.Points[2 * v + 1];
+    }
+  }
+  this->Hooks.Report(1.0);
+  return true;
+}
+} // namespace topospline

@@ -1,0 +1,100 @@
+#include "SyntheticFields.h"
+
+#include <cmath>
+
+namespace topospline
+{
+namespace
+{
+// SplitMix64: tiny, well-distributed and identical everywhere.
+struct SplitMix64
+{
+  std::uint64_t State;
+  std::uint64_t Next()
+  {
+    std::uint64_t z = (this->State += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  }
+  double Uniform() { return static_cast<double>(this->Next() >> 11) * 0x1.0p-53; }
+};
+} // namespace
+
+GridField ShepardField(int sites, double power, int resolution, std::uint64_t seed, const ParallelFor& parallelFor)
+{
+  GridField grid;
+  grid.Dimensions[0] = grid.Dimensions[1] = resolution;
+  grid.Values.assign(static_cast<size_t>(resolution) * resolution, 0.0);
+  SplitMix64 random{ seed };
+  const double extent = resolution - 1;
+  std::vector<double> sx(sites), sy(sites), sv(sites);
+  for (int k = 0; k < sites; ++k)
+  {
+    sx[k] = random.Uniform() * extent;
+    sy[k] = random.Uniform() * extent;
+    sv[k] = random.Uniform();
+  }
+  const double halfPower = 0.5 * power;
+  parallelFor(0, resolution, [&](Index begin, Index end) {
+    for (Index j = begin; j < end; ++j)
+    {
+      for (int i = 0; i < resolution; ++i)
+      {
+        double numerator = 0, denominator = 0, exact = -1;
+        for (int k = 0; k < sites && exact < 0; ++k)
+        {
+          const double d2 = (i - sx[k]) * (i - sx[k]) + (j - sy[k]) * (j - sy[k]);
+          if (d2 == 0)
+          {
+            exact = sv[k];
+            break;
+          }
+          const double w = power == 2 ? 1.0 / d2 : std::pow(d2, -halfPower);
+          numerator += w * sv[k];
+          denominator += w;
+        }
+        grid.Values[static_cast<size_t>(j) * resolution + i] = exact >= 0 ? exact : numerator / denominator;
+      }
+    }
+  });
+  return grid;
+}
+
+GridField TrigonometricField(double amplitude, int resolution, double origin)
+{
+  GridField grid;
+  grid.Dimensions[0] = grid.Dimensions[1] = resolution;
+  grid.Origin[0] = grid.Origin[1] = origin;
+  grid.Values.resize(static_cast<size_t>(resolution) * resolution);
+  for (int j = 0; j < resolution; ++j)
+  {
+    for (int i = 0; i < resolution; ++i)
+    {
+      const double x = origin + i, y = origin + j;
+      grid.Values[static_cast<size_t>(j) * resolution + i] =
+        amplitude * std::sin(x / amplitude) * std::sin(y / amplitude);
+    }
+  }
+  return grid;
+}
+
+std::vector<Index> GridTriangles(int nx, int ny)
+{
+  std::vector<Index> triangles;
+  if (nx < 2 || ny < 2)
+  {
+    return triangles;
+  }
+  triangles.reserve(6 * static_cast<size_t>(nx - 1) * (ny - 1));
+  for (int j = 0; j + 1 < ny; ++j)
+  {
+    for (int i = 0; i + 1 < nx; ++i)
+    {
+      const Index p00 = j * nx + i, p10 = p00 + 1, p01 = p00 + nx, p11 = p01 + 1;
+      triangles.insert(triangles.end(), { p00, p10, p01, p10, p11, p01 });
+    }
+  }
+  return triangles;
+}
+} // namespace topospline

@@ -1,0 +1,60 @@
+// Edge and incidence structure of a planar triangulation, built once per input and shared by
+// the discrete gradient, the 1-cell tracing and the segmentation.
+#pragma once
+
+#include "CoreTypes.h"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace topospline
+{
+class TriangleMeshTopology
+{
+public:
+  // triangles: 3 vertex ids per triangle. Returns false and fills `error` for meshes the
+  // Morse-Smale machinery cannot handle (degenerate triangles, edges with 3+ triangles).
+  bool Build(Index numberOfVertices, const std::vector<Index>& triangles, const ParallelFor& parallelFor,
+    std::string& error);
+
+  Index NumberOfVertices() const { return this->NumVertices; }
+  Index NumberOfEdges() const { return static_cast<Index>(this->EdgeVertices.size()); }
+  Index NumberOfTriangles() const { return static_cast<Index>(this->TriangleVertices.size()); }
+
+  bool IsBoundaryEdge(Index e) const { return this->EdgeTriangles[e][1] == InvalidIndex; }
+  bool IsBoundaryVertex(Index v) const { return this->BoundaryVertex[v] != 0; }
+  Index OtherEdgeVertex(Index e, Index v) const
+  {
+    return this->EdgeVertices[e][0] == v ? this->EdgeVertices[e][1] : this->EdgeVertices[e][0];
+  }
+  Index OtherEdgeTriangle(Index e, Index t) const
+  {
+    return this->EdgeTriangles[e][0] == t ? this->EdgeTriangles[e][1] : this->EdgeTriangles[e][0];
+  }
+  // Triangles incident to vertex v: [VertexTriangles + begin, + end).
+  Index VertexTriangleBegin(Index v) const { return this->VertexTriangleOffsets[v]; }
+  Index VertexTriangleEnd(Index v) const { return this->VertexTriangleOffsets[v + 1]; }
+  Index VertexTriangle(Index i) const { return this->VertexTriangles[i]; }
+  // Edge joining a and b, or InvalidIndex.
+  Index FindEdge(Index a, Index b) const;
+  // Number of connected components of the vertex graph; the Euler characteristic V - E + T.
+  long long EulerCharacteristic() const
+  {
+    return static_cast<long long>(this->NumVertices) - this->NumberOfEdges() + this->NumberOfTriangles();
+  }
+
+  std::vector<std::array<Index, 3>> TriangleVertices;
+  std::vector<std::array<Index, 3>> TriangleEdges; // edge opposite nothing: (v0v1, v1v2, v2v0)
+  std::vector<std::array<Index, 2>> EdgeVertices;  // sorted: [0] < [1]
+  std::vector<std::array<Index, 2>> EdgeTriangles; // [1] == InvalidIndex on the domain boundary
+  std::vector<unsigned char> BoundaryVertex;
+
+private:
+  Index NumVertices = 0;
+  std::vector<Index> VertexTriangleOffsets;
+  std::vector<Index> VertexTriangles;
+  // Edges (v, w) with w > v are numbered consecutively per v: [EdgeOffsets[v], EdgeOffsets[v+1]).
+  std::vector<Index> EdgeOffsets;
+};
+} // namespace topospline
