@@ -151,7 +151,7 @@ bool MorseSmaleComplexExtraction::Extract(
     if (grad.IsCriticalEdge(e))
     {
       const Index o = DiscreteGradient::EdgeOwner(mesh, order, e);
-      cps.push_back({ InvalidIndex, 1, o, e, f[o], mesh.IsBoundaryEdge(e) });
+      cps.push_back({ InvalidIndex, 1, o, e, f[o], mesh.IsBoundaryVertex(o) });
     }
   }
   for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
@@ -159,13 +159,7 @@ bool MorseSmaleComplexExtraction::Extract(
     if (grad.IsCriticalTriangle(t))
     {
       const Index o = DiscreteGradient::TriangleOwner(mesh, order, t);
-      // A maximum lies on the boundary when its triangle touches it.
-      bool onBoundary = false;
-      for (Index e : mesh.TriangleEdges[t])
-      {
-        onBoundary = onBoundary || mesh.IsBoundaryEdge(e);
-      }
-      cps.push_back({ InvalidIndex, 2, o, t, f[o], onBoundary });
+      cps.push_back({ InvalidIndex, 2, o, t, f[o], mesh.IsBoundaryVertex(o) });
     }
   }
   std::sort(cps.begin(), cps.end(), [](const CriticalPoint& a, const CriticalPoint& b) {

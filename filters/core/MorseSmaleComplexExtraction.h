@@ -27,7 +27,7 @@ struct CriticalPoint
   Index Vertex = InvalidIndex;  // where it sits: the highest vertex of its critical cell
   Index Cell = InvalidIndex;    // the critical vertex, edge or triangle
   double Value = 0;
-  bool OnBoundary = false;
+  bool OnBoundary = false;     // its vertex lies on the domain boundary
 };
 
 // A separatrix between a lower-index source and a higher-index destination critical point.

@@ -1,0 +1,51 @@
+// Names of the blocks and arrays TopoSpline filters produce, defined once: downstream
+// filters, tests and states rely on them, so never rename one that has shipped.
+#pragma once
+
+namespace vtkTopoSplineArrayNames
+{
+// Blocks of the complex (a vtkMultiBlockDataSet, in this order).
+constexpr const char* CriticalPointsBlock = "Critical Points";
+constexpr const char* SeparatricesBlock = "1-Cells";
+constexpr const char* TwoCellsBlock = "2-Cells";
+constexpr const char* SegmentationBlock = "Segmentation";
+enum BlockIndex
+{
+  CriticalPointsIndex = 0,
+  SeparatricesIndex = 1,
+  TwoCellsIndex = 2,
+  SegmentationIndex = 3,
+  NumberOfBlocks = 4
+};
+
+// Critical points (point data of the "Critical Points" block).
+constexpr const char* CriticalPointId = "CriticalPointId";
+constexpr const char* CriticalIndex = "CriticalIndex";
+constexpr const char* CriticalValue = "CriticalValue";
+constexpr const char* VertexId = "VertexId";
+constexpr const char* IsOnBoundary = "IsOnBoundary";
+
+// 1-cells (cell data of the "1-Cells" block; point data: the scalar along the 1-cell).
+constexpr const char* SeparatrixId = "SeparatrixId";
+constexpr const char* SourceId = "SourceId";
+constexpr const char* DestinationId = "DestinationId";
+constexpr const char* SeparatrixType = "SeparatrixType"; // 0 descending (min-saddle), 1 ascending
+constexpr const char* ScalarAlong = "ScalarValue";
+constexpr const char* MeshCellId = "MeshCellId"; // vertex (descending) or triangle (ascending) id
+
+// 2-cells (point data of the "2-Cells" block: one point per cell, at its centroid).
+constexpr const char* TwoCellId = "TwoCellId";
+constexpr const char* MinimumId = "MinimumId";
+constexpr const char* MaximumId = "MaximumId";
+constexpr const char* SaddleIds = "SaddleIds";             // 2 components
+constexpr const char* BoundarySeparatrices = "BoundarySeparatrixIds"; // 4 components
+constexpr const char* IsPouch = "IsPouch";
+constexpr const char* NumberOfVertices = "NumberOfVertices";
+
+// Segmentation (point data of the input geometry).
+constexpr const char* AscendingManifoldId = "AscendingManifoldId";
+constexpr const char* DescendingManifoldId = "DescendingManifoldId";
+
+// Field data of the complex: which input array it was computed from.
+constexpr const char* ScalarFieldName = "TopoSplineScalarField";
+}

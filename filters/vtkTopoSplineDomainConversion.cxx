@@ -1,0 +1,612 @@
+#include "vtkTopoSplineDomainConversion.h"
+
+#include "vtkTopoSplineArrayNames.h"
+
+#include "SyntheticFields.h" // core: GridTriangles
+
+#include <vtkArrayDispatch.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkCharArray.h>
+#include <vtkDataArrayRange.h>
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkIdList.h>
+#include <vtkIdTypeArray.h>
+#include <vtkImageData.h>
+#include <vtkInformation.h>
+#include <vtkIntArray.h>
+#include <vtkMultiBlockDataSet.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkSMPTools.h>
+#include <vtkSmartPointer.h>
+#include <vtkStringArray.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace names = vtkTopoSplineArrayNames;
+using topospline::Index;
+
+namespace
+{
+// Which two coordinate axes span the plane of the domain, and where the third one sits.
+struct PlanarEmbedding
+{
+  int U = 0, V = 1, W = 2;
+  double WValue = 0;
+  void To3D(const double* uv, double xyz[3]) const
+  {
+    xyz[this->U] = uv[0];
+    xyz[this->V] = uv[1];
+    xyz[this->W] = this->WValue;
+  }
+};
+
+bool DetectEmbedding(vtkDataSet* data, PlanarEmbedding& embedding)
+{
+  double bounds[6];
+  data->GetBounds(bounds);
+  for (int w = 2; w >= 0; --w)
+  {
+    if (bounds[2 * w + 1] - bounds[2 * w] == 0.0)
+    {
+      embedding.W = w;
+      embedding.U = w == 0 ? 1 : 0;
+      embedding.V = w == 2 ? 1 : 2;
+      embedding.WValue = bounds[2 * w];
+      return true;
+    }
+  }
+  return false;
+}
+
+struct CopyToDouble
+{
+  template <typename ArrayT>
+  void operator()(ArrayT* array, std::vector<double>& out) const
+  {
+    const auto values = vtk::DataArrayValueRange<1>(array);
+    std::copy(values.begin(), values.end(), out.begin());
+  }
+};
+
+template <typename ArrayT>
+vtkSmartPointer<ArrayT> MakeArray(const char* name, int components, vtkIdType tuples)
+{
+  auto array = vtkSmartPointer<ArrayT>::New();
+  array->SetName(name);
+  array->SetNumberOfComponents(components);
+  array->SetNumberOfTuples(tuples);
+  return array;
+}
+
+vtkDataArray* RequireArray(vtkFieldData* data, const char* name, std::string& error)
+{
+  vtkDataArray* array = data ? data->GetArray(name) : nullptr;
+  if (!array && error.empty())
+  {
+    error = std::string("array \"") + name + "\" is missing";
+  }
+  return array;
+}
+} // namespace
+
+namespace vtkTopoSplineDomainConversion
+{
+topospline::ParallelFor SMPParallelFor()
+{
+  return [](Index begin, Index end, const topospline::RangeBody& body) {
+    vtkSMPTools::For(begin, end, [&](vtkIdType b, vtkIdType e) { body(static_cast<Index>(b), static_cast<Index>(e)); });
+  };
+}
+
+vtkDataArray* SelectedPointScalars(vtkDataArray* chosen, vtkInformation* info, vtkDataSet* input)
+{
+  if (chosen)
+  {
+    return chosen;
+  }
+  const char* name = info && info->Has(vtkDataObject::FIELD_NAME()) ? info->Get(vtkDataObject::FIELD_NAME()) : nullptr;
+  if (name && name[0] != '\0')
+  {
+    return nullptr;
+  }
+  vtkPointData* pd = input->GetPointData();
+  if (pd->GetScalars() && pd->GetScalars()->GetNumberOfComponents() == 1)
+  {
+    return pd->GetScalars();
+  }
+  for (int i = 0; i < pd->GetNumberOfArrays(); ++i)
+  {
+    vtkDataArray* array = pd->GetArray(i);
+    if (array && array->GetNumberOfComponents() == 1)
+    {
+      return array;
+    }
+  }
+  return nullptr;
+}
+
+bool ToPlanarScalarField(vtkDataSet* input, vtkDataArray* scalars, topospline::PlanarScalarField& field,
+  std::string& error)
+{
+  field = topospline::PlanarScalarField();
+  const vtkIdType nPoints = input->GetNumberOfPoints();
+  if (nPoints == 0)
+  {
+    error = "the input is empty";
+    return false;
+  }
+  if (!scalars)
+  {
+    error = "no point scalar array selected (the input has no point data array to process)";
+    return false;
+  }
+  if (scalars->GetNumberOfComponents() != 1)
+  {
+    error = std::string("the scalar array \"") + (scalars->GetName() ? scalars->GetName() : "") + "\" has " +
+      std::to_string(scalars->GetNumberOfComponents()) + " components; select a 1-component point array";
+    return false;
+  }
+  if (scalars->GetNumberOfTuples() != nPoints)
+  {
+    error = "the scalar array must be point data (one value per point)";
+    return false;
+  }
+  if (nPoints >= std::numeric_limits<Index>::max() / 4)
+  {
+    error = "the input has too many points (" + std::to_string(nPoints) + ")";
+    return false;
+  }
+
+  field.Values.resize(nPoints);
+  if (!vtkArrayDispatch::DispatchByValueType<vtkArrayDispatch::Reals>::Execute(scalars, CopyToDouble{}, field.Values))
+  {
+    CopyToDouble{}(scalars, field.Values);
+  }
+
+  field.Points.resize(2 * nPoints);
+  if (auto* image = vtkImageData::SafeDownCast(input))
+  {
+    int dims[3];
+    image->GetDimensions(dims);
+    int axes[2], nAxes = 0;
+    for (int a = 0; a < 3; ++a)
+    {
+      if (dims[a] > 1)
+      {
+        if (nAxes == 2)
+        {
+          error = "the image is 3D (" + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
+            std::to_string(dims[2]) + "); TopoSpline works on 2D images (one layer): extract a slice first";
+          return false;
+        }
+        axes[nAxes++] = a;
+      }
+    }
+    if (nAxes < 2)
+    {
+      error = "the image has fewer than two dimensions with more than one point";
+      return false;
+    }
+    const int n0 = dims[axes[0]], n1 = dims[axes[1]];
+    for (vtkIdType id = 0; id < nPoints; ++id)
+    {
+      double p[3];
+      image->GetPoint(id, p);
+      field.Points[2 * id] = p[axes[0]];
+      field.Points[2 * id + 1] = p[axes[1]];
+    }
+    field.Triangles = topospline::GridTriangles(n0, n1);
+    return true;
+  }
+
+  PlanarEmbedding embedding;
+  if (!DetectEmbedding(input, embedding))
+  {
+    error = "the points do not lie in a coordinate plane (x, y or z constant); TopoSpline needs a planar "
+            "triangulation (use the mesh before any Warp By Scalar)";
+    return false;
+  }
+  for (vtkIdType id = 0; id < nPoints; ++id)
+  {
+    double p[3];
+    input->GetPoint(id, p);
+    field.Points[2 * id] = p[embedding.U];
+    field.Points[2 * id + 1] = p[embedding.V];
+  }
+  const vtkIdType nCells = input->GetNumberOfCells();
+  if (nCells == 0)
+  {
+    error = "the input has no cells; TopoSpline needs a triangulation";
+    return false;
+  }
+  field.Triangles.resize(3 * nCells);
+  vtkNew<vtkIdList> ids;
+  for (vtkIdType c = 0; c < nCells; ++c)
+  {
+    const int type = input->GetCellType(c);
+    if (type != VTK_TRIANGLE)
+    {
+      error = "cell " + std::to_string(c) + " is not a triangle (VTK cell type " + std::to_string(type) +
+        "); apply the Triangulate filter first";
+      return false;
+    }
+    input->GetCellPoints(c, ids);
+    for (int k = 0; k < 3; ++k)
+    {
+      field.Triangles[3 * c + k] = static_cast<Index>(ids->GetId(k));
+    }
+  }
+  return true;
+}
+
+void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* domain, const char* scalarName,
+  vtkMultiBlockDataSet* output)
+{
+  PlanarEmbedding embedding;
+  if (!vtkImageData::SafeDownCast(domain))
+  {
+    DetectEmbedding(domain, embedding);
+  }
+  else
+  {
+    int dims[3];
+    vtkImageData::SafeDownCast(domain)->GetDimensions(dims);
+    double origin[3];
+    vtkImageData::SafeDownCast(domain)->GetOrigin(origin);
+    for (int w = 2; w >= 0; --w)
+    {
+      if (dims[w] == 1)
+      {
+        embedding.W = w;
+        embedding.U = w == 0 ? 1 : 0;
+        embedding.V = w == 2 ? 1 : 2;
+        embedding.WValue = origin[w];
+        break;
+      }
+    }
+  }
+  const auto& cps = complex.CriticalPoints;
+
+  // Critical points.
+  vtkNew<vtkPolyData> critical;
+  {
+    const vtkIdType n = static_cast<vtkIdType>(cps.size());
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    points->SetNumberOfPoints(n);
+    vtkNew<vtkCellArray> verts;
+    auto id = MakeArray<vtkIntArray>(names::CriticalPointId, 1, n);
+    auto index = MakeArray<vtkIntArray>(names::CriticalIndex, 1, n);
+    auto value = MakeArray<vtkDoubleArray>(names::CriticalValue, 1, n);
+    auto vertex = MakeArray<vtkIdTypeArray>(names::VertexId, 1, n);
+    auto cell = MakeArray<vtkIdTypeArray>("CriticalCellId", 1, n);
+    auto boundary = MakeArray<vtkCharArray>(names::IsOnBoundary, 1, n);
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      points->SetPoint(i, domain->GetPoint(cps[i].Vertex));
+      verts->InsertNextCell(1, &i);
+      id->SetValue(i, cps[i].Id);
+      index->SetValue(i, cps[i].MorseIndex);
+      value->SetValue(i, cps[i].Value);
+      vertex->SetValue(i, cps[i].Vertex);
+      cell->SetValue(i, cps[i].Cell);
+      boundary->SetValue(i, cps[i].OnBoundary ? 1 : 0);
+    }
+    critical->SetPoints(points);
+    critical->SetVerts(verts);
+    for (vtkDataArray* a : { static_cast<vtkDataArray*>(id), static_cast<vtkDataArray*>(index),
+           static_cast<vtkDataArray*>(value), static_cast<vtkDataArray*>(vertex), static_cast<vtkDataArray*>(cell),
+           static_cast<vtkDataArray*>(boundary) })
+    {
+      critical->GetPointData()->AddArray(a);
+    }
+    critical->GetPointData()->SetActiveScalars(names::CriticalIndex);
+  }
+
+  // 1-cells as polylines.
+  vtkNew<vtkPolyData> separatrices;
+  {
+    vtkIdType nPoints = 0;
+    for (const auto& arc : complex.Separatrices)
+    {
+      nPoints += static_cast<vtkIdType>(arc.Values.size());
+    }
+    const vtkIdType n = static_cast<vtkIdType>(complex.Separatrices.size());
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    points->SetNumberOfPoints(nPoints);
+    vtkNew<vtkCellArray> lines;
+    auto along = MakeArray<vtkDoubleArray>(names::ScalarAlong, 1, nPoints);
+    auto meshCell = MakeArray<vtkIdTypeArray>(names::MeshCellId, 1, nPoints);
+    auto id = MakeArray<vtkIntArray>(names::SeparatrixId, 1, n);
+    auto source = MakeArray<vtkIntArray>(names::SourceId, 1, n);
+    auto destination = MakeArray<vtkIntArray>(names::DestinationId, 1, n);
+    auto type = MakeArray<vtkIntArray>(names::SeparatrixType, 1, n);
+    vtkIdType next = 0;
+    std::vector<vtkIdType> ids;
+    for (vtkIdType a = 0; a < n; ++a)
+    {
+      const auto& arc = complex.Separatrices[a];
+      const vtkIdType count = static_cast<vtkIdType>(arc.Values.size());
+      // Ascending arcs carry one more point at each end than mesh cells (saddle, maximum).
+      const vtkIdType offset = arc.Type == topospline::Separatrix::Ascending ? 1 : 0;
+      ids.resize(count);
+      for (vtkIdType p = 0; p < count; ++p)
+      {
+        double xyz[3];
+        embedding.To3D(&arc.Points[2 * p], xyz);
+        points->SetPoint(next, xyz);
+        along->SetValue(next, arc.Values[p]);
+        const vtkIdType c = p - offset;
+        meshCell->SetValue(next, c >= 0 && c < static_cast<vtkIdType>(arc.MeshCells.size()) ? arc.MeshCells[c] : -1);
+        ids[p] = next++;
+      }
+      lines->InsertNextCell(count, ids.data());
+      id->SetValue(a, static_cast<int>(a));
+      source->SetValue(a, cps[arc.Source].Id);
+      destination->SetValue(a, cps[arc.Destination].Id);
+      type->SetValue(a, arc.Type);
+    }
+    separatrices->SetPoints(points);
+    separatrices->SetLines(lines);
+    separatrices->GetPointData()->AddArray(along);
+    separatrices->GetPointData()->AddArray(meshCell);
+    separatrices->GetPointData()->SetActiveScalars(names::ScalarAlong);
+    for (vtkDataArray* a : { static_cast<vtkDataArray*>(id), static_cast<vtkDataArray*>(source),
+           static_cast<vtkDataArray*>(destination), static_cast<vtkDataArray*>(type) })
+    {
+      separatrices->GetCellData()->AddArray(a);
+    }
+  }
+
+  // 2-cells: one point per cell at its centroid, carrying its corners and sides.
+  vtkNew<vtkPolyData> twoCells;
+  {
+    const vtkIdType n = static_cast<vtkIdType>(complex.TwoCells.size());
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    points->SetNumberOfPoints(n);
+    vtkNew<vtkCellArray> verts;
+    auto id = MakeArray<vtkIntArray>(names::TwoCellId, 1, n);
+    auto minimum = MakeArray<vtkIntArray>(names::MinimumId, 1, n);
+    auto maximum = MakeArray<vtkIntArray>(names::MaximumId, 1, n);
+    auto saddles = MakeArray<vtkIntArray>(names::SaddleIds, 2, n);
+    auto arcs = MakeArray<vtkIntArray>(names::BoundarySeparatrices, 4, n);
+    auto pouch = MakeArray<vtkCharArray>(names::IsPouch, 1, n);
+    auto size = MakeArray<vtkIdTypeArray>(names::NumberOfVertices, 1, n);
+    auto stable = [&](Index cp) { return cp == topospline::InvalidIndex ? -1 : cps[cp].Id; };
+    for (vtkIdType c = 0; c < n; ++c)
+    {
+      const auto& cell = complex.TwoCells[c];
+      double xyz[3];
+      embedding.To3D(cell.Centroid, xyz);
+      points->SetPoint(c, xyz);
+      verts->InsertNextCell(1, &c);
+      id->SetValue(c, static_cast<int>(c));
+      minimum->SetValue(c, stable(cell.Minimum));
+      maximum->SetValue(c, stable(cell.Maximum));
+      saddles->SetTypedComponent(c, 0, stable(cell.Saddles[0]));
+      saddles->SetTypedComponent(c, 1, stable(cell.Saddles[1]));
+      for (int k = 0; k < 4; ++k)
+      {
+        arcs->SetTypedComponent(c, k, cell.Arcs[k]);
+      }
+      pouch->SetValue(c, cell.Pouch ? 1 : 0);
+      size->SetValue(c, cell.NumberOfVertices);
+    }
+    twoCells->SetPoints(points);
+    twoCells->SetVerts(verts);
+    for (vtkDataArray* a : { static_cast<vtkDataArray*>(id), static_cast<vtkDataArray*>(minimum),
+           static_cast<vtkDataArray*>(maximum), static_cast<vtkDataArray*>(saddles),
+           static_cast<vtkDataArray*>(arcs), static_cast<vtkDataArray*>(pouch), static_cast<vtkDataArray*>(size) })
+    {
+      twoCells->GetPointData()->AddArray(a);
+    }
+  }
+
+  // The input geometry with the per-vertex segmentation.
+  vtkSmartPointer<vtkDataSet> segmentation = vtkSmartPointer<vtkDataSet>::Take(domain->NewInstance());
+  segmentation->ShallowCopy(domain);
+  {
+    const vtkIdType n = domain->GetNumberOfPoints();
+    auto ascending = MakeArray<vtkIntArray>(names::AscendingManifoldId, 1, n);
+    auto descending = MakeArray<vtkIntArray>(names::DescendingManifoldId, 1, n);
+    auto cell = MakeArray<vtkIntArray>(names::TwoCellId, 1, n);
+    for (vtkIdType v = 0; v < n; ++v)
+    {
+      ascending->SetValue(v, cps[complex.AscendingManifold[v]].Id);
+      descending->SetValue(v, cps[complex.DescendingManifold[v]].Id);
+      cell->SetValue(v, complex.TwoCellId[v]);
+    }
+    segmentation->GetPointData()->AddArray(ascending);
+    segmentation->GetPointData()->AddArray(descending);
+    segmentation->GetPointData()->AddArray(cell);
+  }
+
+  output->SetNumberOfBlocks(names::NumberOfBlocks);
+  const std::pair<vtkDataObject*, const char*> blocks[] = { { critical, names::CriticalPointsBlock },
+    { separatrices, names::SeparatricesBlock }, { twoCells, names::TwoCellsBlock },
+    { segmentation, names::SegmentationBlock } };
+  for (unsigned int b = 0; b < names::NumberOfBlocks; ++b)
+  {
+    output->SetBlock(b, blocks[b].first);
+    output->GetMetaData(b)->Set(vtkCompositeDataSet::NAME(), blocks[b].second);
+  }
+  vtkNew<vtkStringArray> scalarField;
+  scalarField->SetName(names::ScalarFieldName);
+  scalarField->InsertNextValue(scalarName ? scalarName : "");
+  output->GetFieldData()->AddArray(scalarField);
+}
+
+vtkDataSet* SegmentationOf(vtkMultiBlockDataSet* input)
+{
+  if (!input || input->GetNumberOfBlocks() != names::NumberOfBlocks)
+  {
+    return nullptr;
+  }
+  return vtkDataSet::SafeDownCast(input->GetBlock(names::SegmentationIndex));
+}
+
+bool FromMultiBlock(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& complex, std::string& error)
+{
+  complex = topospline::MorseSmaleComplex();
+  auto* critical = input ? vtkPolyData::SafeDownCast(input->GetBlock(names::CriticalPointsIndex)) : nullptr;
+  auto* separatrices = input ? vtkPolyData::SafeDownCast(input->GetBlock(names::SeparatricesIndex)) : nullptr;
+  auto* twoCells = input ? vtkPolyData::SafeDownCast(input->GetBlock(names::TwoCellsIndex)) : nullptr;
+  vtkDataSet* segmentation = SegmentationOf(input);
+  if (!critical || !separatrices || !twoCells || !segmentation)
+  {
+    error = "the input is not a Morse-Smale complex (expected the output of the \"Morse-Smale Complex\" filter)";
+    return false;
+  }
+  PlanarEmbedding embedding;
+  if (!vtkImageData::SafeDownCast(segmentation) && !DetectEmbedding(segmentation, embedding))
+  {
+    error = "the segmentation block is not planar";
+    return false;
+  }
+  if (auto* image = vtkImageData::SafeDownCast(segmentation))
+  {
+    int dims[3];
+    image->GetDimensions(dims);
+    for (int w = 2; w >= 0; --w)
+    {
+      if (dims[w] == 1)
+      {
+        embedding.W = w;
+        embedding.U = w == 0 ? 1 : 0;
+        embedding.V = w == 2 ? 1 : 2;
+        break;
+      }
+    }
+  }
+
+  auto* pd = critical->GetPointData();
+  vtkDataArray* id = RequireArray(pd, names::CriticalPointId, error);
+  vtkDataArray* index = RequireArray(pd, names::CriticalIndex, error);
+  vtkDataArray* value = RequireArray(pd, names::CriticalValue, error);
+  vtkDataArray* vertex = RequireArray(pd, names::VertexId, error);
+  vtkDataArray* cell = RequireArray(pd, "CriticalCellId", error);
+  vtkDataArray* boundary = RequireArray(pd, names::IsOnBoundary, error);
+  auto* cd = separatrices->GetCellData();
+  vtkDataArray* source = RequireArray(cd, names::SourceId, error);
+  vtkDataArray* destination = RequireArray(cd, names::DestinationId, error);
+  vtkDataArray* type = RequireArray(cd, names::SeparatrixType, error);
+  vtkDataArray* along = RequireArray(separatrices->GetPointData(), names::ScalarAlong, error);
+  vtkDataArray* meshCell = RequireArray(separatrices->GetPointData(), names::MeshCellId, error);
+  auto* sd = segmentation->GetPointData();
+  vtkDataArray* ascending = RequireArray(sd, names::AscendingManifoldId, error);
+  vtkDataArray* descending = RequireArray(sd, names::DescendingManifoldId, error);
+  vtkDataArray* cellId = RequireArray(sd, names::TwoCellId, error);
+  auto* td = twoCells->GetPointData();
+  vtkDataArray* minimum = RequireArray(td, names::MinimumId, error);
+  vtkDataArray* maximum = RequireArray(td, names::MaximumId, error);
+  vtkDataArray* saddles = RequireArray(td, names::SaddleIds, error);
+  vtkDataArray* arcs = RequireArray(td, names::BoundarySeparatrices, error);
+  vtkDataArray* pouch = RequireArray(td, names::IsPouch, error);
+  vtkDataArray* size = RequireArray(td, names::NumberOfVertices, error);
+  if (!error.empty())
+  {
+    error = "the input is not a Morse-Smale complex: " + error;
+    return false;
+  }
+
+  // Stable id -> position in this complex.
+  std::vector<Index> position;
+  const vtkIdType nCP = critical->GetNumberOfPoints();
+  for (vtkIdType i = 0; i < nCP; ++i)
+  {
+    topospline::CriticalPoint cp;
+    cp.Id = static_cast<Index>(id->GetComponent(i, 0));
+    cp.MorseIndex = static_cast<int>(index->GetComponent(i, 0));
+    cp.Value = value->GetComponent(i, 0);
+    cp.Vertex = static_cast<Index>(vertex->GetComponent(i, 0));
+    cp.Cell = static_cast<Index>(cell->GetComponent(i, 0));
+    cp.OnBoundary = boundary->GetComponent(i, 0) != 0;
+    if (cp.Id < 0)
+    {
+      error = "the input is not a Morse-Smale complex: negative critical point id";
+      return false;
+    }
+    if (static_cast<size_t>(cp.Id) >= position.size())
+    {
+      position.resize(cp.Id + 1, topospline::InvalidIndex);
+    }
+    position[cp.Id] = static_cast<Index>(i);
+    complex.CriticalPoints.push_back(cp);
+  }
+  auto local = [&](double stableId) {
+    const auto s = static_cast<long long>(stableId);
+    return s >= 0 && s < static_cast<long long>(position.size()) ? position[s] : topospline::InvalidIndex;
+  };
+
+  vtkCellArray* lines = separatrices->GetLines();
+  vtkNew<vtkIdList> ids;
+  lines->InitTraversal();
+  for (vtkIdType a = 0; lines->GetNextCell(ids); ++a)
+  {
+    topospline::Separatrix arc;
+    arc.Type = type->GetComponent(a, 0) == 0 ? topospline::Separatrix::Descending : topospline::Separatrix::Ascending;
+    arc.Source = local(source->GetComponent(a, 0));
+    arc.Destination = local(destination->GetComponent(a, 0));
+    for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k)
+    {
+      double xyz[3];
+      separatrices->GetPoint(ids->GetId(k), xyz);
+      arc.Points.push_back(xyz[embedding.U]);
+      arc.Points.push_back(xyz[embedding.V]);
+      arc.Values.push_back(along->GetComponent(ids->GetId(k), 0));
+      const auto c = static_cast<Index>(meshCell->GetComponent(ids->GetId(k), 0));
+      if (c >= 0)
+      {
+        arc.MeshCells.push_back(c);
+      }
+    }
+    if (arc.Source == topospline::InvalidIndex || arc.Destination == topospline::InvalidIndex)
+    {
+      error = "the input is not a Morse-Smale complex: a 1-cell refers to a missing critical point";
+      return false;
+    }
+    complex.Separatrices.push_back(std::move(arc));
+  }
+
+  const vtkIdType nCells = twoCells->GetNumberOfPoints();
+  for (vtkIdType c = 0; c < nCells; ++c)
+  {
+    topospline::TwoCell twoCell;
+    twoCell.Minimum = local(minimum->GetComponent(c, 0));
+    twoCell.Maximum = local(maximum->GetComponent(c, 0));
+    twoCell.Saddles = { local(saddles->GetComponent(c, 0)), local(saddles->GetComponent(c, 1)) };
+    for (int k = 0; k < 4; ++k)
+    {
+      twoCell.Arcs[k] = static_cast<Index>(arcs->GetComponent(c, k));
+    }
+    twoCell.Pouch = pouch->GetComponent(c, 0) != 0;
+    twoCell.NumberOfVertices = static_cast<Index>(size->GetComponent(c, 0));
+    double xyz[3];
+    twoCells->GetPoint(c, xyz);
+    twoCell.Centroid[0] = xyz[embedding.U];
+    twoCell.Centroid[1] = xyz[embedding.V];
+    twoCell.Sectors = twoCell.Saddles[1] == topospline::InvalidIndex ? 1 : 2;
+    complex.TwoCells.push_back(twoCell);
+  }
+
+  const vtkIdType nV = segmentation->GetNumberOfPoints();
+  complex.AscendingManifold.resize(nV);
+  complex.DescendingManifold.resize(nV);
+  complex.TwoCellId.resize(nV);
+  for (vtkIdType v = 0; v < nV; ++v)
+  {
+    complex.AscendingManifold[v] = local(ascending->GetComponent(v, 0));
+    complex.DescendingManifold[v] = local(descending->GetComponent(v, 0));
+    complex.TwoCellId[v] = static_cast<Index>(cellId->GetComponent(v, 0));
+  }
+  return true;
+}
+}

@@ -1,0 +1,93 @@
+#include "vtkTopoSplineMorseSmaleComplex.h"
+
+#include "vtkTopoSplineDomainConversion.h"
+
+#include "MorseSmaleComplexExtraction.h" // core
+
+#include <vtkDataArray.h>
+#include <vtkDataObject.h>
+#include <vtkDataSet.h>
+#include <vtkDataSetAttributes.h>
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
+#include <vtkLogger.h>
+#include <vtkMultiBlockDataSet.h>
+#include <vtkObjectFactory.h>
+
+vtkStandardNewMacro(vtkTopoSplineMorseSmaleComplex);
+
+vtkTopoSplineMorseSmaleComplex::vtkTopoSplineMorseSmaleComplex()
+{
+  // Default: the active point scalars.
+  this->SetInputArrayToProcess(
+    0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
+}
+
+int vtkTopoSplineMorseSmaleComplex::FillInputPortInformation(int, vtkInformation* info)
+{
+  info->Remove(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE());
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkUnstructuredGrid");
+  return 1;
+}
+
+int vtkTopoSplineMorseSmaleComplex::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkLogScopeFunction(TRACE);
+  vtkDataSet* input = vtkDataSet::GetData(inputVector[0], 0);
+  vtkMultiBlockDataSet* output = vtkMultiBlockDataSet::GetData(outputVector, 0);
+  if (!input || !output)
+  {
+    vtkErrorMacro("Missing input or output.");
+    return 0;
+  }
+
+  // On bad input: a clear error and an empty output (returning 1 keeps the pipeline alive).
+  vtkDataArray* scalars = vtkTopoSplineDomainConversion::SelectedPointScalars(
+    this->GetInputArrayToProcess(0, inputVector), this->GetInputArrayInformation(0), input);
+  topospline::PlanarScalarField field;
+  std::string error;
+  {
+    vtkLogScopeF(TRACE, "convert input");
+    if (!vtkTopoSplineDomainConversion::ToPlanarScalarField(input, scalars, field, error))
+    {
+      vtkErrorMacro("Morse-Smale Complex: " << error << ".");
+      return 1;
+    }
+  }
+
+  topospline::MorseSmaleComplexExtraction extraction;
+  extraction.Parallel = vtkTopoSplineDomainConversion::SMPParallelFor();
+  // The core reports between its passes, on this thread.
+  extraction.Hooks.Progress = [this](double fraction) { this->UpdateProgress(0.05 + 0.85 * fraction); };
+  extraction.Hooks.AbortRequested = [this]() { return this->GetAbortExecute() != 0; };
+  topospline::MorseSmaleComplex complex;
+  {
+    vtkLogScopeF(TRACE, "extract Morse-Smale complex");
+    if (!extraction.Extract(field, complex, error))
+    {
+      if (error != "aborted")
+      {
+        vtkErrorMacro("Morse-Smale Complex: " << error << ".");
+      }
+      return 1;
+    }
+  }
+  const auto counts = complex.CountByIndex();
+  vtkLog(TRACE, "Morse-Smale complex: " << counts[0] << " minima, " << counts[1] << " saddles, " << counts[2]
+                                       << " maxima, " << complex.Separatrices.size() << " 1-cells, "
+                                       << complex.TwoCells.size() << " 2-cells");
+  {
+    vtkLogScopeF(TRACE, "build output");
+    vtkTopoSplineDomainConversion::ToMultiBlock(complex, input, scalars->GetName(), output);
+  }
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+void vtkTopoSplineMorseSmaleComplex::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+}
