@@ -104,31 +104,34 @@ topospline::ParallelFor SMPParallelFor()
   };
 }
 
-vtkDataArray* SelectedPointScalars(vtkDataArray* chosen, vtkInformation* info, vtkDataSet* input)
+vtkDataArray* SelectedPointScalars(vtkDataArray* chosen, vtkInformation* info, vtkDataSet* input, std::string& note)
 {
   if (chosen)
   {
     return chosen;
   }
   const char* name = info && info->Has(vtkDataObject::FIELD_NAME()) ? info->Get(vtkDataObject::FIELD_NAME()) : nullptr;
-  if (name && name[0] != '\0')
-  {
-    return nullptr;
-  }
   vtkPointData* pd = input->GetPointData();
+  vtkDataArray* fallback = nullptr;
   if (pd->GetScalars() && pd->GetScalars()->GetNumberOfComponents() == 1)
   {
-    return pd->GetScalars();
+    fallback = pd->GetScalars();
   }
-  for (int i = 0; i < pd->GetNumberOfArrays(); ++i)
+  for (int i = 0; !fallback && i < pd->GetNumberOfArrays(); ++i)
   {
     vtkDataArray* array = pd->GetArray(i);
     if (array && array->GetNumberOfComponents() == 1)
     {
-      return array;
+      fallback = array;
     }
   }
-  return nullptr;
+  if (fallback && name && name[0] != '\0')
+  {
+    // ParaView may hand a filter created on a never-updated source a stale array name.
+    note = std::string("point array \"") + name + "\" not found; using \"" +
+      (fallback->GetName() ? fallback->GetName() : "") + "\"";
+  }
+  return fallback;
 }
 
 bool ToPlanarScalarField(vtkDataSet* input, vtkDataArray* scalars, topospline::PlanarScalarField& field,

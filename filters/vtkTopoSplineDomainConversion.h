@@ -17,10 +17,12 @@ namespace vtkTopoSplineDomainConversion
 // vtkSMPTools-backed loop (results are identical with every backend: see CoreTypes.h).
 topospline::ParallelFor SMPParallelFor();
 
-// The point array chosen with SetInputArrayToProcess(0, ...). When no name was chosen (e.g. a
-// pvpython filter created before its source ever ran), the active point scalars, else the
-// first 1-component point array. nullptr when a chosen name does not exist.
-vtkDataArray* SelectedPointScalars(vtkDataArray* chosen, vtkInformation* arrayInformation, vtkDataSet* input);
+// The point array chosen with SetInputArrayToProcess(0, ...). When none was chosen or the
+// chosen name does not exist (a pvpython filter created before its source ever ran may get a
+// stale name), the active point scalars, else the first 1-component point array; `note` then
+// says so when a name had been given. nullptr when the input has no usable point array.
+vtkDataArray* SelectedPointScalars(
+  vtkDataArray* chosen, vtkInformation* arrayInformation, vtkDataSet* input, std::string& note);
 
 // Fills `field` from a 2D vtkImageData (one layer) or a planar triangle vtkPolyData /
 // vtkUnstructuredGrid and a point scalar array. Returns false with a user-facing message.

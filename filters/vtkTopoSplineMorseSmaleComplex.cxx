@@ -45,8 +45,13 @@ int vtkTopoSplineMorseSmaleComplex::RequestData(
   }
 
   // On bad input: a clear error and an empty output (returning 1 keeps the pipeline alive).
+  std::string note;
   vtkDataArray* scalars = vtkTopoSplineDomainConversion::SelectedPointScalars(
-    this->GetInputArrayToProcess(0, inputVector), this->GetInputArrayInformation(0), input);
+    this->GetInputArrayToProcess(0, inputVector), this->GetInputArrayInformation(0), input, note);
+  if (!note.empty())
+  {
+    vtkWarningMacro("Morse-Smale Complex: " << note << ".");
+  }
   topospline::PlanarScalarField field;
   std::string error;
   {

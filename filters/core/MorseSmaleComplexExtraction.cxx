@@ -71,7 +71,75 @@ bool LabelByFlow(Index n, std::vector<Index>& label, Next next, Terminal termina
   }
   return true;
 }
+Index ThirdVertex(const TriangleMeshTopology& mesh, Index t, Index a, Index b)
+{
+  for (Index v : mesh.TriangleVertices[t])
+  {
+    if (v != a && v != b)
+    {
+      return v;
+    }
+  }
+  return InvalidIndex;
+}
+
+double Orientation(const std::vector<double>& p, Index a, Index b, Index c)
+{
+  return (p[2 * b] - p[2 * a]) * (p[2 * c + 1] - p[2 * a + 1]) - (p[2 * b + 1] - p[2 * a + 1]) * (p[2 * c] - p[2 * a]);
+}
+
+// Counter-clockwise angle in [0, 2pi) from direction (rx, ry) to (dx, dy).
+double TurningAngle(double rx, double ry, double dx, double dy)
+{
+  double angle = std::atan2(rx * dy - ry * dx, rx * dx + ry * dy);
+  return angle < 0 ? angle + 2 * M_PI : angle;
+}
 } // namespace
+
+const std::vector<Index>& MorseSmaleComplexExtraction::DescendingAroundMinimum(
+  const MorseSmaleComplex& complex, Index minimum, const PlanarScalarField& field) const
+{
+  // The descending 1-cells of a minimum form a planar tree rooted at it (V-paths merge and
+  // never split). Order its leaves counter-clockwise: compare two paths where they diverge,
+  // by the turning angle of their next step from the way back (from +x at the root).
+  std::vector<Index> arcs;
+  for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
+  {
+    const Separatrix& arc = complex.Separatrices[a];
+    if (arc.Type == Separatrix::Descending && arc.Source == minimum)
+    {
+      arcs.push_back(a);
+    }
+  }
+  const auto& P = field.Points;
+  auto less = [&](Index ia, Index ib) {
+    const auto& pa = complex.Separatrices[ia].MeshCells;
+    const auto& pb = complex.Separatrices[ib].MeshCells;
+    size_t k = 1;
+    while (k < pa.size() && k < pb.size() && pa[k] == pb[k])
+    {
+      ++k;
+    }
+    if (k >= pa.size() || k >= pb.size())
+    {
+      return pa.size() != pb.size() ? pa.size() < pb.size() : ia < ib; // one path contains the other
+    }
+    const Index node = pa[k - 1];
+    double rx = 1, ry = 0;
+    if (k >= 2)
+    {
+      rx = P[2 * pa[k - 2]] - P[2 * node];
+      ry = P[2 * pa[k - 2] + 1] - P[2 * node + 1];
+    }
+    const double aa = TurningAngle(rx, ry, P[2 * pa[k]] - P[2 * node], P[2 * pa[k] + 1] - P[2 * node + 1]);
+    const double ab = TurningAngle(rx, ry, P[2 * pb[k]] - P[2 * node], P[2 * pb[k] + 1] - P[2 * node + 1]);
+    return aa != ab ? aa < ab : ia < ib;
+  };
+  std::sort(arcs.begin(), arcs.end(), less);
+  auto& cached = this->RotationCache[minimum];
+  cached = arcs;
+  return cached;
+}
 
 std::array<Index, 3> MorseSmaleComplex::CountByIndex() const
 {
@@ -366,6 +434,7 @@ bool MorseSmaleComplexExtraction::Extract(
   struct Sector
   {
     Index Saddle, Descending, Ascending, Component;
+    bool LeftOfDescending; // walking the descending 1-cell from the minimum to the saddle
   };
   std::vector<Sector> sectors;
   for (Index k = 0; k < nS; ++k)
@@ -382,7 +451,12 @@ bool MorseSmaleComplexExtraction::Extract(
       const Separatrix& up = complex.Separatrices[ascending];
       for (int dside = 0; dside < 2; ++dside)
       {
-        Sector sector{ saddles[k], arcOfSlot[4 * k + dside], ascending, InvalidIndex };
+        // The sector lies left of the curve (minimum -> x -> y -> other minimum) through the
+        // saddle edge when its triangle does.
+        const Index x = mesh.EdgeVertices[e][dside], y = mesh.EdgeVertices[e][1 - dside];
+        const Index c = ThirdVertex(mesh, up.MeshCells.front(), x, y);
+        Sector sector{ saddles[k], arcOfSlot[4 * k + dside], ascending, InvalidIndex,
+          Orientation(field.Points, x, y, c) > 0 };
         const Index m = complex.Separatrices[sector.Descending].Source;
         auto accept = [&](Index w) {
           if (!onSeparatrix[w] && complex.AscendingManifold[w] == m)
@@ -440,6 +514,8 @@ bool MorseSmaleComplexExtraction::Extract(
     {
       ++j;
     }
+    // First by region: two sectors opening into the same region are one cell.
+    std::vector<std::array<Index, 2>> byRegion;
     std::vector<Index> leftover;
     for (size_t k = i; k < j;)
     {
@@ -450,7 +526,7 @@ bool MorseSmaleComplexExtraction::Extract(
       }
       if (l - k == 2 && sectors[bySector[k]].Component != InvalidIndex)
       {
-        cellSectors.push_back({ bySector[k], bySector[k + 1] });
+        byRegion.push_back({ bySector[k], bySector[k + 1] });
       }
       else
       {
@@ -458,13 +534,60 @@ bool MorseSmaleComplexExtraction::Extract(
       }
       k = l;
     }
-    if (leftover.size() == 2)
+    if (leftover.size() <= 2)
     {
-      cellSectors.push_back({ leftover[0], leftover[1] });
+      cellSectors.insert(cellSectors.end(), byRegion.begin(), byRegion.end());
+      if (leftover.size() == 2)
+      {
+        cellSectors.push_back({ leftover[0], leftover[1] });
+      }
     }
     else
     {
-      unpairedSectors.insert(unpairedSectors.end(), leftover.begin(), leftover.end());
+      // Thin cells (e.g. ascending 1-cells that run side by side and merge) have no region to
+      // tell them apart: pair the whole group by the planar order of the descending 1-cells
+      // at the minimum. A cell lies between two descending 1-cells that are consecutive
+      // around its minimum: the sector left of one pairs with the sector right of its
+      // counter-clockwise successor.
+      const std::vector<Index> group(bySector.begin() + i, bySector.begin() + j);
+      const std::vector<Index>& around = this->DescendingAroundMinimum(complex, groupKey(group[0]).first, field);
+      std::vector<unsigned char> used(group.size(), 0);
+      for (size_t a = 0; a < group.size(); ++a)
+      {
+        const Sector& left = sectors[group[a]];
+        const auto at = std::find(around.begin(), around.end(), left.Descending);
+        if (used[a] || !left.LeftOfDescending || at == around.end())
+        {
+          continue;
+        }
+        const Index successor = std::next(at) == around.end() ? around.front() : *std::next(at);
+        for (size_t b = 0; b < group.size(); ++b)
+        {
+          const Sector& right = sectors[group[b]];
+          if (!used[b] && b != a && !right.LeftOfDescending && right.Descending == successor)
+          {
+            cellSectors.push_back({ group[a], group[b] });
+            used[a] = used[b] = 1;
+            break;
+          }
+        }
+      }
+      std::vector<Index> rest;
+      for (size_t a = 0; a < group.size(); ++a)
+      {
+        if (!used[a])
+        {
+          rest.push_back(group[a]);
+        }
+      }
+      if (rest.size() == 2)
+      {
+        cellSectors.push_back({ rest[0], rest[1] });
+      }
+      else
+      {
+        unpairedSectors.insert(unpairedSectors.end(), rest.begin(), rest.end());
+      }
     }
     i = j;
   }
@@ -523,11 +646,24 @@ bool MorseSmaleComplexExtraction::Extract(
   complex.TwoCellId.assign(nV, InvalidIndex);
   std::vector<Index> queue;
   queue.reserve(nV);
+  std::vector<unsigned char> hasRegion(complex.TwoCells.size(), 0);
   for (Index v = 0; v < nV; ++v)
   {
     complex.TwoCellId[v] = cellOfRoot[components.Find(v)];
     if (complex.TwoCellId[v] != InvalidIndex)
     {
+      hasRegion[complex.TwoCellId[v]] = 1;
+      queue.push_back(v);
+    }
+  }
+  // A cell without a region of its own (a thin cell, or a whole domain that is one pouch)
+  // grows from its saddle's vertex.
+  for (Index c = 0; c < static_cast<Index>(complex.TwoCells.size()); ++c)
+  {
+    const Index v = cps[complex.TwoCells[c].Saddles[0]].Vertex;
+    if (!hasRegion[c] && complex.TwoCellId[v] == InvalidIndex)
+    {
+      complex.TwoCellId[v] = c;
       queue.push_back(v);
     }
   }

@@ -8,6 +8,7 @@
 #include "TriangleMeshTopology.h"
 
 #include <array>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -83,8 +84,15 @@ public:
   ParallelFor Parallel = SequentialFor;
   ProgressHooks Hooks;
 
+  // Descending 1-cells of a minimum in counter-clockwise order around it.
+  const std::vector<Index>& DescendingAroundMinimum(
+    const MorseSmaleComplex& complex, Index minimum, const PlanarScalarField& field) const;
+
   // Intermediate structures, kept for tests and later stages.
   TriangleMeshTopology Mesh;
   DiscreteGradient Gradient;
+
+private:
+  mutable std::map<Index, std::vector<Index>> RotationCache;
 };
 } // namespace topospline

@@ -1,0 +1,135 @@
+// Stage 2 of the paper (section 3.2): persistence simplification of a discrete Morse-Smale
+// complex, as a hierarchy computed once per input and replayed for any threshold.
+//
+// Cancellation rule (the paper's section 3.2; Shivashankar's mscomplex-tri `cancel_pair`):
+// cancelling a saddle s with an extremum x removes both and connects every other neighbour of
+// s (the other extremum x' of s, of x's kind) to every other neighbour of x (the other saddles
+// of x). Every 1-cell keeps its saddle, so this amounts to "every 1-cell that ended at x now
+// ends at x'": x' inherits x's region, 1-cells and 2-cells.
+//
+// Threshold semantics (saved states depend on them; never change them):
+//  * persistence of a pair = |f(saddle) - f(extremum)|;
+//  * MaximumPersistence() = (largest critical value) - (smallest critical value) of the
+//    complex given to ComputeHierarchy; for a complex extracted from a field this is the
+//    field's range max f - min f, since the global extrema are always critical;
+//  * Simplify(percent) performs, in hierarchy order, the cancellations whose Threshold (the
+//    running maximum of the persistences of the hierarchy up to it) is strictly below
+//    percent / 100 * MaximumPersistence(); percent = 0 performs none, percent = 100 performs
+//    the whole hierarchy (every cancellation that the validity rules allow).
+// The running maximum makes the replay of a threshold t exactly what a greedy simplification
+// stopped at t would do (it stops at the first pair of persistence >= t), and makes the
+// counts monotone in t even where a cancellation creates a pair of lower persistence.
+#pragma once
+
+#include "CoreTypes.h"
+#include "MorseSmaleComplexExtraction.h"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace topospline
+{
+// One step of the hierarchy, in the stable ids (CriticalPoint::Id) of the input complex.
+struct Cancellation
+{
+  Index Lower = InvalidIndex;    // the minimum (min-saddle pair) or the saddle (saddle-max pair)
+  Index Upper = InvalidIndex;    // the saddle or the maximum
+  Index Survivor = InvalidIndex; // the extremum that inherits the cancelled extremum's region
+  double Persistence = 0;        // |f(Upper) - f(Lower)|
+  double Threshold = 0;          // performed for every absolute threshold strictly above this
+};
+
+// A vertex (descending 1-cells) or triangle (ascending 1-cells) where 1-cells that share an
+// extremum split apart when followed from the extremum towards their saddles (equivalently:
+// merge when followed from the saddles). Stage 3 cuts 1-cells into pieces at these points.
+struct JunctionPoint
+{
+  Separatrix::Kind Type = Separatrix::Descending; // Cell is a vertex (Descending) or a triangle
+  Index Extremum = InvalidIndex;      // position in the output CriticalPoints
+  Index Cell = InvalidIndex;
+  double Position[2] = { 0, 0 };      // the vertex, or the triangle's centroid
+  double Value = 0;                   // f at the vertex, or the mean of the triangle's values
+  // Position of a saddle sitting on this vertex whose descending 1-cell ends here while
+  // others go on (the junction is then also that critical point), else InvalidIndex.
+  Index CriticalPoint = InvalidIndex;
+  std::vector<Index> Separatrices;    // output 1-cells through it, ascending order
+};
+
+struct SimplificationOutput
+{
+  // The simplified complex, in the form stage 1 produces. Every reference to a critical
+  // point in it (Separatrix::Source/Destination, TwoCell::Minimum/Maximum/Saddles and the
+  // per-vertex AscendingManifold/DescendingManifold) is a position in its CriticalPoints;
+  // CriticalPoints[i].Id is the stable id of the input. Separatrices and 2-cells keep the
+  // relative order of the input ones they come from.
+  MorseSmaleComplex Complex;
+  std::vector<Cancellation> Cancellations; // performed, in hierarchy order
+  std::vector<JunctionPoint> JunctionPoints;
+  double AbsoluteThreshold = 0;            // percent / 100 * MaximumPersistence()
+};
+
+class MorseSmaleComplexSimplification
+{
+public:
+  // Checks the input, copies it and computes the whole cancellation sequence. Returns false
+  // with a message for inputs that are not a complex of the stage-1 form.
+  bool ComputeHierarchy(const MorseSmaleComplex& input, std::string& error);
+
+  // Replays the hierarchy up to `percent` of MaximumPersistence() (see the top of this file)
+  // and builds the simplified complex; never recomputes the hierarchy. Fails for a percent
+  // outside [0, 100] or when no hierarchy was computed.
+  bool Simplify(double percent, SimplificationOutput& output, std::string& error) const;
+  bool Simplify(double percent, MorseSmaleComplex& output, std::string& error) const;
+
+  bool HasHierarchy() const { return this->Computed; }
+  double MaximumPersistence() const { return this->MaxPersistence; }
+  // Every cancellation, in order; Threshold is non-decreasing along it.
+  const std::vector<Cancellation>& Hierarchy() const { return this->Sequence; }
+  // How many cancellations of Hierarchy() Simplify(percent) performs (percent in [0, 100]).
+  Index NumberOfCancellations(double percent) const;
+
+  ProgressHooks Hooks;
+
+private:
+  // Where, in the input, each cancellation happens (positions, not stable ids).
+  struct Step
+  {
+    Index Saddle;
+    Index Extremum;
+    Index Survivor;
+    int Side; // which of the saddle's 1-cells of the extremum's kind reached the extremum
+  };
+  // Mesh cells of the 1-cells, numbered compactly, with their point and value: the nodes of
+  // the gradient forests in which merged 1-cells are traced.
+  struct NodeSet
+  {
+    std::vector<Index> Cell;
+    std::vector<double> Point; // x, y per node
+    std::vector<double> Value;
+    std::vector<std::array<Index, 2>> Edges; // gradient steps, each once
+  };
+
+  bool Check(const MorseSmaleComplex& input, std::string& error) const;
+  void BuildForests();
+  void ComputeSequence();
+
+  bool Computed = false;
+  MorseSmaleComplex Input;
+  double MaxPersistence = 0;
+  std::vector<Cancellation> Sequence;
+  std::vector<Step> Steps;
+
+  // Per critical point (position): for a saddle its descending 1-cells [0..1] and ascending
+  // ones [2..3] (InvalidIndex when it has a single ascending one, on the boundary).
+  std::vector<std::array<Index, 4>> SaddleArcs;
+  std::vector<Index> ArcExtremum; // per input 1-cell: its minimum or maximum (position)
+
+  NodeSet DescendingNodes; // vertices
+  NodeSet AscendingNodes;  // triangles
+  std::vector<Index> ArcFirstNode; // per 1-cell: the saddle-side node of the forest path
+  std::vector<Index> ArcLastNode;  // per descending 1-cell: the saddle's vertex
+  std::vector<Index> RootNode;     // per extremum: its vertex / triangle node
+  std::vector<double> CriticalPointPosition; // x, y per critical point (its vertex)
+};
+} // namespace topospline

@@ -1,0 +1,336 @@
+// Unit tests of stage 1 (pure core): the discrete gradient and the Morse-Smale complex.
+#include "MorseSmaleComplexExtraction.h"
+#include "SyntheticFields.h"
+#include "TestHarness.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <thread>
+
+using namespace topospline;
+
+namespace
+{
+PlanarScalarField FieldFromGrid(const GridField& grid)
+{
+  PlanarScalarField field;
+  const int nx = grid.Dimensions[0], ny = grid.Dimensions[1];
+  for (int j = 0; j < ny; ++j)
+  {
+    for (int i = 0; i < nx; ++i)
+    {
+      field.Points.push_back(grid.Origin[0] + i);
+      field.Points.push_back(grid.Origin[1] + j);
+    }
+  }
+  field.Values = grid.Values;
+  field.Triangles = GridTriangles(nx, ny);
+  return field;
+}
+
+// A ParallelFor over real threads with a deliberately uneven split, to show the result does
+// not depend on the partition.
+void ThreadedFor(Index begin, Index end, const RangeBody& body)
+{
+  const Index n = end - begin;
+  const Index cuts[] = { begin, begin + n / 7, begin + n / 2, begin + (5 * n) / 6, end };
+  std::vector<std::thread> threads;
+  for (int k = 0; k < 4; ++k)
+  {
+    if (cuts[k] < cuts[k + 1])
+    {
+      threads.emplace_back([&, k] { body(cuts[k], cuts[k + 1]); });
+    }
+  }
+  for (auto& t : threads)
+  {
+    t.join();
+  }
+}
+
+MorseSmaleComplex Extract(const PlanarScalarField& field, const ParallelFor& parallel = SequentialFor)
+{
+  MorseSmaleComplexExtraction extraction;
+  extraction.Parallel = parallel;
+  MorseSmaleComplex complex;
+  std::string error;
+  const bool ok = extraction.Extract(field, complex, error);
+  CHECK(ok);
+  if (!ok)
+  {
+    std::printf("  extraction failed: %s\n", error.c_str());
+  }
+  return complex;
+}
+
+// The structural invariants every complex on a disk must satisfy.
+void CheckInvariants(const PlanarScalarField& field, const MorseSmaleComplex& c)
+{
+  const auto n = c.CountByIndex();
+  CHECK_EQ(n[0] - n[1] + n[2], 1);
+  const auto& cps = c.CriticalPoints;
+  for (size_t i = 0; i < cps.size(); ++i)
+  {
+    CHECK_EQ(cps[i].Id, static_cast<Index>(i));
+    CHECK_EQ(cps[i].Value, field.Values[cps[i].Vertex]);
+  }
+  // Separatrices join critical points of consecutive indices; values increase along descending
+  // ones (vertex paths) and their end values are the critical values.
+  for (const auto& arc : c.Separatrices)
+  {
+    const int lower = arc.Type == Separatrix::Descending ? 0 : 1;
+    CHECK_EQ(cps[arc.Source].MorseIndex, lower);
+    CHECK_EQ(cps[arc.Destination].MorseIndex, lower + 1);
+    CHECK_EQ(arc.Values.front(), cps[arc.Source].Value);
+    CHECK_EQ(arc.Values.back(), cps[arc.Destination].Value);
+    CHECK_EQ(arc.Points.size(), 2 * arc.Values.size());
+    if (arc.Type == Separatrix::Descending)
+    {
+      for (size_t k = 1; k < arc.MeshCells.size(); ++k)
+      {
+        const Index a = arc.MeshCells[k - 1], b = arc.MeshCells[k];
+        CHECK(field.Values[a] < field.Values[b] || (field.Values[a] == field.Values[b] && a < b));
+      }
+    }
+  }
+  // 2-cells: quads minimum-saddle-maximum-saddle (or pouches), sides consistent with corners.
+  size_t sectors = 0;
+  for (const auto& cell : c.TwoCells)
+  {
+    CHECK_EQ(cell.Sectors, 2);
+    sectors += cell.Sectors;
+    CHECK_EQ(cps[cell.Minimum].MorseIndex, 0);
+    CHECK_EQ(cps[cell.Maximum].MorseIndex, 2);
+    for (int k = 0; k < 2; ++k)
+    {
+      CHECK_EQ(cps[cell.Saddles[k]].MorseIndex, 1);
+      const auto& down = c.Separatrices[cell.Arcs[2 * k]];
+      const auto& up = c.Separatrices[cell.Arcs[2 * k + 1]];
+      CHECK(down.Type == Separatrix::Descending && down.Destination == cell.Saddles[k] && down.Source == cell.Minimum);
+      CHECK(up.Type == Separatrix::Ascending && up.Source == cell.Saddles[k] && up.Destination == cell.Maximum);
+    }
+    CHECK_EQ(cell.Pouch, cell.Saddles[0] == cell.Saddles[1]);
+  }
+  // Every saddle corner belongs to exactly one cell: 4 per interior saddle, 2 per boundary one.
+  size_t ascending = 0;
+  for (const auto& arc : c.Separatrices)
+  {
+    ascending += arc.Type == Separatrix::Ascending;
+  }
+  CHECK_EQ(sectors, 2 * ascending); // one sector on each side of every ascending separatrix
+  // Every vertex lies in exactly one 2-cell, and in the manifolds of that cell's extrema.
+  CHECK_EQ(c.TwoCellId.size(), field.Values.size());
+  size_t total = 0;
+  for (const auto& cell : c.TwoCells)
+  {
+    total += cell.NumberOfVertices;
+  }
+  CHECK_EQ(total, field.Values.size());
+  for (size_t v = 0; v < c.TwoCellId.size(); ++v)
+  {
+    CHECK(c.TwoCellId[v] >= 0 && c.TwoCellId[v] < static_cast<Index>(c.TwoCells.size()));
+  }
+}
+} // namespace
+
+TEST_CASE(TrigonometricFieldCounts)
+{
+  // The paper reports 8/15/8 for this field, but with a boundary made of 1-cells every local
+  // extremum of the field along the boundary curve must be a critical point (10 minima and
+  // 10 maxima along this boundary loop): 8 interior minima + 10 boundary minima, 9 interior
+  // saddles + 10 boundary saddles + 8 where the boundary meets a lower interior, 8 interior
+  // maxima + 2 corner maxima. See docs/MorseSmaleComplex.md.
+  const auto field = FieldFromGrid(TrigonometricField(10, 100, -49));
+  const auto c = Extract(field);
+  const auto n = c.CountByIndex();
+  CHECK_EQ(n[0], 18);
+  CHECK_EQ(n[1], 27);
+  CHECK_EQ(n[2], 10);
+  int interior[3] = { 0, 0, 0 };
+  for (const auto& cp : c.CriticalPoints)
+  {
+    interior[cp.MorseIndex] += !cp.OnBoundary;
+  }
+  // Interior critical points are exactly the paper's: 8 minima, 9 saddles, 8 maxima.
+  CHECK_EQ(interior[0], 8);
+  CHECK_EQ(interior[1], 9);
+  CHECK_EQ(interior[2], 8);
+  CheckInvariants(field, c);
+}
+
+TEST_CASE(ShepardFieldsSeveralSeeds)
+{
+  for (int seed = 1; seed <= 6; ++seed)
+  {
+    const auto field = FieldFromGrid(ShepardField(50, 2, 150 + 20 * seed, seed));
+    CheckInvariants(field, Extract(field));
+  }
+}
+
+TEST_CASE(SequentialAndThreadedAgree)
+{
+  const auto field = FieldFromGrid(ShepardField(60, 2, 300, 7));
+  const auto a = Extract(field);
+  const auto b = Extract(field, ThreadedFor);
+  CHECK_EQ(a.CriticalPoints.size(), b.CriticalPoints.size());
+  CHECK_EQ(a.Separatrices.size(), b.Separatrices.size());
+  CHECK(a.TwoCellId == b.TwoCellId);
+  CHECK(a.AscendingManifold == b.AscendingManifold);
+  CHECK(a.DescendingManifold == b.DescendingManifold);
+  bool samePaths = a.Separatrices.size() == b.Separatrices.size();
+  for (size_t i = 0; samePaths && i < a.Separatrices.size(); ++i)
+  {
+    samePaths = a.Separatrices[i].MeshCells == b.Separatrices[i].MeshCells;
+  }
+  CHECK(samePaths);
+}
+
+TEST_CASE(PlateausAreBrokenByVertexId)
+{
+  // A constant field: simulation of simplicity turns it into the ramp of vertex ids.
+  GridField flat;
+  flat.Dimensions[0] = flat.Dimensions[1] = 40;
+  flat.Values.assign(1600, 3.0);
+  const auto field = FieldFromGrid(flat);
+  const auto c = Extract(field);
+  CheckInvariants(field, c);
+  // A field with a large flat area and a bump.
+  GridField mesa = TrigonometricField(5, 60, 0);
+  for (double& v : mesa.Values)
+  {
+    v = std::max(v, 0.0);
+  }
+  const auto mesaField = FieldFromGrid(mesa);
+  CheckInvariants(mesaField, Extract(mesaField));
+}
+
+TEST_CASE(InteriorCriticalPointsArePiecewiseLinearOnes)
+{
+  // Away from the boundary the discrete gradient's critical cells are the PL critical points:
+  // count them independently from the lower links (components of lower neighbours).
+  const auto field = FieldFromGrid(ShepardField(40, 2, 120, 3));
+  const auto c = Extract(field);
+  const int n = 120;
+  auto lower = [&](Index a, Index b) {
+    return field.Values[a] < field.Values[b] || (field.Values[a] == field.Values[b] && a < b);
+  };
+  // Link of an interior grid vertex in the (i+1,j)-(i,j+1) triangulation, in cyclic order.
+  const int ring[6][2] = { { 1, 0 }, { 0, 1 }, { -1, 1 }, { -1, 0 }, { 0, -1 }, { 1, -1 } };
+  int pl[3] = { 0, 0, 0 };
+  for (int j = 1; j + 1 < n; ++j)
+  {
+    for (int i = 1; i + 1 < n; ++i)
+    {
+      const Index v = j * n + i;
+      int lowerCount = 0, changes = 0;
+      bool prev = lower((j + ring[5][1]) * n + i + ring[5][0], v);
+      for (auto& r : ring)
+      {
+        const bool cur = lower((j + r[1]) * n + i + r[0], v);
+        lowerCount += cur;
+        changes += cur != prev;
+        prev = cur;
+      }
+      if (lowerCount == 0)
+      {
+        ++pl[0];
+      }
+      else if (lowerCount == 6)
+      {
+        ++pl[2];
+      }
+      else
+      {
+        pl[1] += changes / 2 - 1;
+      }
+    }
+  }
+  int interior[3] = { 0, 0, 0 };
+  for (const auto& cp : c.CriticalPoints)
+  {
+    interior[cp.MorseIndex] += !cp.OnBoundary;
+  }
+  CHECK_EQ(interior[0], pl[0]);
+  CHECK_EQ(interior[1], pl[1]);
+  CHECK_EQ(interior[2], pl[2]);
+}
+
+TEST_CASE(UnstructuredMeshWithHoleAndOddTriangles)
+{
+  // A fan of triangles around a centre, not a grid: the machinery is mesh-agnostic.
+  PlanarScalarField field;
+  const int rings = 12, sectors = 17;
+  field.Points = { 0, 0 };
+  field.Values = { 0.3 };
+  for (int r = 1; r <= rings; ++r)
+  {
+    for (int s = 0; s < sectors; ++s)
+    {
+      const double angle = 2 * M_PI * s / sectors + 0.1 * r;
+      field.Points.push_back(r * std::cos(angle));
+      field.Points.push_back(r * std::sin(angle));
+      field.Values.push_back(std::sin(0.9 * r) * std::cos(3 * angle));
+    }
+  }
+  auto id = [&](int r, int s) { return r == 0 ? 0 : 1 + (r - 1) * sectors + (s % sectors); };
+  for (int s = 0; s < sectors; ++s)
+  {
+    field.Triangles.insert(field.Triangles.end(), { id(0, 0), id(1, s), id(1, s + 1) });
+  }
+  for (int r = 1; r < rings; ++r)
+  {
+    for (int s = 0; s < sectors; ++s)
+    {
+      field.Triangles.insert(field.Triangles.end(), { id(r, s), id(r + 1, s), id(r + 1, s + 1) });
+      field.Triangles.insert(field.Triangles.end(), { id(r, s), id(r + 1, s + 1), id(r, s + 1) });
+    }
+  }
+  CheckInvariants(field, Extract(field));
+}
+
+TEST_CASE(BadInputIsRefusedWithAMessage)
+{
+  auto refuse = [](const PlanarScalarField& field, const std::string& expected) {
+    MorseSmaleComplexExtraction extraction;
+    MorseSmaleComplex complex;
+    std::string error;
+    CHECK(!extraction.Extract(field, complex, error));
+    CHECK(error.find(expected) != std::string::npos);
+    if (error.find(expected) == std::string::npos)
+    {
+      std::printf("  got \"%s\", expected \"%s\"\n", error.c_str(), expected.c_str());
+    }
+  };
+  auto field = FieldFromGrid(TrigonometricField(10, 20, 0));
+  auto nan = field;
+  nan.Values[17] = std::numeric_limits<double>::quiet_NaN();
+  refuse(nan, "non-finite");
+  auto inf = field;
+  inf.Values[3] = std::numeric_limits<double>::infinity();
+  refuse(inf, "non-finite");
+  refuse(PlanarScalarField(), "no triangles");
+  auto degenerate = field;
+  degenerate.Triangles[4] = degenerate.Triangles[3];
+  refuse(degenerate, "degenerate");
+  auto nonManifold = field;
+  nonManifold.Points.insert(nonManifold.Points.end(), { 0.5, 0.5 });
+  nonManifold.Values.push_back(1.0);
+  const Index extra = static_cast<Index>(nonManifold.Values.size()) - 1;
+  // The diagonal of the first quad, shared by its two triangles, gets a third one.
+  nonManifold.Triangles.insert(nonManifold.Triangles.end(), { field.Triangles[1], field.Triangles[2], extra });
+  refuse(nonManifold, "not a 2-manifold");
+  auto isolated = field;
+  isolated.Points.insert(isolated.Points.end(), { 50, 50 });
+  isolated.Values.push_back(0);
+  refuse(isolated, "not used by any triangle");
+  auto outOfRange = field;
+  outOfRange.Triangles[0] = 100000;
+  refuse(outOfRange, "does not exist");
+}
+
+int main()
+{
+  return testing_harness::RunAll();
+}

@@ -1,0 +1,75 @@
+"""Bad input gets a clear error message and an empty output, never a crash: each case runs in
+its own pvpython process so that a crash is seen as such."""
+import os
+import subprocess
+import sys
+
+import topospline_testing as tt
+
+checks = tt.Checks()
+PRELUDE = """
+import numpy as np
+from paraview.simple import *
+from paraview import servermanager as sm
+from vtkmodules.util.numpy_support import numpy_to_vtk
+from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPolyData
+LoadPlugin(%r, remote=False, ns=globals())
+def producer(data):
+    p = TrivialProducer()
+    p.GetClientSideObject().SetOutput(data)
+    return p
+def image(values, dims, name="f", comps=1):
+    im = vtkImageData()
+    im.SetDimensions(*dims)
+    arr = numpy_to_vtk(np.asarray(values, dtype=float).reshape(-1, comps), deep=1)
+    arr.SetName(name)
+    im.GetPointData().AddArray(arr)
+    return im
+""" % tt.plugin_path()
+EPILOGUE = """
+ms.UpdatePipeline()
+out = sm.Fetch(ms)
+print("BLOCKS", out.GetNumberOfBlocks())
+"""
+
+CASES = {
+    "no point scalars": ("im = vtkImageData(); im.SetDimensions(10, 10, 1)\n"
+                         "ms = MorseSmaleComplex(Input=producer(im))", "no point scalar array"),
+    "multi-component array": ("ms = MorseSmaleComplex(Input=producer(image(np.random.rand(300), (10, 10, 1), 'v', 3)))\n"
+                              "ms.ScalarField = ['POINTS', 'v']", "3 components"),
+    "3D image": ("ms = MorseSmaleComplex(Input=Wavelet())", "the image is 3D"),
+    "NaN values": ("v = np.random.rand(100); v[42] = np.nan\n"
+                   "ms = MorseSmaleComplex(Input=producer(image(v, (10, 10, 1))))", "non-finite"),
+    "Inf values": ("v = np.random.rand(100); v[7] = np.inf\n"
+                   "ms = MorseSmaleComplex(Input=producer(image(v, (10, 10, 1))))", "non-finite"),
+    "empty data set": ("ms = MorseSmaleComplex(Input=producer(vtkPolyData()))", "empty"),
+    "non-triangle cells": ("plane = Plane(XResolution=5, YResolution=5)\n"
+                           "calc = Calculator(Input=plane, ResultArrayName='f', Function='coordsX*coordsY')\n"
+                           "ms = MorseSmaleComplex(Input=calc)\nms.ScalarField = ['POINTS', 'f']",
+                           "is not a triangle"),
+    "1D image": ("ms = MorseSmaleComplex(Input=producer(image(np.random.rand(10), (10, 1, 1))))",
+                 "fewer than two dimensions"),
+    "non-planar mesh": ("s = Sphere()\ncalc = Calculator(Input=s, ResultArrayName='f', Function='coordsZ')\n"
+                        "ms = MorseSmaleComplex(Input=calc)\nms.ScalarField = ['POINTS', 'f']", "coordinate plane"),
+}
+# Not an error: a stale or mistyped array name falls back to the active scalars, with a warning.
+FALLBACKS = {
+    "missing array name": ("ms = MorseSmaleComplex(Input=TrigonometricField())\n"
+                           "ms.ScalarField = ['POINTS', 'doesnotexist']",
+                           'point array "doesnotexist" not found; using "Trigonometric"'),
+}
+
+def run(name, body, expected, blocks):
+    result = subprocess.run(["pvpython", "--force-offscreen-rendering", "-c", PRELUDE + body + EPILOGUE],
+                            capture_output=True, text=True, timeout=300)
+    output = result.stdout + result.stderr
+    checks.equal(result.returncode, 0, "%s: exits cleanly (output: %s)" % (name, output[-500:]))
+    checks.check(expected in output, "%s: message contains %r (output: %s)" % (name, expected, output[-500:]))
+    checks.check("BLOCKS %d" % blocks in output, "%s: %d output blocks" % (name, blocks))
+
+
+for name, (body, expected) in CASES.items():
+    run(name, body, expected, 0)
+for name, (body, expected) in FALLBACKS.items():
+    run(name, body, expected, 4)
+checks.finish()
