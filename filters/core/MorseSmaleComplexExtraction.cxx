@@ -96,25 +96,35 @@ double TurningAngle(double rx, double ry, double dx, double dy)
 }
 } // namespace
 
-const std::vector<Index>& MorseSmaleComplexExtraction::DescendingAroundMinimum(
-  const MorseSmaleComplex& complex, Index minimum, const PlanarScalarField& field) const
+std::vector<Index> MorseSmaleComplexExtraction::SeparatricesAround(
+  const MorseSmaleComplex& complex, Index extremum)
 {
-  // The descending 1-cells of a minimum form a planar tree rooted at it (V-paths merge and
-  // never split). Order its leaves counter-clockwise: compare two paths where they diverge,
-  // by the turning angle of their next step from the way back (from +x at the root).
+  // The 1-cells of an extremum form a planar tree rooted at it (V-paths merge and never
+  // split): descending ones as vertex paths, ascending ones as triangle paths (through the
+  // centroids). Order its leaves counter-clockwise: compare two paths where they diverge by
+  // the turning angle of their next step from the way back (from +x at the root).
+  const bool minimum = complex.CriticalPoints[extremum].MorseIndex == 0;
   std::vector<Index> arcs;
+  std::vector<std::vector<std::array<double, 2>>> paths(complex.Separatrices.size());
   for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
   {
     const Separatrix& arc = complex.Separatrices[a];
-    if (arc.Type == Separatrix::Descending && arc.Source == minimum)
+    if (minimum ? (arc.Type == Separatrix::Descending && arc.Source == extremum)
+                : (arc.Type == Separatrix::Ascending && arc.Destination == extremum))
     {
       arcs.push_back(a);
+      auto& path = paths[a];
+      // From the extremum outwards; ascending 1-cells are stored from the saddle.
+      for (size_t k = 0; k < arc.Values.size(); ++k)
+      {
+        const size_t i = minimum ? k : arc.Values.size() - 1 - k;
+        path.push_back({ arc.Points[2 * i], arc.Points[2 * i + 1] });
+      }
     }
   }
-  const auto& P = field.Points;
   auto less = [&](Index ia, Index ib) {
-    const auto& pa = complex.Separatrices[ia].MeshCells;
-    const auto& pb = complex.Separatrices[ib].MeshCells;
+    const auto& pa = paths[ia];
+    const auto& pb = paths[ib];
     size_t k = 1;
     while (k < pa.size() && k < pb.size() && pa[k] == pb[k])
     {
@@ -124,21 +134,19 @@ const std::vector<Index>& MorseSmaleComplexExtraction::DescendingAroundMinimum(
     {
       return pa.size() != pb.size() ? pa.size() < pb.size() : ia < ib; // one path contains the other
     }
-    const Index node = pa[k - 1];
+    const auto& node = pa[k - 1];
     double rx = 1, ry = 0;
     if (k >= 2)
     {
-      rx = P[2 * pa[k - 2]] - P[2 * node];
-      ry = P[2 * pa[k - 2] + 1] - P[2 * node + 1];
+      rx = pa[k - 2][0] - node[0];
+      ry = pa[k - 2][1] - node[1];
     }
-    const double aa = TurningAngle(rx, ry, P[2 * pa[k]] - P[2 * node], P[2 * pa[k] + 1] - P[2 * node + 1]);
-    const double ab = TurningAngle(rx, ry, P[2 * pb[k]] - P[2 * node], P[2 * pb[k] + 1] - P[2 * node + 1]);
+    const double aa = TurningAngle(rx, ry, pa[k][0] - node[0], pa[k][1] - node[1]);
+    const double ab = TurningAngle(rx, ry, pb[k][0] - node[0], pb[k][1] - node[1]);
     return aa != ab ? aa < ab : ia < ib;
   };
   std::sort(arcs.begin(), arcs.end(), less);
-  auto& cached = this->RotationCache[minimum];
-  cached = arcs;
-  return cached;
+  return arcs;
 }
 
 std::array<Index, 3> MorseSmaleComplex::CountByIndex() const
@@ -434,7 +442,9 @@ bool MorseSmaleComplexExtraction::Extract(
   struct Sector
   {
     Index Saddle, Descending, Ascending, Component;
-    bool LeftOfDescending; // walking the descending 1-cell from the minimum to the saddle
+    // Left of the descending 1-cell walked from the minimum to the saddle; then it is also
+    // left of the ascending 1-cell walked from the saddle to the maximum.
+    bool LeftOfDescending;
   };
   std::vector<Sector> sectors;
   for (Index k = 0; k < nS; ++k)
@@ -550,36 +560,59 @@ bool MorseSmaleComplexExtraction::Extract(
       // around its minimum: the sector left of one pairs with the sector right of its
       // counter-clockwise successor.
       const std::vector<Index> group(bySector.begin() + i, bySector.begin() + j);
-      const std::vector<Index>& around = this->DescendingAroundMinimum(complex, groupKey(group[0]).first, field);
-      std::vector<unsigned char> used(group.size(), 0);
-      for (size_t a = 0; a < group.size(); ++a)
+      std::vector<std::array<Index, 2>> pairs;
+      std::vector<Index> rest;
+      // At the maximum the same holds with the ascending 1-cells; there the sector left of
+      // one (walking towards the maximum) pairs with the one right of its clockwise
+      // predecessor. Try the minimum first; fall back to the maximum when some stay unpaired
+      // (e.g. saddles sharing a vertex have identical descending paths).
+      for (int end = 0; end < 2; ++end)
       {
-        const Sector& left = sectors[group[a]];
-        const auto at = std::find(around.begin(), around.end(), left.Descending);
-        if (used[a] || !left.LeftOfDescending || at == around.end())
+        std::vector<std::array<Index, 2>> tryPairs;
+        std::vector<Index> tryRest;
+        const Index extremum = end == 0 ? groupKey(group[0]).first : groupKey(group[0]).second;
+        const std::vector<Index> around = SeparatricesAround(complex, extremum);
+        auto arcOf = [&](const Sector& sector) { return end == 0 ? sector.Descending : sector.Ascending; };
+        std::vector<unsigned char> used(group.size(), 0);
+        for (size_t a = 0; a < group.size(); ++a)
         {
-          continue;
-        }
-        const Index successor = std::next(at) == around.end() ? around.front() : *std::next(at);
-        for (size_t b = 0; b < group.size(); ++b)
-        {
-          const Sector& right = sectors[group[b]];
-          if (!used[b] && b != a && !right.LeftOfDescending && right.Descending == successor)
+          const Sector& left = sectors[group[a]];
+          const auto at = std::find(around.begin(), around.end(), arcOf(left));
+          if (used[a] || !left.LeftOfDescending || at == around.end())
           {
-            cellSectors.push_back({ group[a], group[b] });
-            used[a] = used[b] = 1;
-            break;
+            continue;
+          }
+          const Index neighbour = end == 0 ? (std::next(at) == around.end() ? around.front() : *std::next(at))
+                                           : (at == around.begin() ? around.back() : *std::prev(at));
+          for (size_t b = 0; b < group.size(); ++b)
+          {
+            const Sector& right = sectors[group[b]];
+            if (!used[b] && b != a && !right.LeftOfDescending && arcOf(right) == neighbour)
+            {
+              tryPairs.push_back({ group[a], group[b] });
+              used[a] = used[b] = 1;
+              break;
+            }
           }
         }
-      }
-      std::vector<Index> rest;
-      for (size_t a = 0; a < group.size(); ++a)
-      {
-        if (!used[a])
+        for (size_t a = 0; a < group.size(); ++a)
         {
-          rest.push_back(group[a]);
+          if (!used[a])
+          {
+            tryRest.push_back(group[a]);
+          }
+        }
+        if (end == 0 || tryRest.size() < rest.size())
+        {
+          pairs = tryPairs;
+          rest = tryRest;
+        }
+        if (rest.size() <= 2)
+        {
+          break;
         }
       }
+      cellSectors.insert(cellSectors.end(), pairs.begin(), pairs.end());
       if (rest.size() == 2)
       {
         cellSectors.push_back({ rest[0], rest[1] });

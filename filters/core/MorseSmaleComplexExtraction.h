@@ -8,7 +8,6 @@
 #include "TriangleMeshTopology.h"
 
 #include <array>
-#include <map>
 #include <string>
 #include <vector>
 
@@ -84,15 +83,12 @@ public:
   ParallelFor Parallel = SequentialFor;
   ProgressHooks Hooks;
 
-  // Descending 1-cells of a minimum in counter-clockwise order around it.
-  const std::vector<Index>& DescendingAroundMinimum(
-    const MorseSmaleComplex& complex, Index minimum, const PlanarScalarField& field) const;
+  // The 1-cells of an extremum (descending for a minimum, ascending for a maximum) in
+  // counter-clockwise order around it.
+  static std::vector<Index> SeparatricesAround(const MorseSmaleComplex& complex, Index extremum);
 
   // Intermediate structures, kept for tests and later stages.
   TriangleMeshTopology Mesh;
   DiscreteGradient Gradient;
-
-private:
-  mutable std::map<Index, std::vector<Index>> RotationCache;
 };
 } // namespace topospline
