@@ -100,9 +100,51 @@ struct LowerStarProcessor
     }
   }
 
+  // The common case, a regular interior vertex: its link is a cycle and its lower link one
+  // path of k vertices (k lower edges, k - 1 lower triangles). ProcessLowerStars then pairs v
+  // with the steepest edge and every triangle with its face farther from that edge along the
+  // path, whatever the queue order: do exactly that, without the queues.
+  void ProcessRegular(Index v)
+  {
+    int steepest = 0;
+    for (int i = 1; i < static_cast<int>(this->Edges.size()); ++i)
+    {
+      if (this->KeyLess(this->Edges[i].Key, this->Edges[steepest].Key))
+      {
+        steepest = i;
+      }
+    }
+    this->Edges[steepest].Paired = true;
+    this->Gradient.VertexEdge[v] = this->Edges[steepest].Id;
+    this->Gradient.EdgeVertex[this->Edges[steepest].Id] = v;
+    for (int direction = 0; direction < 2; ++direction)
+    {
+      int current = steepest;
+      for (bool advanced = true; advanced;)
+      {
+        advanced = false;
+        for (StarCell& tri : this->Triangles)
+        {
+          if (!tri.Paired && (tri.Faces[0] == current || tri.Faces[1] == current))
+          {
+            const int other = tri.Faces[0] == current ? tri.Faces[1] : tri.Faces[0];
+            tri.Paired = true;
+            this->Edges[other].Paired = true;
+            this->Gradient.EdgeTriangle[this->Edges[other].Id] = tri.Id;
+            this->Gradient.TriangleEdge[tri.Id] = this->Edges[other].Id;
+            current = other;
+            advanced = true;
+            break;
+          }
+        }
+      }
+    }
+  }
+
   void Process(Index v)
   {
     const TriangleMeshTopology& mesh = this->Mesh;
+    const bool boundaryVertex = mesh.IsBoundaryVertex(v);
     this->Edges.clear();
     this->Triangles.clear();
     auto localEdge = [&](Index e, Index other) {
@@ -117,7 +159,8 @@ struct LowerStarProcessor
       c.Id = e;
       c.Key = { other, InvalidIndex };
       c.IsEdge = true;
-      c.Boundary = mesh.IsBoundaryEdge(e);
+      // Only a boundary vertex has boundary edges (saves a random read per edge).
+      c.Boundary = boundaryVertex && mesh.IsBoundaryEdge(e);
       this->Edges.push_back(c);
       return static_cast<int>(this->Edges.size()) - 1;
     };
@@ -155,8 +198,14 @@ struct LowerStarProcessor
       }
     }
 
+    if (!boundaryVertex && !this->Edges.empty() && this->Triangles.size() + 1 == this->Edges.size() &&
+      !DiscreteGradient::GeneralPathOnly)
+    {
+      this->ProcessRegular(v);
+      return;
+    }
+
     // 1. The vertex pairs with its steepest admissible lower edge (same boundary flag).
-    const bool boundaryVertex = mesh.IsBoundaryVertex(v);
     int steepest = -1;
     for (int i = 0; i < static_cast<int>(this->Edges.size()); ++i)
     {
@@ -235,6 +284,8 @@ struct LowerStarProcessor
   }
 };
 } // namespace
+
+bool DiscreteGradient::GeneralPathOnly = false;
 
 Index DiscreteGradient::EdgeOwner(const TriangleMeshTopology& mesh, const VertexOrder& order, Index e)
 {

@@ -48,6 +48,10 @@ public:
   }
   bool IsCriticalTriangle(Index t) const { return this->TriangleEdge[t] == InvalidIndex; }
 
+  // Tests only: process every lower star with the general queues (no fast path for regular
+  // interior vertices), to show both give the same gradient.
+  static bool GeneralPathOnly;
+
   // The vertex whose lower star holds the cell (its highest vertex): where a critical cell
   // is placed in the domain.
   static Index EdgeOwner(const TriangleMeshTopology& mesh, const VertexOrder& order, Index e);

@@ -677,16 +677,18 @@ bool MorseSmaleComplexExtraction::Extract(
   // vertices, slivers) join a neighbouring cell, first through neighbours flowing to the same
   // minimum, then through any neighbour.
   complex.TwoCellId.assign(nV, InvalidIndex);
-  std::vector<Index> queue;
-  queue.reserve(nV);
   std::vector<unsigned char> hasRegion(complex.TwoCells.size(), 0);
+  std::vector<Index> unassigned;
   for (Index v = 0; v < nV; ++v)
   {
     complex.TwoCellId[v] = cellOfRoot[components.Find(v)];
     if (complex.TwoCellId[v] != InvalidIndex)
     {
       hasRegion[complex.TwoCellId[v]] = 1;
-      queue.push_back(v);
+    }
+    else
+    {
+      unassigned.push_back(v);
     }
   }
   // A cell without a region of its own (a thin cell, or a whole domain that is one pouch)
@@ -697,36 +699,47 @@ bool MorseSmaleComplexExtraction::Extract(
     if (!hasRegion[c] && complex.TwoCellId[v] == InvalidIndex)
     {
       complex.TwoCellId[v] = c;
-      queue.push_back(v);
     }
   }
-  for (int pass = 0; pass < 2; ++pass)
-  {
-    if (pass == 1)
+  auto forNeighbours = [&](Index u, auto&& visit) {
+    for (Index i = mesh.VertexTriangleBegin(u); i < mesh.VertexTriangleEnd(u); ++i)
     {
-      queue.clear();
-      for (Index v = 0; v < nV; ++v)
+      for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
       {
-        if (complex.TwoCellId[v] != InvalidIndex)
-        {
-          queue.push_back(v);
-        }
+        visit(w);
       }
     }
+  };
+  // Breadth-first from the assigned vertices that touch unassigned ones (the only ones that
+  // can spread), in vertex order: linear in the unassigned part, deterministic.
+  for (int pass = 0; pass < 2; ++pass)
+  {
+    std::vector<Index> queue;
+    for (Index u : unassigned)
+    {
+      forNeighbours(u, [&](Index w) {
+        if (complex.TwoCellId[w] != InvalidIndex)
+        {
+          queue.push_back(w);
+        }
+      });
+      if (complex.TwoCellId[u] != InvalidIndex)
+      {
+        queue.push_back(u);
+      }
+    }
+    std::sort(queue.begin(), queue.end());
+    queue.erase(std::unique(queue.begin(), queue.end()), queue.end());
     for (size_t head = 0; head < queue.size(); ++head)
     {
       const Index u = queue[head];
-      for (Index i = mesh.VertexTriangleBegin(u); i < mesh.VertexTriangleEnd(u); ++i)
-      {
-        for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
+      forNeighbours(u, [&](Index w) {
+        if (complex.TwoCellId[w] == InvalidIndex && (pass == 1 || sameLabels(u, w)))
         {
-          if (complex.TwoCellId[w] == InvalidIndex && (pass == 1 || sameLabels(u, w)))
-          {
-            complex.TwoCellId[w] = complex.TwoCellId[u];
-            queue.push_back(w);
-          }
+          complex.TwoCellId[w] = complex.TwoCellId[u];
+          queue.push_back(w);
         }
-      }
+      });
     }
   }
   for (Index v = 0; v < nV; ++v)

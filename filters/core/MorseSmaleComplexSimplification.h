@@ -128,7 +128,7 @@ private:
   NodeSet DescendingNodes; // vertices
   NodeSet AscendingNodes;  // triangles
   std::vector<Index> ArcFirstNode; // per 1-cell: the saddle-side node of the forest path
-  std::vector<Index> ArcLastNode;  // per descending 1-cell: the saddle's vertex
+  std::vector<Index> ArcLastNode;  // per descending 1-cell: the saddle's vertex (none if 1 vertex)
   std::vector<Index> RootNode;     // per extremum: its vertex / triangle node
   std::vector<double> CriticalPointPosition; // x, y per critical point (its vertex)
 };

@@ -107,63 +107,61 @@ bool TriangleMeshTopology::Build(Index numberOfVertices, const std::vector<Index
   const Index nE = this->EdgeOffsets[numberOfVertices];
   this->EdgeVertices.resize(nE);
   this->EdgeTriangles.assign(nE, { InvalidIndex, InvalidIndex });
+  this->TriangleEdges.resize(nT);
+  // One pass per vertex v numbers the edges (v, w > v), and records for each of them its
+  // triangles and its slot in those triangles: every slot written belongs to an edge whose
+  // lower endpoint is v, so the tasks never write the same memory.
+  std::vector<unsigned char> manifold(numberOfVertices, 1);
   parallelFor(0, numberOfVertices, [&](Index begin, Index end) {
     std::vector<Index> scratch;
     for (Index v = begin; v < end; ++v)
     {
       HigherNeighbours(*this, v, scratch);
-      Index e = this->EdgeOffsets[v];
-      for (Index w : scratch)
+      const Index first = this->EdgeOffsets[v];
+      for (size_t k = 0; k < scratch.size(); ++k)
       {
-        this->EdgeVertices[e++] = { v, w };
+        this->EdgeVertices[first + k] = { v, scratch[k] };
       }
-    }
-  });
-
-  // Edge -> triangles: the triangles of the lower endpoint that contain the other endpoint.
-  std::vector<unsigned char> manifold(nE, 1);
-  parallelFor(0, nE, [&](Index begin, Index end) {
-    for (Index e = begin; e < end; ++e)
-    {
-      const Index a = this->EdgeVertices[e][0], b = this->EdgeVertices[e][1];
-      int count = 0;
-      for (Index i = this->VertexTriangleOffsets[a]; i < this->VertexTriangleOffsets[a + 1]; ++i)
+      for (Index i = this->VertexTriangleOffsets[v]; i < this->VertexTriangleOffsets[v + 1]; ++i)
       {
         const Index t = this->VertexTriangles[i];
         const auto& tv = this->TriangleVertices[t];
-        if (tv[0] == b || tv[1] == b || tv[2] == b)
+        for (int k = 0; k < 3; ++k)
         {
-          if (count < 2)
+          const Index a = tv[k], b = tv[(k + 1) % 3];
+          if (std::min(a, b) != v)
           {
-            this->EdgeTriangles[e][count] = t;
+            continue;
           }
-          ++count;
+          const Index w = std::max(a, b);
+          const Index e = first + static_cast<Index>(std::lower_bound(scratch.begin(), scratch.end(), w) - scratch.begin());
+          this->TriangleEdges[t][k] = e;
+          auto& slots = this->EdgeTriangles[e];
+          if (slots[0] == InvalidIndex)
+          {
+            slots[0] = t;
+          }
+          else if (slots[1] == InvalidIndex)
+          {
+            slots[1] = t;
+          }
+          else
+          {
+            manifold[v] = 0;
+          }
         }
       }
-      manifold[e] = count <= 2;
     }
   });
-  for (Index e = 0; e < nE; ++e)
+  for (Index v = 0; v < numberOfVertices; ++v)
   {
-    if (!manifold[e])
+    if (!manifold[v])
     {
-      error = "the mesh is not a 2-manifold: edge (" + std::to_string(this->EdgeVertices[e][0]) + ", " +
-        std::to_string(this->EdgeVertices[e][1]) + ") is shared by more than two triangles";
+      error = "the mesh is not a 2-manifold: an edge at point " + std::to_string(v) +
+        " is shared by more than two triangles";
       return false;
     }
   }
-
-  this->TriangleEdges.resize(nT);
-  parallelFor(0, nT, [&](Index begin, Index end) {
-    for (Index t = begin; t < end; ++t)
-    {
-      const auto& tv = this->TriangleVertices[t];
-      for (int k = 0; k < 3; ++k)
-      {
-        this->TriangleEdges[t][k] = this->FindEdge(tv[k], tv[(k + 1) % 3]);
-      }
-    }
-  });
 
   this->BoundaryVertex.assign(numberOfVertices, 0);
   for (Index e = 0; e < nE; ++e)

@@ -1,0 +1,972 @@
+#include "MorseSmaleComplexSimplification.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <queue>
+#include <tuple>
+
+namespace topospline
+{
+namespace
+{
+// Forwarding pointers with path halving: cancelled extremum -> the extremum that absorbed it,
+// merged 2-cell -> the 2-cell that represents the union. Links are set by the caller, so the
+// representative is always the survivor (not whichever root union-by-rank would pick).
+Index FollowForwarding(std::vector<Index>& forward, Index x)
+{
+  while (forward[x] != x)
+  {
+    forward[x] = forward[forward[x]];
+    x = forward[x];
+  }
+  return x;
+}
+
+// The domain boundary is a closed curve made of descending 1-cells between boundary minima
+// and boundary saddles (stage 1's boundary rule: boundary cells pair only with boundary
+// cells). Those critical points are the critical points of f restricted to that curve: a 1D
+// complex of its own, with as many minima as saddles. Maxima are triangles and never lie on
+// the curve; stage 1's OnBoundary flag on a maximum only says that its triangle touches the
+// boundary, so it is ignored here.
+bool OnBoundaryCurve(const CriticalPoint& cp)
+{
+  return cp.MorseIndex < 2 && cp.OnBoundary;
+}
+
+// (value, vertex, id): the order of simulation of simplicity used by stage 1, made total.
+bool LowerCriticalPoint(const CriticalPoint& a, const CriticalPoint& b)
+{
+  if (a.Value != b.Value)
+  {
+    return a.Value < b.Value;
+  }
+  if (a.Vertex != b.Vertex)
+  {
+    return a.Vertex < b.Vertex;
+  }
+  return a.Id < b.Id;
+}
+
+// A graph in compressed rows (each edge stored both ways).
+struct AdjacencyRows
+{
+  std::vector<Index> Offsets;
+  std::vector<Index> Neighbours;
+
+  void Build(Index numberOfNodes, const std::vector<std::array<Index, 2>>& edges,
+    const std::vector<std::array<Index, 2>>& moreEdges)
+  {
+    this->Offsets.assign(numberOfNodes + 1, 0);
+    for (const auto* list : { &edges, &moreEdges })
+    {
+      for (const auto& e : *list)
+      {
+        ++this->Offsets[e[0] + 1];
+        ++this->Offsets[e[1] + 1];
+      }
+    }
+    for (Index n = 0; n < numberOfNodes; ++n)
+    {
+      this->Offsets[n + 1] += this->Offsets[n];
+    }
+    this->Neighbours.resize(this->Offsets[numberOfNodes]);
+    std::vector<Index> cursor(this->Offsets.begin(), this->Offsets.end() - 1);
+    for (const auto* list : { &edges, &moreEdges })
+    {
+      for (const auto& e : *list)
+      {
+        this->Neighbours[cursor[e[0]]++] = e[1];
+        this->Neighbours[cursor[e[1]]++] = e[0];
+      }
+    }
+  }
+};
+} // namespace
+
+//------------------------------------------------------------------------------
+bool MorseSmaleComplexSimplification::Check(const MorseSmaleComplex& input, std::string& error) const
+{
+  auto fail = [&error](const std::string& what) {
+    error = "the input is not a Morse-Smale complex: " + what;
+    return false;
+  };
+  const auto& cps = input.CriticalPoints;
+  const Index nCP = static_cast<Index>(cps.size());
+  if (nCP == 0)
+  {
+    return fail("it has no critical points");
+  }
+  for (Index i = 0; i < nCP; ++i)
+  {
+    const CriticalPoint& cp = cps[i];
+    if (cp.MorseIndex < 0 || cp.MorseIndex > 2 || cp.Vertex < 0 || cp.Cell < 0 || !std::isfinite(cp.Value))
+    {
+      return fail("critical point " + std::to_string(i) + " has an invalid index, vertex, cell or value");
+    }
+  }
+  auto isCriticalPoint = [&](Index i, int morseIndex) {
+    return i >= 0 && i < nCP && cps[i].MorseIndex == morseIndex;
+  };
+  std::vector<int> descending(nCP, 0), ascending(nCP, 0);
+  const auto& arcs = input.Separatrices;
+  for (size_t a = 0; a < arcs.size(); ++a)
+  {
+    const Separatrix& arc = arcs[a];
+    const std::string name = "1-cell " + std::to_string(a);
+    const size_t n = arc.MeshCells.size();
+    if (std::any_of(arc.MeshCells.begin(), arc.MeshCells.end(), [](Index c) { return c < 0; }))
+    {
+      return fail(name + " has a negative mesh cell id");
+    }
+    if (arc.Type == Separatrix::Descending)
+    {
+      if (!isCriticalPoint(arc.Source, 0) || !isCriticalPoint(arc.Destination, 1))
+      {
+        return fail(name + " is descending but does not join a minimum to a saddle");
+      }
+      if (n < 1 || arc.Points.size() != 2 * n || arc.Values.size() != n)
+      {
+        return fail(name + ": a descending 1-cell needs 1+ vertices, with one point and value each");
+      }
+      if (arc.MeshCells.front() != cps[arc.Source].Vertex || arc.MeshCells.back() != cps[arc.Destination].Vertex)
+      {
+        return fail(name + " does not run from its minimum's vertex to its saddle's vertex");
+      }
+      ++descending[arc.Destination];
+    }
+    else if (arc.Type == Separatrix::Ascending)
+    {
+      if (!isCriticalPoint(arc.Source, 1) || !isCriticalPoint(arc.Destination, 2))
+      {
+        return fail(name + " is ascending but does not join a saddle to a maximum");
+      }
+      if (n < 1 || arc.Points.size() != 2 * (n + 2) || arc.Values.size() != n + 2)
+      {
+        return fail(name + ": an ascending 1-cell needs 1+ triangles and n+2 points and values");
+      }
+      if (arc.MeshCells.back() != cps[arc.Destination].Cell)
+      {
+        return fail(name + " does not end at its maximum's triangle");
+      }
+      ++ascending[arc.Source];
+    }
+    else
+    {
+      return fail(name + " has an unknown type");
+    }
+  }
+  for (Index i = 0; i < nCP; ++i)
+  {
+    if (cps[i].MorseIndex == 1 && (descending[i] != 2 || ascending[i] < 1 || ascending[i] > 2))
+    {
+      return fail("saddle " + std::to_string(i) + " has " + std::to_string(descending[i]) +
+        " descending and " + std::to_string(ascending[i]) + " ascending 1-cells (expected 2 and 1 or 2)");
+    }
+  }
+  const Index nArcs = static_cast<Index>(arcs.size());
+  for (size_t c = 0; c < input.TwoCells.size(); ++c)
+  {
+    const TwoCell& cell = input.TwoCells[c];
+    const std::string name = "2-cell " + std::to_string(c);
+    if (!isCriticalPoint(cell.Minimum, 0) || !isCriticalPoint(cell.Maximum, 2) || cell.Saddles[0] == InvalidIndex)
+    {
+      return fail(name + " lacks its minimum, maximum or first saddle");
+    }
+    for (int k = 0; k < 2; ++k)
+    {
+      if (cell.Saddles[k] == InvalidIndex)
+      {
+        continue;
+      }
+      const Index d = cell.Arcs[2 * k], u = cell.Arcs[2 * k + 1];
+      if (!isCriticalPoint(cell.Saddles[k], 1) || d < 0 || d >= nArcs || u < 0 || u >= nArcs ||
+        arcs[d].Type != Separatrix::Descending || arcs[d].Destination != cell.Saddles[k] ||
+        arcs[u].Type != Separatrix::Ascending || arcs[u].Source != cell.Saddles[k])
+      {
+        return fail(name + " has a corner whose 1-cells do not belong to its saddle");
+      }
+    }
+  }
+  const size_t nV = input.AscendingManifold.size();
+  if (input.DescendingManifold.size() != nV || input.TwoCellId.size() != nV)
+  {
+    return fail("its per-vertex arrays (manifolds, 2-cell ids) have different sizes");
+  }
+  const Index nCells = static_cast<Index>(input.TwoCells.size());
+  for (size_t v = 0; v < nV; ++v)
+  {
+    const Index a = input.AscendingManifold[v], d = input.DescendingManifold[v], c = input.TwoCellId[v];
+    if ((a != InvalidIndex && !isCriticalPoint(a, 0)) || (d != InvalidIndex && !isCriticalPoint(d, 2)) ||
+      c < 0 || c >= nCells)
+    {
+      return fail("vertex " + std::to_string(v) + " has an invalid manifold or 2-cell id");
+    }
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& input, std::string& error)
+{
+  this->Computed = false;
+  this->Sequence.clear();
+  this->Steps.clear();
+  if (!this->Check(input, error))
+  {
+    return false;
+  }
+  this->Input = input;
+  const auto& cps = this->Input.CriticalPoints;
+  const auto& arcs = this->Input.Separatrices;
+  const Index nCP = static_cast<Index>(cps.size());
+
+  double lowest = cps[0].Value, highest = cps[0].Value;
+  for (const CriticalPoint& cp : cps)
+  {
+    lowest = std::min(lowest, cp.Value);
+    highest = std::max(highest, cp.Value);
+  }
+  this->MaxPersistence = highest - lowest;
+
+  this->SaddleArcs.assign(nCP, { InvalidIndex, InvalidIndex, InvalidIndex, InvalidIndex });
+  this->ArcExtremum.resize(arcs.size());
+  for (Index a = 0; a < static_cast<Index>(arcs.size()); ++a)
+  {
+    const Separatrix& arc = arcs[a];
+    auto& slots = this->SaddleArcs[arc.Type == Separatrix::Descending ? arc.Destination : arc.Source];
+    const int first = arc.Type == Separatrix::Descending ? 0 : 2;
+    slots[slots[first] == InvalidIndex ? first : first + 1] = a;
+    this->ArcExtremum[a] = arc.Type == Separatrix::Descending ? arc.Source : arc.Destination;
+  }
+  this->Hooks.Report(0.1);
+
+  this->BuildForests();
+  this->Hooks.Report(0.3);
+  this->ComputeSequence();
+  if (this->Hooks.Aborted())
+  {
+    error = "aborted";
+    return false;
+  }
+  this->Hooks.Report(1.0);
+  this->Computed = true;
+  return true;
+}
+
+//------------------------------------------------------------------------------
+// The geometry of a merged 1-cell is the paper's trivial embedding: arc(s'->x) followed by
+// arc(s->x) backwards and arc(s->x'), for the cancelled pair (s, x). All three are paths in
+// the gradient forest (V-paths are deterministic, so all 1-cells reaching an extremum form a
+// tree rooted at it), and a cancellation joins the trees of x and x' by the saddle's own
+// cells, so they stay a forest whose trees are the merged regions. Trimming the back-and-forth
+// spikes of the concatenation (erasing its loops) leaves the unique path of that forest;
+// Simplify computes this path directly, which is equivalent, linear and needs no mesh.
+//
+// Descending 1-cells end with one step that is not a gradient step for one of the saddle's
+// two 1-cells: the saddle edge itself, from its lower vertex to its highest vertex (where the
+// saddle sits). So a descending 1-cell is stored as a forest path (minimum .. its next-to-last
+// vertex) plus its last vertex, and the last steps join the forest only when the saddle is
+// cancelled against a minimum. Ascending 1-cells are triangle V-paths throughout; cancelling
+// a saddle against a maximum joins the two triangles of the saddle edge.
+void MorseSmaleComplexSimplification::BuildForests()
+{
+  const auto& cps = this->Input.CriticalPoints;
+  const auto& arcs = this->Input.Separatrices;
+  const Index nCP = static_cast<Index>(cps.size());
+  const Index nArcs = static_cast<Index>(arcs.size());
+
+  Index vertexBound = 0, triangleBound = 0;
+  for (const Separatrix& arc : arcs)
+  {
+    for (Index c : arc.MeshCells)
+    {
+      Index& bound = arc.Type == Separatrix::Descending ? vertexBound : triangleBound;
+      bound = std::max(bound, c + 1);
+    }
+  }
+  std::vector<Index> nodeOfVertex(vertexBound, InvalidIndex), nodeOfTriangle(triangleBound, InvalidIndex);
+  this->DescendingNodes = NodeSet();
+  this->AscendingNodes = NodeSet();
+  auto node = [](NodeSet& set, std::vector<Index>& nodeOf, Index cell, const double* point, double value) {
+    if (nodeOf[cell] == InvalidIndex)
+    {
+      nodeOf[cell] = static_cast<Index>(set.Cell.size());
+      set.Cell.push_back(cell);
+      set.Point.push_back(point[0]);
+      set.Point.push_back(point[1]);
+      set.Value.push_back(value);
+    }
+    return nodeOf[cell];
+  };
+  auto addEdge = [](NodeSet& set, Index a, Index b) {
+    if (a != b)
+    {
+      set.Edges.push_back({ std::min(a, b), std::max(a, b) });
+    }
+  };
+
+  this->ArcFirstNode.assign(nArcs, InvalidIndex);
+  this->ArcLastNode.assign(nArcs, InvalidIndex);
+  this->RootNode.assign(nCP, InvalidIndex);
+  this->CriticalPointPosition.assign(2 * static_cast<size_t>(nCP), 0.0);
+  auto setPosition = [this](Index cp, const double* point) {
+    this->CriticalPointPosition[2 * cp] = point[0];
+    this->CriticalPointPosition[2 * cp + 1] = point[1];
+  };
+  for (Index a = 0; a < nArcs; ++a)
+  {
+    const Separatrix& arc = arcs[a];
+    const Index n = static_cast<Index>(arc.MeshCells.size());
+    if (arc.Type == Separatrix::Descending)
+    {
+      Index previous = InvalidIndex;
+      for (Index i = 0; i < n; ++i)
+      {
+        const Index current =
+          node(this->DescendingNodes, nodeOfVertex, arc.MeshCells[i], &arc.Points[2 * i], arc.Values[i]);
+        if (i > 0 && i < n - 1)
+        {
+          addEdge(this->DescendingNodes, previous, current);
+        }
+        if (i == 0)
+        {
+          this->RootNode[arc.Source] = current;
+        }
+        previous = current;
+      }
+      if (n == 1)
+      {
+        // A boundary minimum that owns an interior saddle (an epsilon pair of the boundary
+        // rule): the 1-cell is that vertex alone, with no saddle step.
+        this->ArcFirstNode[a] = nodeOfVertex[arc.MeshCells[0]];
+      }
+      else
+      {
+        this->ArcFirstNode[a] = nodeOfVertex[arc.MeshCells[n - 2]];
+        this->ArcLastNode[a] = nodeOfVertex[arc.MeshCells[n - 1]];
+      }
+      setPosition(arc.Source, &arc.Points[0]);
+      setPosition(arc.Destination, &arc.Points[2 * (n - 1)]);
+    }
+    else
+    {
+      Index previous = InvalidIndex;
+      for (Index i = 0; i < n; ++i)
+      {
+        const Index current = node(
+          this->AscendingNodes, nodeOfTriangle, arc.MeshCells[i], &arc.Points[2 * (i + 1)], arc.Values[i + 1]);
+        if (i > 0)
+        {
+          addEdge(this->AscendingNodes, previous, current);
+        }
+        previous = current;
+      }
+      this->ArcFirstNode[a] = nodeOfTriangle[arc.MeshCells[0]];
+      this->RootNode[arc.Destination] = previous;
+      setPosition(arc.Source, &arc.Points[0]);
+      setPosition(arc.Destination, &arc.Points[2 * (n + 1)]);
+    }
+  }
+  for (NodeSet* set : { &this->DescendingNodes, &this->AscendingNodes })
+  {
+    std::sort(set->Edges.begin(), set->Edges.end());
+    set->Edges.erase(std::unique(set->Edges.begin(), set->Edges.end()), set->Edges.end());
+  }
+}
+
+//------------------------------------------------------------------------------
+// Greedy cancellation in order of increasing persistence with a lazy priority queue
+// (Shivashankar's mscomplex-tri): every saddle-extremum pair joined by a 1-cell is a
+// candidate; validity is checked when a candidate is popped. Pairs are never re-validated
+// later because validity can only be lost: an extremum's 1-cells only ever gain saddles, and
+// a saddle's 1-cells only ever move to the survivor of a cancelled extremum. The threshold is
+// infinite, so the sequence holds every cancellation any threshold can perform; each valid
+// pop removes two critical points, so the loop ends.
+void MorseSmaleComplexSimplification::ComputeSequence()
+{
+  const auto& cps = this->Input.CriticalPoints;
+  const Index nCP = static_cast<Index>(cps.size());
+
+  struct Candidate
+  {
+    double Persistence;
+    Index Saddle;
+    Index Extremum;
+  };
+  // Ties in persistence (common: symmetric fields, and pairs on one vertex) are broken so
+  // that the younger extremum goes first, as the elder rule of persistent homology would
+  // (a higher minimum, a lower maximum, in stage 1's (value, vertex) order), then the saddle
+  // where the elder rule would pair it (the lower saddle for a minimum, the higher for a
+  // maximum), then ids: a total order, so the hierarchy does not depend on the queue.
+  auto popsBefore = [&cps](const Candidate& a, const Candidate& b) {
+    if (a.Persistence != b.Persistence)
+    {
+      return a.Persistence < b.Persistence;
+    }
+    const CriticalPoint& xa = cps[a.Extremum];
+    const CriticalPoint& xb = cps[b.Extremum];
+    if (xa.MorseIndex != xb.MorseIndex)
+    {
+      return xa.MorseIndex < xb.MorseIndex;
+    }
+    const bool minima = xa.MorseIndex == 0;
+    if (a.Extremum != b.Extremum)
+    {
+      return LowerCriticalPoint(xa, xb) != minima;
+    }
+    if (a.Saddle != b.Saddle)
+    {
+      return LowerCriticalPoint(cps[a.Saddle], cps[b.Saddle]) == minima;
+    }
+    return false;
+  };
+  auto popsAfter = [&popsBefore](const Candidate& a, const Candidate& b) { return popsBefore(b, a); };
+  std::priority_queue<Candidate, std::vector<Candidate>, decltype(popsAfter)> queue(popsAfter);
+  auto push = [&](Index saddle, Index extremum) {
+    queue.push({ std::abs(cps[saddle].Value - cps[extremum].Value), saddle, extremum });
+  };
+
+  // Saddles reached by each extremum's 1-cells (may hold dead saddles and repeats).
+  std::vector<std::vector<Index>> saddlesOf(nCP);
+  for (Index s = 0; s < nCP; ++s)
+  {
+    if (cps[s].MorseIndex != 1)
+    {
+      continue;
+    }
+    for (Index a : this->SaddleArcs[s])
+    {
+      if (a != InvalidIndex)
+      {
+        saddlesOf[this->ArcExtremum[a]].push_back(s);
+        push(s, this->ArcExtremum[a]);
+      }
+    }
+  }
+
+  std::vector<unsigned char> alive(nCP, 1);
+  std::vector<Index> forward(nCP);
+  std::iota(forward.begin(), forward.end(), 0);
+  std::vector<Index> stamp(nCP, InvalidIndex);
+  double threshold = 0;
+  size_t pops = 0;
+  while (!queue.empty())
+  {
+    if ((++pops & 0xfff) == 0 && this->Hooks.Aborted())
+    {
+      return;
+    }
+    const Candidate candidate = queue.top();
+    queue.pop();
+    const Index s = candidate.Saddle, x = candidate.Extremum;
+    if (!alive[s] || !alive[x])
+    {
+      continue;
+    }
+    // The saddle's 1-cells of the extremum's kind, and how many of them reach it now.
+    const int first = cps[x].MorseIndex == 0 ? 0 : 2;
+    const auto& slots = this->SaddleArcs[s];
+    if (slots[first + 1] == InvalidIndex)
+    {
+      // A boundary saddle has a single ascending 1-cell: no other maximum could take over.
+      continue;
+    }
+    int reaching = 0, side = 0;
+    for (int k = 0; k < 2; ++k)
+    {
+      if (FollowForwarding(forward, this->ArcExtremum[slots[first + k]]) == x)
+      {
+        ++reaching;
+        side = k;
+      }
+    }
+    // Exactly one 1-cell: a pair joined twice bounds a region (a pouch or a strangulation)
+    // that the cancellation would pinch off, and the new 1-cells would be loops.
+    if (reaching != 1)
+    {
+      continue;
+    }
+    // Boundary-boundary pairs are cancellations inside the 1D complex of the boundary curve:
+    // the curve keeps as many minima as saddles and stays a chain of descending 1-cells. A
+    // boundary-interior pair would remove a critical point of that curve alone: the curve
+    // would lose a minimum (or saddle) without its partner, so it would no longer be made of
+    // 1-cells joining boundary minima and saddles, and the 2-cells along it would not close.
+    if (OnBoundaryCurve(cps[s]) != OnBoundaryCurve(cps[x]))
+    {
+      continue;
+    }
+    const Index survivor = FollowForwarding(forward, this->ArcExtremum[slots[first + 1 - side]]);
+    threshold = std::max(threshold, candidate.Persistence);
+    const bool minimum = cps[x].MorseIndex == 0;
+    this->Sequence.push_back({ minimum ? cps[x].Id : cps[s].Id, minimum ? cps[s].Id : cps[x].Id,
+      cps[survivor].Id, candidate.Persistence, threshold });
+    this->Steps.push_back({ s, x, survivor, side });
+    alive[s] = alive[x] = 0;
+    forward[x] = survivor;
+
+    // The paper's rule: every other saddle of x is now joined to the survivor, once per
+    // 1-cell that reached x (multiplicities multiply, and s has one 1-cell to the survivor).
+    const Index step = static_cast<Index>(this->Steps.size());
+    std::vector<Index>& moved = saddlesOf[x];
+    std::vector<Index>& kept = saddlesOf[survivor];
+    for (Index other : moved)
+    {
+      if (alive[other] && stamp[other] != step)
+      {
+        stamp[other] = step;
+        kept.push_back(other);
+        push(other, survivor);
+      }
+    }
+    std::vector<Index>().swap(moved);
+  }
+}
+
+//------------------------------------------------------------------------------
+Index MorseSmaleComplexSimplification::NumberOfCancellations(double percent) const
+{
+  if (!this->Computed)
+  {
+    return 0;
+  }
+  if (percent >= 100)
+  {
+    return static_cast<Index>(this->Sequence.size());
+  }
+  const double threshold = percent / 100 * this->MaxPersistence;
+  const auto end = std::lower_bound(this->Sequence.begin(), this->Sequence.end(), threshold,
+    [](const Cancellation& c, double t) { return c.Threshold < t; });
+  return static_cast<Index>(end - this->Sequence.begin());
+}
+
+//------------------------------------------------------------------------------
+bool MorseSmaleComplexSimplification::Simplify(double percent, MorseSmaleComplex& output, std::string& error) const
+{
+  SimplificationOutput result;
+  if (!this->Simplify(percent, result, error))
+  {
+    return false;
+  }
+  output = std::move(result.Complex);
+  return true;
+}
+
+bool MorseSmaleComplexSimplification::Simplify(
+  double percent, SimplificationOutput& output, std::string& error) const
+{
+  if (!this->Computed)
+  {
+    error = "no simplification hierarchy: ComputeHierarchy must succeed first";
+    return false;
+  }
+  if (!(percent >= 0 && percent <= 100))
+  {
+    error = "the persistence threshold must be a percentage in [0, 100], got " + std::to_string(percent);
+    return false;
+  }
+  output = SimplificationOutput();
+  output.AbsoluteThreshold = percent / 100 * this->MaxPersistence;
+  const Index performed = this->NumberOfCancellations(percent);
+  output.Cancellations.assign(this->Sequence.begin(), this->Sequence.begin() + performed);
+
+  const MorseSmaleComplex& in = this->Input;
+  const auto& cps = in.CriticalPoints;
+  const auto& arcs = in.Separatrices;
+  const Index nCP = static_cast<Index>(cps.size());
+  const Index nArcs = static_cast<Index>(arcs.size());
+  MorseSmaleComplex& out = output.Complex;
+
+  // Survivors and where each cancelled extremum's region went.
+  std::vector<unsigned char> alive(nCP, 1);
+  std::vector<Index> forward(nCP);
+  std::iota(forward.begin(), forward.end(), 0);
+  for (Index j = 0; j < performed; ++j)
+  {
+    const Step& step = this->Steps[j];
+    alive[step.Saddle] = alive[step.Extremum] = 0;
+    forward[step.Extremum] = step.Survivor;
+  }
+  std::vector<Index> position(nCP, InvalidIndex);
+  for (Index i = 0; i < nCP; ++i)
+  {
+    if (alive[i])
+    {
+      position[i] = static_cast<Index>(out.CriticalPoints.size());
+      out.CriticalPoints.push_back(cps[i]);
+    }
+  }
+  auto survivorPosition = [&](Index cp) {
+    return cp == InvalidIndex ? InvalidIndex : position[FollowForwarding(forward, cp)];
+  };
+
+  // The merged gradient forests, each tree grown from its surviving extremum. A tree is
+  // traversed breadth-first, so every node gets its parent towards the extremum.
+  std::vector<std::array<Index, 2>> descendingJoins, ascendingJoins;
+  for (Index j = 0; j < performed; ++j)
+  {
+    const Step& step = this->Steps[j];
+    const auto& slots = this->SaddleArcs[step.Saddle];
+    if (cps[step.Extremum].MorseIndex == 0)
+    {
+      for (int k = 0; k < 2; ++k)
+      {
+        if (this->ArcLastNode[slots[k]] != InvalidIndex)
+        {
+          descendingJoins.push_back({ this->ArcFirstNode[slots[k]], this->ArcLastNode[slots[k]] });
+        }
+      }
+    }
+    else
+    {
+      ascendingJoins.push_back({ this->ArcFirstNode[slots[2]], this->ArcFirstNode[slots[3]] });
+    }
+  }
+  auto growForest = [&](const NodeSet& nodes, const std::vector<std::array<Index, 2>>& joins, int morseIndex,
+                      std::vector<Index>& parent, std::vector<Index>& tree) {
+    const Index n = static_cast<Index>(nodes.Cell.size());
+    AdjacencyRows rows;
+    rows.Build(n, nodes.Edges, joins);
+    parent.assign(n, InvalidIndex);
+    tree.assign(n, InvalidIndex);
+    std::vector<Index> queue;
+    for (Index x = 0; x < nCP; ++x)
+    {
+      const Index root = this->RootNode[x];
+      if (!alive[x] || cps[x].MorseIndex != morseIndex || root == InvalidIndex || tree[root] != InvalidIndex)
+      {
+        continue;
+      }
+      parent[root] = root;
+      tree[root] = x;
+      queue.assign(1, root);
+      for (size_t head = 0; head < queue.size(); ++head)
+      {
+        const Index u = queue[head];
+        for (Index i = rows.Offsets[u]; i < rows.Offsets[u + 1]; ++i)
+        {
+          const Index w = rows.Neighbours[i];
+          if (tree[w] == InvalidIndex)
+          {
+            tree[w] = x;
+            parent[w] = u;
+            queue.push_back(w);
+          }
+        }
+      }
+    }
+  };
+  std::vector<Index> descendingParent, descendingTree, ascendingParent, ascendingTree;
+  growForest(this->DescendingNodes, descendingJoins, 0, descendingParent, descendingTree);
+  growForest(this->AscendingNodes, ascendingJoins, 2, ascendingParent, ascendingTree);
+
+  // 1-cells: one per 1-cell of a surviving saddle, now ending at the survivor of its
+  // extremum. Each keeps its node sequence from the extremum, for the junction points.
+  std::vector<Index> outputArc(nArcs, InvalidIndex);
+  std::vector<std::vector<Index>> fromExtremum;
+  for (Index a = 0; a < nArcs; ++a)
+  {
+    const Separatrix& arc = arcs[a];
+    const bool descending = arc.Type == Separatrix::Descending;
+    const Index saddle = descending ? arc.Destination : arc.Source;
+    if (!alive[saddle])
+    {
+      continue;
+    }
+    const Index extremum = FollowForwarding(forward, this->ArcExtremum[a]);
+    const NodeSet& nodes = descending ? this->DescendingNodes : this->AscendingNodes;
+    const std::vector<Index>& parent = descending ? descendingParent : ascendingParent;
+    const std::vector<Index>& tree = descending ? descendingTree : ascendingTree;
+    const Index start = this->ArcFirstNode[a];
+    if (tree[start] != extremum)
+    {
+      error = "internal error: 1-cell " + std::to_string(a) + " is not connected to the extremum that absorbed its own";
+      return false;
+    }
+    std::vector<Index> path; // saddle side first
+    for (Index u = start;; u = parent[u])
+    {
+      path.push_back(u);
+      if (parent[u] == u)
+      {
+        break;
+      }
+    }
+    std::reverse(path.begin(), path.end()); // extremum first
+    if (descending && this->ArcLastNode[a] != InvalidIndex)
+    {
+      path.push_back(this->ArcLastNode[a]);
+    }
+
+    outputArc[a] = static_cast<Index>(out.Separatrices.size());
+    out.Separatrices.emplace_back();
+    Separatrix& merged = out.Separatrices.back();
+    merged.Type = arc.Type;
+    merged.Source = descending ? position[extremum] : position[saddle];
+    merged.Destination = descending ? position[saddle] : position[extremum];
+    const size_t n = path.size();
+    merged.MeshCells.resize(n);
+    if (descending)
+    {
+      merged.Points.resize(2 * n);
+      merged.Values.resize(n);
+      for (size_t i = 0; i < n; ++i)
+      {
+        merged.MeshCells[i] = nodes.Cell[path[i]];
+        merged.Points[2 * i] = nodes.Point[2 * path[i]];
+        merged.Points[2 * i + 1] = nodes.Point[2 * path[i] + 1];
+        merged.Values[i] = nodes.Value[path[i]];
+      }
+    }
+    else
+    {
+      // Saddle vertex, triangle centroids from the saddle to the maximum, maximum vertex.
+      merged.Points.resize(2 * (n + 2));
+      merged.Values.resize(n + 2);
+      merged.Points[0] = arc.Points[0];
+      merged.Points[1] = arc.Points[1];
+      merged.Values[0] = arc.Values[0];
+      for (size_t i = 0; i < n; ++i)
+      {
+        const Index u = path[n - 1 - i];
+        merged.MeshCells[i] = nodes.Cell[u];
+        merged.Points[2 * (i + 1)] = nodes.Point[2 * u];
+        merged.Points[2 * (i + 1) + 1] = nodes.Point[2 * u + 1];
+        merged.Values[i + 1] = nodes.Value[u];
+      }
+      merged.Points[2 * (n + 1)] = this->CriticalPointPosition[2 * extremum];
+      merged.Points[2 * (n + 1) + 1] = this->CriticalPointPosition[2 * extremum + 1];
+      merged.Values[n + 1] = cps[extremum].Value;
+    }
+    fromExtremum.push_back(std::move(path));
+  }
+
+  // Junction points. Followed from the extremum, each 1-cell is a path down its tree; a node
+  // is a junction when the 1-cells through it do not all continue the same way: to the same
+  // next node, or all end there. An ascending 1-cell ends at its saddle's vertex (encoded
+  // below zero); a descending one ends at its last node, which belongs to the extremum's tree
+  // only when that vertex lies in the tree (then a saddle sits on the junction). Nodes of
+  // other trees are skipped: a tree is the only place the 1-cells of one extremum share.
+  for (int pass = 0; pass < 2; ++pass)
+  {
+    const bool descending = pass == 0;
+    const NodeSet& nodes = descending ? this->DescendingNodes : this->AscendingNodes;
+    const std::vector<Index>& tree = descending ? descendingTree : ascendingTree;
+    const Index n = static_cast<Index>(nodes.Cell.size());
+    constexpr Index Unseen = std::numeric_limits<Index>::min();
+    constexpr Index EndsHere = -1;
+    std::vector<Index> next(n, Unseen);
+    std::vector<unsigned char> split(n, 0);
+    std::vector<Index> junctionOfNode(n, InvalidIndex);
+    for (int sweep = 0; sweep < 2; ++sweep)
+    {
+      for (Index a = 0; a < static_cast<Index>(out.Separatrices.size()); ++a)
+      {
+        const Separatrix& arc = out.Separatrices[a];
+        if ((arc.Type == Separatrix::Descending) != descending)
+        {
+          continue;
+        }
+        const std::vector<Index>& path = fromExtremum[a];
+        const Index extremum = descending ? arc.Source : arc.Destination;
+        const Index owner = tree[path[0]];
+        for (size_t i = 1; i < path.size(); ++i)
+        {
+          const Index u = path[i];
+          if (tree[u] != owner)
+          {
+            continue;
+          }
+          if (sweep == 0)
+          {
+            Index following = EndsHere;
+            if (i + 1 < path.size())
+            {
+              following = path[i + 1];
+            }
+            else if (!descending)
+            {
+              following = -2 - out.CriticalPoints[arc.Source].Vertex;
+            }
+            if (next[u] == Unseen)
+            {
+              next[u] = following;
+            }
+            else if (next[u] != following)
+            {
+              split[u] = 1;
+            }
+            continue;
+          }
+          if (!split[u])
+          {
+            continue;
+          }
+          if (junctionOfNode[u] == InvalidIndex)
+          {
+            junctionOfNode[u] = static_cast<Index>(output.JunctionPoints.size());
+            JunctionPoint junction;
+            junction.Type = arc.Type;
+            junction.Extremum = extremum;
+            junction.Cell = nodes.Cell[u];
+            junction.Position[0] = nodes.Point[2 * u];
+            junction.Position[1] = nodes.Point[2 * u + 1];
+            junction.Value = nodes.Value[u];
+            output.JunctionPoints.push_back(junction);
+          }
+          JunctionPoint& junction = output.JunctionPoints[junctionOfNode[u]];
+          junction.Separatrices.push_back(a);
+          if (descending && i + 1 == path.size())
+          {
+            junction.CriticalPoint = arc.Destination;
+          }
+        }
+      }
+    }
+  }
+
+  // 2-cells: unions of the input ones. Cancelling (s, x) merges, for each 1-cell of s of the
+  // other kind, the two 2-cells on either side of it that have s as a corner: the corners
+  // (s, 1-cell to x, that 1-cell) and (s, 1-cell to the survivor, that 1-cell).
+  const auto& cells = in.TwoCells;
+  const Index nCells = static_cast<Index>(cells.size());
+  struct Corner
+  {
+    Index Saddle, Descending, Ascending, Cell;
+    bool operator<(const Corner& o) const
+    {
+      return std::tie(this->Saddle, this->Descending, this->Ascending) < std::tie(o.Saddle, o.Descending, o.Ascending);
+    }
+  };
+  std::vector<Corner> corners;
+  for (Index c = 0; c < nCells; ++c)
+  {
+    for (int k = 0; k < 2; ++k)
+    {
+      if (cells[c].Saddles[k] != InvalidIndex)
+      {
+        corners.push_back({ cells[c].Saddles[k], cells[c].Arcs[2 * k], cells[c].Arcs[2 * k + 1], c });
+      }
+    }
+  }
+  std::sort(corners.begin(), corners.end());
+  auto cellAt = [&corners](Index saddle, Index descending, Index ascending) {
+    const Corner key{ saddle, descending, ascending, InvalidIndex };
+    const auto it = std::lower_bound(corners.begin(), corners.end(), key);
+    return it != corners.end() && !(key < *it) ? it->Cell : InvalidIndex;
+  };
+  std::vector<Index> cellForward(nCells);
+  std::iota(cellForward.begin(), cellForward.end(), 0);
+  auto mergeCells = [&](Index a, Index b) {
+    if (a == InvalidIndex || b == InvalidIndex)
+    {
+      return;
+    }
+    a = FollowForwarding(cellForward, a);
+    b = FollowForwarding(cellForward, b);
+    // The first cell represents the union, so unmerged cells keep their relative order.
+    cellForward[std::max(a, b)] = std::min(a, b);
+  };
+  for (Index j = 0; j < performed; ++j)
+  {
+    const Step& step = this->Steps[j];
+    const auto& slots = this->SaddleArcs[step.Saddle];
+    if (cps[step.Extremum].MorseIndex == 0)
+    {
+      for (int k = 2; k < 4; ++k)
+      {
+        if (slots[k] != InvalidIndex)
+        {
+          mergeCells(cellAt(step.Saddle, slots[step.Side], slots[k]), cellAt(step.Saddle, slots[1 - step.Side], slots[k]));
+        }
+      }
+    }
+    else
+    {
+      for (int k = 0; k < 2; ++k)
+      {
+        mergeCells(cellAt(step.Saddle, slots[k], slots[2 + step.Side]), cellAt(step.Saddle, slots[k], slots[3 - step.Side]));
+      }
+    }
+  }
+  std::vector<Index> outputCell(nCells, InvalidIndex);
+  std::vector<std::vector<std::array<Index, 3>>> outputCorners;
+  std::vector<double> weightedCentroid;
+  std::vector<Index> members;
+  for (Index c = 0; c < nCells; ++c)
+  {
+    const TwoCell& cell = cells[c];
+    const Index root = FollowForwarding(cellForward, c);
+    if (root == c)
+    {
+      outputCell[c] = static_cast<Index>(out.TwoCells.size());
+      TwoCell merged = cell;
+      merged.Minimum = survivorPosition(cell.Minimum);
+      merged.Maximum = survivorPosition(cell.Maximum);
+      merged.NumberOfVertices = 0;
+      out.TwoCells.push_back(merged);
+      outputCorners.emplace_back();
+      weightedCentroid.push_back(0);
+      weightedCentroid.push_back(0);
+      members.push_back(0);
+    }
+    const Index target = outputCell[root];
+    ++members[target];
+    TwoCell& merged = out.TwoCells[target];
+    merged.NumberOfVertices += cell.NumberOfVertices;
+    weightedCentroid[2 * target] += cell.Centroid[0] * cell.NumberOfVertices;
+    weightedCentroid[2 * target + 1] += cell.Centroid[1] * cell.NumberOfVertices;
+    for (int k = 0; k < 2; ++k)
+    {
+      if (cell.Saddles[k] != InvalidIndex && alive[cell.Saddles[k]])
+      {
+        outputCorners[target].push_back({ cell.Saddles[k], cell.Arcs[2 * k], cell.Arcs[2 * k + 1] });
+      }
+    }
+  }
+  for (Index c = 0; c < static_cast<Index>(out.TwoCells.size()); ++c)
+  {
+    TwoCell& cell = out.TwoCells[c];
+    const auto& list = outputCorners[c];
+    // Well-formed unions keep two corners; Sectors reports any other count for the tests.
+    cell.Sectors = static_cast<int>(list.size());
+    for (int k = 0; k < 2; ++k)
+    {
+      const bool present = k < static_cast<int>(list.size());
+      cell.Saddles[k] = present ? position[list[k][0]] : InvalidIndex;
+      cell.Arcs[2 * k] = present ? outputArc[list[k][1]] : InvalidIndex;
+      cell.Arcs[2 * k + 1] = present ? outputArc[list[k][2]] : InvalidIndex;
+    }
+    cell.Pouch = list.size() == 2 && cell.Saddles[0] == cell.Saddles[1];
+    if (members[c] == 1)
+    {
+      // Unmerged: keep the input centroid as it is (a weighted mean of one is not exact).
+    }
+    else if (cell.NumberOfVertices > 0)
+    {
+      cell.Centroid[0] = weightedCentroid[2 * c] / cell.NumberOfVertices;
+      cell.Centroid[1] = weightedCentroid[2 * c + 1] / cell.NumberOfVertices;
+    }
+    else if (!list.empty())
+    {
+      // A cell with no vertex of its own sits at its first saddle, as in stage 1.
+      cell.Centroid[0] = this->CriticalPointPosition[2 * list[0][0]];
+      cell.Centroid[1] = this->CriticalPointPosition[2 * list[0][0] + 1];
+    }
+  }
+
+  // Per-vertex labels: unions of the old regions.
+  const size_t nV = in.TwoCellId.size();
+  out.TwoCellId.resize(nV);
+  out.AscendingManifold.resize(nV);
+  out.DescendingManifold.resize(nV);
+  for (size_t v = 0; v < nV; ++v)
+  {
+    out.TwoCellId[v] = outputCell[FollowForwarding(cellForward, in.TwoCellId[v])];
+    out.AscendingManifold[v] = survivorPosition(in.AscendingManifold[v]);
+    out.DescendingManifold[v] = survivorPosition(in.DescendingManifold[v]);
+  }
+  return true;
+}
+} // namespace topospline
