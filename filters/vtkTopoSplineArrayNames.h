@@ -4,10 +4,11 @@
 
 namespace vtkTopoSplineArrayNames
 {
-// Blocks of the complex (a vtkMultiBlockDataSet, in this order).
-constexpr const char* CriticalPointsBlock = "Critical Points";
-constexpr const char* SeparatricesBlock = "1-Cells";
-constexpr const char* TwoCellsBlock = "2-Cells";
+// Blocks of the complex (a vtkMultiBlockDataSet, in this order). The names are valid
+// data-assembly node names, so ParaView selectors are simply "/Root/OneCells" etc.
+constexpr const char* CriticalPointsBlock = "CriticalPoints";
+constexpr const char* SeparatricesBlock = "OneCells";
+constexpr const char* TwoCellsBlock = "TwoCells";
 constexpr const char* SegmentationBlock = "Segmentation";
 enum BlockIndex
 {
@@ -18,14 +19,14 @@ enum BlockIndex
   NumberOfBlocks = 4
 };
 
-// Critical points (point data of the "Critical Points" block).
+// Critical points (point data of the "CriticalPoints" block).
 constexpr const char* CriticalPointId = "CriticalPointId";
 constexpr const char* CriticalIndex = "CriticalIndex";
 constexpr const char* CriticalValue = "CriticalValue";
 constexpr const char* VertexId = "VertexId";
 constexpr const char* IsOnBoundary = "IsOnBoundary";
 
-// 1-cells (cell data of the "1-Cells" block; point data: the scalar along the 1-cell).
+// 1-cells (cell data of the "OneCells" block; point data: the scalar along the 1-cell).
 constexpr const char* SeparatrixId = "SeparatrixId";
 constexpr const char* SourceId = "SourceId";
 constexpr const char* DestinationId = "DestinationId";
@@ -33,7 +34,7 @@ constexpr const char* SeparatrixType = "SeparatrixType"; // 0 descending (min-sa
 constexpr const char* ScalarAlong = "ScalarValue";
 constexpr const char* MeshCellId = "MeshCellId"; // vertex (descending) or triangle (ascending) id
 
-// 2-cells (point data of the "2-Cells" block: one point per cell, at its centroid).
+// 2-cells (point data of the "TwoCells" block: one point per cell, at its centroid).
 constexpr const char* TwoCellId = "TwoCellId";
 constexpr const char* MinimumId = "MinimumId";
 constexpr const char* MaximumId = "MaximumId";

@@ -8,12 +8,12 @@
  *
  * Output: one vtkMultiBlockDataSet holding the whole complex, so the next stage takes a single
  * input. Blocks (names and arrays in vtkTopoSplineArrayNames.h):
- *  0 "Critical Points"  vertices: CriticalPointId (stable), CriticalIndex (0/1/2),
+ *  0 "CriticalPoints"   vertices: CriticalPointId (stable), CriticalIndex (0/1/2),
  *                       CriticalValue, VertexId, IsOnBoundary
- *  1 "1-Cells"          polylines from the lower to the higher critical point: cell data
+ *  1 "OneCells"         polylines (the 1-cells) from the lower to the higher critical point: cell data
  *                       SeparatrixId, SourceId, DestinationId, SeparatrixType (0 descending
  *                       minimum-saddle, 1 ascending saddle-maximum); point data ScalarValue
- *  2 "2-Cells"          one point per 2-cell at its centroid: MinimumId, MaximumId, SaddleIds,
+ *  2 "TwoCells"         one point per 2-cell at its centroid: MinimumId, MaximumId, SaddleIds,
  *                       BoundarySeparatrixIds, IsPouch, NumberOfVertices
  *  3 "Segmentation"     the input geometry with AscendingManifoldId, DescendingManifoldId and
  *                       TwoCellId per point

@@ -24,17 +24,6 @@ Index FollowForwarding(std::vector<Index>& forward, Index x)
   return x;
 }
 
-// The domain boundary is a closed curve made of descending 1-cells between boundary minima
-// and boundary saddles (stage 1's boundary rule: boundary cells pair only with boundary
-// cells). Those critical points are the critical points of f restricted to that curve: a 1D
-// complex of its own, with as many minima as saddles. Maxima are triangles and never lie on
-// the curve; stage 1's OnBoundary flag on a maximum only says that its triangle touches the
-// boundary, so it is ignored here.
-bool OnBoundaryCurve(const CriticalPoint& cp)
-{
-  return cp.MorseIndex < 2 && cp.OnBoundary;
-}
-
 // (value, vertex, id): the order of simulation of simplicity used by stage 1, made total.
 bool LowerCriticalPoint(const CriticalPoint& a, const CriticalPoint& b)
 {
@@ -239,6 +228,26 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
     const int first = arc.Type == Separatrix::Descending ? 0 : 2;
     slots[slots[first] == InvalidIndex ? first : first + 1] = a;
     this->ArcExtremum[a] = arc.Type == Separatrix::Descending ? arc.Source : arc.Destination;
+  }
+
+  // The domain boundary is a closed curve made of descending 1-cells between boundary minima
+  // and boundary saddles (stage 1's boundary rule: boundary cells pair only with boundary
+  // cells): a 1D complex of its own, whose critical points are those of f along the curve,
+  // as many minima as saddles. A saddle is on it when its edge is a boundary edge, i.e. it
+  // has one triangle and so one ascending 1-cell; a minimum when such a saddle's 1-cells
+  // reach it. Read from the complex itself rather than from CriticalPoint::OnBoundary, which
+  // says where the vertex is: an interior saddle edge can hang from a boundary vertex (the
+  // epsilon pair of a boundary minimum whose vertex also owns an interior saddle), and a
+  // maximum triangle can touch the boundary; neither is a cell of the curve.
+  this->OnBoundaryCurve.assign(nCP, 0);
+  for (Index s = 0; s < nCP; ++s)
+  {
+    if (cps[s].MorseIndex == 1 && this->SaddleArcs[s][3] == InvalidIndex)
+    {
+      this->OnBoundaryCurve[s] = 1;
+      this->OnBoundaryCurve[this->ArcExtremum[this->SaddleArcs[s][0]]] = 1;
+      this->OnBoundaryCurve[this->ArcExtremum[this->SaddleArcs[s][1]]] = 1;
+    }
   }
   this->Hooks.Report(0.1);
 
@@ -493,7 +502,7 @@ void MorseSmaleComplexSimplification::ComputeSequence()
     // boundary-interior pair would remove a critical point of that curve alone: the curve
     // would lose a minimum (or saddle) without its partner, so it would no longer be made of
     // 1-cells joining boundary minima and saddles, and the 2-cells along it would not close.
-    if (OnBoundaryCurve(cps[s]) != OnBoundaryCurve(cps[x]))
+    if (this->OnBoundaryCurve[s] != this->OnBoundaryCurve[x])
     {
       continue;
     }

@@ -124,6 +124,7 @@ private:
   // ones [2..3] (InvalidIndex when it has a single ascending one, on the boundary).
   std::vector<std::array<Index, 4>> SaddleArcs;
   std::vector<Index> ArcExtremum; // per input 1-cell: its minimum or maximum (position)
+  std::vector<unsigned char> OnBoundaryCurve; // per critical point: a cell of the boundary curve
 
   NodeSet DescendingNodes; // vertices
   NodeSet AscendingNodes;  // triangles

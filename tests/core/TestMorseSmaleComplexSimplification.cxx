@@ -4,13 +4,15 @@
 // split trees by union-find) for the extrema that survive each threshold.
 //
 // Usage: TestMorseSmaleComplexSimplification [--benchmark]
-//   --benchmark also times ComputeHierarchy and Simplify on a 1000x1000 Shepard field.
-// Prints "N passed, N failed" and returns nonzero on failure.
+//   --benchmark only times ComputeHierarchy and Simplify on a 1000x1000 Shepard field.
+// Prints "N passed, N failed" (test cases) and returns nonzero on failure.
 #include "MorseSmaleComplexExtraction.h"
 #include "MorseSmaleComplexSimplification.h"
 #include "SyntheticFields.h"
+#include "TestHarness.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -20,31 +22,41 @@
 #include <numeric>
 #include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 using namespace topospline;
 
 namespace
 {
-int Passed = 0;
-int Failed = 0;
-
-// Records one check; prints the first few failures of each label.
-bool Check(bool condition, const std::string& label, const std::string& detail = std::string())
+// Failed checks of one test case, by label: a sweep repeats every check at 101 thresholds,
+// so each label is reported once, with how often and where it first failed.
+struct Failures
 {
-  static std::map<std::string, int> printed;
-  if (condition)
+  std::map<std::string, std::pair<int, std::string>> ByLabel;
+
+  bool Check(bool condition, const std::string& label, const std::string& detail = std::string())
   {
-    ++Passed;
-    return true;
+    if (!condition)
+    {
+      auto& entry = this->ByLabel[label];
+      if (entry.first++ == 0)
+      {
+        entry.second = detail;
+      }
+    }
+    return condition;
   }
-  ++Failed;
-  if (printed[label]++ < 5)
+  // Reports to the harness (one CHECK failure per label).
+  void Report() const
   {
-    std::printf("  FAILED: %s %s\n", label.c_str(), detail.c_str());
+    for (const auto& entry : this->ByLabel)
+    {
+      std::printf("  FAILED %dx: %s (first: %s)\n", entry.second.first, entry.first.c_str(), entry.second.second.c_str());
+      CHECK(entry.first.empty());
+    }
   }
-  return false;
-}
+};
 
 PlanarScalarField FieldFromGrid(const GridField& grid)
 {
@@ -69,19 +81,6 @@ double Milliseconds(std::chrono::steady_clock::time_point start)
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-bool SameSeparatrix(const Separatrix& a, const Separatrix& b)
-{
-  return a.Type == b.Type && a.Source == b.Source && a.Destination == b.Destination &&
-    a.MeshCells == b.MeshCells && a.Points == b.Points && a.Values == b.Values;
-}
-
-bool SameTwoCell(const TwoCell& a, const TwoCell& b)
-{
-  return a.Minimum == b.Minimum && a.Maximum == b.Maximum && a.Saddles == b.Saddles && a.Arcs == b.Arcs &&
-    a.Pouch == b.Pouch && a.NumberOfVertices == b.NumberOfVertices && a.Centroid[0] == b.Centroid[0] &&
-    a.Centroid[1] == b.Centroid[1] && a.Sectors == b.Sectors;
-}
-
 bool SameComplex(const MorseSmaleComplex& a, const MorseSmaleComplex& b)
 {
   if (a.CriticalPoints.size() != b.CriticalPoints.size() || a.Separatrices.size() != b.Separatrices.size() ||
@@ -100,14 +99,19 @@ bool SameComplex(const MorseSmaleComplex& a, const MorseSmaleComplex& b)
   }
   for (size_t i = 0; i < a.Separatrices.size(); ++i)
   {
-    if (!SameSeparatrix(a.Separatrices[i], b.Separatrices[i]))
+    const Separatrix &p = a.Separatrices[i], &q = b.Separatrices[i];
+    if (p.Type != q.Type || p.Source != q.Source || p.Destination != q.Destination || p.MeshCells != q.MeshCells ||
+      p.Points != q.Points || p.Values != q.Values)
     {
       return false;
     }
   }
   for (size_t i = 0; i < a.TwoCells.size(); ++i)
   {
-    if (!SameTwoCell(a.TwoCells[i], b.TwoCells[i]))
+    const TwoCell &p = a.TwoCells[i], &q = b.TwoCells[i];
+    if (p.Minimum != q.Minimum || p.Maximum != q.Maximum || p.Saddles != q.Saddles || p.Arcs != q.Arcs ||
+      p.Pouch != q.Pouch || p.NumberOfVertices != q.NumberOfVertices || p.Centroid[0] != q.Centroid[0] ||
+      p.Centroid[1] != q.Centroid[1] || p.Sectors != q.Sectors)
     {
       return false;
     }
@@ -119,12 +123,12 @@ bool SameComplex(const MorseSmaleComplex& a, const MorseSmaleComplex& b)
 //------------------------------------------------------------------------------
 // Independent persistence of the extrema of the PL field: the join tree (minima, sweeping up)
 // and the split tree (maxima, sweeping down) by union-find over the vertices, in stage 1's
-// order (value, then vertex id). Knows nothing of gradients or of the complex.
+// order (value, then vertex id), elder rule. Knows nothing of gradients or of the complex.
 struct ExtremumPersistence
 {
-  double Persistence = std::numeric_limits<double>::infinity(); // infinite for the global one
-  // The extremum's sublevel (superlevel) component just before it dies, or ever, touches the
-  // domain boundary, or it dies at a boundary vertex.
+  double Persistence = std::numeric_limits<double>::infinity(); // the global extremum never dies
+  // Its sublevel (superlevel) component touched the domain boundary before it died, or it
+  // died at a boundary vertex, or it never died.
   bool SeesBoundary = false;
 };
 
@@ -138,13 +142,13 @@ std::map<Index, ExtremumPersistence> MergeTreePersistence(
     neighbours[edge[0]].push_back(edge[1]);
     neighbours[edge[1]].push_back(edge[0]);
   }
-  auto below = [&](Index a, Index b) { // a comes first in the sweep
+  auto sweepsFirst = [&](Index a, Index b) {
     const bool lower = f[a] < f[b] || (f[a] == f[b] && a < b);
     return minima ? lower : !lower;
   };
   std::vector<Index> order(nV);
   std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), below);
+  std::sort(order.begin(), order.end(), sweepsFirst);
   std::vector<Index> rank(nV);
   for (Index i = 0; i < nV; ++i)
   {
@@ -161,12 +165,13 @@ std::map<Index, ExtremumPersistence> MergeTreePersistence(
     return x;
   };
   std::map<Index, ExtremumPersistence> result;
+  std::vector<Index> roots;
   for (Index v : order)
   {
     parent[v] = v;
     oldest[v] = v;
     boundary[v] = mesh.IsBoundaryVertex(v);
-    std::vector<Index> roots;
+    roots.clear();
     for (Index w : neighbours[v])
     {
       if (rank[w] < rank[v])
@@ -209,32 +214,25 @@ std::map<Index, ExtremumPersistence> MergeTreePersistence(
   }
   for (auto& entry : result)
   {
-    if (std::isinf(entry.second.Persistence))
-    {
-      entry.second.SeesBoundary = true; // its component ends up being the whole domain
-    }
+    entry.second.SeesBoundary = entry.second.SeesBoundary || std::isinf(entry.second.Persistence);
   }
   return result;
 }
 
 //------------------------------------------------------------------------------
 // Structural checks of one simplified complex against the mesh and field it came from.
-struct Shape
-{
-  int NonSimpleArcs = 0;
-};
-
-void CheckComplex(const std::string& name, const PlanarScalarField& field, const TriangleMeshTopology& mesh,
-  const MorseSmaleComplex& input, const SimplificationOutput& result, bool wholeHierarchy, Shape& shape)
+void CheckComplex(Failures& failures, const std::string& at, const PlanarScalarField& field,
+  const TriangleMeshTopology& mesh, const MorseSmaleComplex& input, const SimplificationOutput& result,
+  bool wholeHierarchy, int& nonSimpleArcs)
 {
   const MorseSmaleComplex& c = result.Complex;
   const auto& cps = c.CriticalPoints;
   const Index nCP = static_cast<Index>(cps.size());
   const auto counts = c.CountByIndex();
-  Check(counts[0] - counts[1] + counts[2] == 1, name + " Euler characteristic",
-    std::to_string(counts[0]) + " - " + std::to_string(counts[1]) + " + " + std::to_string(counts[2]));
+  failures.Check(counts[0] - counts[1] + counts[2] == 1, "Euler characteristic #min - #saddles + #max = 1",
+    at + ": " + std::to_string(counts[0]) + " - " + std::to_string(counts[1]) + " + " + std::to_string(counts[2]));
 
-  // Survivors: a sorted subset of the input, unchanged; the removed ones are listed.
+  // Survivors: a sorted subset of the input, unchanged; the others are listed as removed.
   bool sorted = true, unchanged = true;
   std::set<Index> kept;
   for (Index i = 0; i < nCP; ++i)
@@ -252,55 +250,53 @@ void CheckComplex(const std::string& name, const PlanarScalarField& field, const
     unchanged = unchanged && valid && original.Vertex == cp.Vertex && original.Cell == cp.Cell &&
       original.Value == cp.Value && original.MorseIndex == cp.MorseIndex && original.OnBoundary == cp.OnBoundary;
   }
-  Check(sorted, name + " critical points sorted");
-  Check(unchanged, name + " surviving critical points keep id, vertex, value");
+  failures.Check(sorted, "critical points stay sorted", at);
+  failures.Check(unchanged, "surviving critical points keep their id, vertex and value", at);
   std::set<Index> removed;
-  bool cancellationsConsistent = true;
+  bool consistent = true;
   for (const Cancellation& k : result.Cancellations)
   {
     removed.insert(k.Lower);
     removed.insert(k.Upper);
     const CriticalPoint& lower = input.CriticalPoints[k.Lower];
     const CriticalPoint& upper = input.CriticalPoints[k.Upper];
-    cancellationsConsistent = cancellationsConsistent && upper.MorseIndex == lower.MorseIndex + 1 &&
+    consistent = consistent && upper.MorseIndex == lower.MorseIndex + 1 &&
       k.Persistence == std::abs(upper.Value - lower.Value) && k.Threshold >= k.Persistence &&
       (k.Threshold < result.AbsoluteThreshold || wholeHierarchy) &&
       input.CriticalPoints[k.Survivor].MorseIndex == (lower.MorseIndex == 0 ? 0 : 2);
   }
-  Check(cancellationsConsistent, name + " cancellations consistent");
-  Check(removed.size() == 2 * result.Cancellations.size() && kept.size() + removed.size() == input.CriticalPoints.size(),
-    name + " every input critical point is kept or removed, once");
+  failures.Check(consistent, "cancellations: index pairs, persistence, below the threshold", at);
   bool disjoint = true;
   for (Index id : removed)
   {
     disjoint = disjoint && kept.count(id) == 0;
   }
-  Check(disjoint, name + " removed and kept are disjoint");
+  failures.Check(disjoint && removed.size() == 2 * result.Cancellations.size() &&
+      kept.size() + removed.size() == input.CriticalPoints.size(),
+    "every input critical point is either kept or removed once", at);
 
-  // 1-cells: paths in the mesh from the right critical cells, with the field's points.
+  // 1-cells: mesh paths from the right critical cells, with the field's points and values.
   std::vector<int> descending(nCP, 0), ascending(nCP, 0);
-  bool arcsValid = true, geometryValid = true;
-  std::string detail;
   for (size_t a = 0; a < c.Separatrices.size(); ++a)
   {
     const Separatrix& arc = c.Separatrices[a];
-    const bool d = arc.Type == Separatrix::Descending;
-    const Index lowerIndex = d ? 0 : 1;
-    if (arc.Source < 0 || arc.Source >= nCP || arc.Destination < 0 || arc.Destination >= nCP ||
-      cps[arc.Source].MorseIndex != lowerIndex || cps[arc.Destination].MorseIndex != lowerIndex + 1 ||
-      arc.MeshCells.empty())
+    const std::string where = at + ", 1-cell " + std::to_string(a);
+    const bool down = arc.Type == Separatrix::Descending;
+    const int lowerIndex = down ? 0 : 1;
+    if (!failures.Check(arc.Source >= 0 && arc.Source < nCP && arc.Destination >= 0 && arc.Destination < nCP &&
+          cps[arc.Source].MorseIndex == lowerIndex && cps[arc.Destination].MorseIndex == lowerIndex + 1 &&
+          !arc.MeshCells.empty(),
+          "1-cells join critical points of consecutive index", where))
     {
-      arcsValid = false;
-      detail = "arc " + std::to_string(a) + " endpoints";
       continue;
     }
     const size_t n = arc.MeshCells.size();
-    std::set<Index> distinct(arc.MeshCells.begin(), arc.MeshCells.end());
-    shape.NonSimpleArcs += distinct.size() != n;
-    if (d)
+    nonSimpleArcs += std::set<Index>(arc.MeshCells.begin(), arc.MeshCells.end()).size() != n;
+    bool ok = true;
+    if (down)
     {
       ++descending[arc.Destination];
-      bool ok = arc.MeshCells.front() == cps[arc.Source].Vertex && arc.MeshCells.back() == cps[arc.Destination].Vertex &&
+      ok = arc.MeshCells.front() == cps[arc.Source].Vertex && arc.MeshCells.back() == cps[arc.Destination].Vertex &&
         arc.Points.size() == 2 * n && arc.Values.size() == n;
       for (size_t i = 0; ok && i < n; ++i)
       {
@@ -308,21 +304,15 @@ void CheckComplex(const std::string& name, const PlanarScalarField& field, const
         ok = arc.Points[2 * i] == field.Points[2 * v] && arc.Points[2 * i + 1] == field.Points[2 * v + 1] &&
           arc.Values[i] == field.Values[v] && (i == 0 || mesh.FindEdge(arc.MeshCells[i - 1], v) != InvalidIndex);
       }
-      geometryValid = geometryValid && ok;
-      if (!ok)
-      {
-        detail = "descending arc " + std::to_string(a);
-      }
     }
     else
     {
       ++ascending[arc.Source];
       const auto& saddleTriangles = mesh.EdgeTriangles[cps[arc.Source].Cell];
-      bool ok = arc.MeshCells.back() == cps[arc.Destination].Cell && arc.Points.size() == 2 * (n + 2) &&
-        arc.Values.size() == n + 2 &&
-        (saddleTriangles[0] == arc.MeshCells[0] || saddleTriangles[1] == arc.MeshCells[0]);
       const Index sv = cps[arc.Source].Vertex, mv = cps[arc.Destination].Vertex;
-      ok = ok && arc.Points[0] == field.Points[2 * sv] && arc.Values[0] == field.Values[sv] &&
+      ok = arc.MeshCells.back() == cps[arc.Destination].Cell && arc.Points.size() == 2 * (n + 2) &&
+        arc.Values.size() == n + 2 && (saddleTriangles[0] == arc.MeshCells[0] || saddleTriangles[1] == arc.MeshCells[0]) &&
+        arc.Points[0] == field.Points[2 * sv] && arc.Values[0] == field.Values[sv] &&
         arc.Points[2 * (n + 1)] == field.Points[2 * mv] && arc.Values[n + 1] == field.Values[mv];
       for (size_t i = 0; ok && i < n; ++i)
       {
@@ -334,41 +324,32 @@ void CheckComplex(const std::string& name, const PlanarScalarField& field, const
           value += field.Values[v] / 3;
         }
         ok = arc.Points[2 * (i + 1)] == cx && arc.Values[i + 1] == value;
-        if (ok && i > 0)
+        int shared = 0; // consecutive triangles share an edge
+        for (Index e : mesh.TriangleEdges[t])
         {
-          // Consecutive triangles share an edge.
-          int shared = 0;
-          for (Index e : mesh.TriangleEdges[t])
-          {
-            shared += mesh.OtherEdgeTriangle(e, t) == arc.MeshCells[i - 1];
-          }
-          ok = shared == 1;
+          shared += i > 0 && mesh.OtherEdgeTriangle(e, t) == arc.MeshCells[i - 1];
         }
-      }
-      geometryValid = geometryValid && ok;
-      if (!ok)
-      {
-        detail = "ascending arc " + std::to_string(a);
+        ok = ok && (i == 0 || shared == 1);
       }
     }
+    failures.Check(ok, "1-cells are mesh paths between their critical cells, with the field's points and values", where);
   }
-  Check(arcsValid, name + " 1-cells join critical points of consecutive index", detail);
-  Check(geometryValid, name + " 1-cells are mesh paths with the field's points and values", detail);
   bool saddleArcs = true;
-  Index boundarySaddles = 0, interiorSaddles = 0;
+  Index corners = 0;
   for (Index i = 0; i < nCP; ++i)
   {
     if (cps[i].MorseIndex == 1)
     {
-      const int expectedUp = cps[i].OnBoundary ? 1 : 2;
-      saddleArcs = saddleArcs && descending[i] == 2 && ascending[i] == expectedUp;
-      (cps[i].OnBoundary ? boundarySaddles : interiorSaddles) += 1;
+      const int up = mesh.IsBoundaryEdge(cps[i].Cell) ? 1 : 2;
+      saddleArcs = saddleArcs && descending[i] == 2 && ascending[i] == up;
+      corners += 2 * up;
     }
   }
-  Check(saddleArcs, name + " every saddle keeps 2 descending and 2 (interior) or 1 (boundary) ascending 1-cells");
+  failures.Check(saddleArcs, "saddles keep 2 descending and 2 (1 on a boundary edge) ascending 1-cells", at);
 
-  // 2-cells: closed cycles min -> saddle -> max -> saddle -> min; one per pair of corners.
+  // 2-cells: closed cycles min -> saddle -> max -> saddle -> min, one per two saddle corners.
   bool cellsValid = true;
+  std::string detail = at;
   for (size_t k = 0; k < c.TwoCells.size(); ++k)
   {
     const TwoCell& cell = c.TwoCells[k];
@@ -376,21 +357,20 @@ void CheckComplex(const std::string& name, const PlanarScalarField& field, const
     for (int s = 0; ok && s < 2; ++s)
     {
       const Index down = cell.Arcs[2 * s], up = cell.Arcs[2 * s + 1];
-      ok = down >= 0 && up >= 0 && down < static_cast<Index>(c.Separatrices.size()) &&
-        up < static_cast<Index>(c.Separatrices.size()) &&
+      const Index nArcs = static_cast<Index>(c.Separatrices.size());
+      ok = down >= 0 && up >= 0 && down < nArcs && up < nArcs &&
         c.Separatrices[down].Type == Separatrix::Descending && c.Separatrices[up].Type == Separatrix::Ascending &&
         c.Separatrices[down].Source == cell.Minimum && c.Separatrices[down].Destination == cell.Saddles[s] &&
         c.Separatrices[up].Source == cell.Saddles[s] && c.Separatrices[up].Destination == cell.Maximum;
     }
     if (!ok && cellsValid)
     {
-      detail = "2-cell " + std::to_string(k) + " sectors " + std::to_string(cell.Sectors);
+      detail = at + ", 2-cell " + std::to_string(k) + " with " + std::to_string(cell.Sectors) + " corners";
     }
     cellsValid = cellsValid && ok;
   }
-  Check(cellsValid, name + " every 2-cell is a closed min-saddle-max-saddle cycle (or pouch)", detail);
-  Check(static_cast<Index>(c.TwoCells.size()) == 2 * interiorSaddles + boundarySaddles,
-    name + " one 2-cell per two saddle corners");
+  failures.Check(cellsValid, "every 2-cell is a closed min-saddle-max-saddle cycle (or a pouch)", detail);
+  failures.Check(2 * static_cast<Index>(c.TwoCells.size()) == corners, "one 2-cell per two saddle corners", at);
 
   bool labels = c.TwoCellId.size() == field.Values.size() && c.AscendingManifold.size() == field.Values.size() &&
     c.DescendingManifold.size() == field.Values.size();
@@ -405,15 +385,15 @@ void CheckComplex(const std::string& name, const PlanarScalarField& field, const
       ++vertices[id];
     }
   }
-  Check(labels, name + " every vertex has a 2-cell and surviving extrema");
+  failures.Check(labels, "every vertex has a 2-cell, a surviving minimum and maximum", at);
   bool counted = labels;
   for (size_t k = 0; counted && k < c.TwoCells.size(); ++k)
   {
     counted = vertices[k] == c.TwoCells[k].NumberOfVertices;
   }
-  Check(counted, name + " 2-cell vertex counts match the per-vertex ids");
+  failures.Check(counted, "2-cell vertex counts match the per-vertex 2-cell ids", at);
 
-  // Junction points: a mesh cell shared by 2+ of the listed 1-cells, all of its extremum.
+  // Junction points: a mesh cell on 2+ of the listed 1-cells, all of its extremum.
   bool junctionsValid = true;
   for (const JunctionPoint& j : result.JunctionPoints)
   {
@@ -421,124 +401,112 @@ void CheckComplex(const std::string& name, const PlanarScalarField& field, const
     for (Index a : j.Separatrices)
     {
       const Separatrix& arc = c.Separatrices[a];
-      ok = ok && arc.Type == j.Type &&
-        (j.Type == Separatrix::Descending ? arc.Source : arc.Destination) == j.Extremum &&
+      ok = ok && arc.Type == j.Type && (j.Type == Separatrix::Descending ? arc.Source : arc.Destination) == j.Extremum &&
         std::find(arc.MeshCells.begin(), arc.MeshCells.end(), j.Cell) != arc.MeshCells.end();
     }
     junctionsValid = junctionsValid && ok;
   }
-  Check(junctionsValid, name + " junction points lie on 2+ 1-cells of their extremum");
+  failures.Check(junctionsValid, "junction points lie on 2+ 1-cells of their extremum", at);
 }
 
 //------------------------------------------------------------------------------
-struct SweepSummary
+struct FieldCase
 {
-  std::array<Index, 3> Input{};
-  std::array<Index, 3> At25{};
-  Index Junctions25 = 0;
-  int NonSimpleArcs = 0;
-  Index Compared = 0;
-  Index Mismatches = 0;
-  Index Inversions = 0;
-  Index ElderViolations = 0;
+  std::string Name;
+  GridField Grid;
 };
 
-SweepSummary RunField(const std::string& name, const GridField& grid, bool fullSweep)
+// Everything the issue asks of one field, over a sweep 0..100% in steps of 1.
+void RunField(const FieldCase& fieldCase)
 {
-  SweepSummary summary;
-  const PlanarScalarField field = FieldFromGrid(grid);
+  Failures failures;
+  const PlanarScalarField field = FieldFromGrid(fieldCase.Grid);
   MorseSmaleComplexExtraction extraction;
   MorseSmaleComplex input;
   std::string error;
-  if (!Check(extraction.Extract(field, input, error), name + " extraction", error))
-  {
-    return summary;
-  }
-  summary.Input = input.CountByIndex();
+  const bool extracted = extraction.Extract(field, input, error);
+  CHECK(extracted);
   MorseSmaleComplexSimplification simplification;
-  if (!Check(simplification.ComputeHierarchy(input, error), name + " hierarchy", error))
+  const bool computed = extracted && simplification.ComputeHierarchy(input, error);
+  CHECK(computed);
+  if (!computed)
   {
-    return summary;
+    std::printf("  %s: %s\n", fieldCase.Name.c_str(), error.c_str());
+    return;
   }
   const auto& hierarchy = simplification.Hierarchy();
-  bool monotone = true;
+  Index inversions = 0, elderViolations = 0;
   for (size_t k = 0; k < hierarchy.size(); ++k)
   {
-    monotone = monotone && (k == 0 || hierarchy[k].Threshold >= hierarchy[k - 1].Threshold);
-    summary.Inversions += k > 0 && hierarchy[k].Persistence < hierarchy[k - 1].Threshold;
-    const CriticalPoint& removed = input.CriticalPoints[hierarchy[k].Lower].MorseIndex == 0
-      ? input.CriticalPoints[hierarchy[k].Lower]
-      : input.CriticalPoints[hierarchy[k].Upper];
+    failures.Check(k == 0 || hierarchy[k].Threshold >= hierarchy[k - 1].Threshold, "hierarchy thresholds non-decreasing");
+    inversions += k > 0 && hierarchy[k].Persistence < hierarchy[k - 1].Threshold;
+    const bool minimum = input.CriticalPoints[hierarchy[k].Lower].MorseIndex == 0;
+    const CriticalPoint& removed = input.CriticalPoints[minimum ? hierarchy[k].Lower : hierarchy[k].Upper];
     const CriticalPoint& survivor = input.CriticalPoints[hierarchy[k].Survivor];
-    // The elder rule would keep the deeper minimum (higher maximum).
-    summary.ElderViolations += removed.MorseIndex == 0 ? survivor.Value > removed.Value : survivor.Value < removed.Value;
+    // The elder rule keeps the deeper minimum (the higher maximum).
+    elderViolations += minimum ? survivor.Value > removed.Value : survivor.Value < removed.Value;
   }
-  Check(monotone, name + " hierarchy thresholds are non-decreasing");
   double range[2] = { input.CriticalPoints[0].Value, input.CriticalPoints[0].Value };
   for (const CriticalPoint& cp : input.CriticalPoints)
   {
     range[0] = std::min(range[0], cp.Value);
     range[1] = std::max(range[1], cp.Value);
   }
-  Check(simplification.MaximumPersistence() == range[1] - range[0], name + " maximum persistence is the critical value range");
+  failures.Check(simplification.MaximumPersistence() == range[1] - range[0],
+    "maximum persistence is the range of critical values");
 
-  // 0%: the input itself.
   SimplificationOutput zero;
-  Check(simplification.Simplify(0, zero, error), name + " simplify 0%", error);
-  Check(SameComplex(zero.Complex, input), name + " 0% returns the input unchanged");
-  Check(zero.Cancellations.empty(), name + " 0% cancels nothing");
+  failures.Check(simplification.Simplify(0, zero, error), "Simplify(0) succeeds", error);
+  failures.Check(SameComplex(zero.Complex, input) && zero.Cancellations.empty(), "0% returns the input unchanged");
 
-  // Independent persistence of the PL extrema, compared where it is comparable (see below).
   const auto joinTree = MergeTreePersistence(extraction.Mesh, field.Values, true);
   const auto splitTree = MergeTreePersistence(extraction.Mesh, field.Values, false);
 
-  // Sweep: counts never increase, survivors only shrink, every output is a valid complex.
   std::set<Index> previous;
   for (const CriticalPoint& cp : input.CriticalPoints)
   {
     previous.insert(cp.Id);
   }
-  std::array<Index, 3> last = summary.Input;
-  std::map<Index, std::string> mismatchOf;
-  const int step = fullSweep ? 1 : 5;
-  for (int percent = 0; percent <= 100; percent += step)
+  std::array<Index, 3> last = input.CountByIndex(), at25{};
+  Index junctions25 = 0, compared = 0;
+  int nonSimpleArcs = 0;
+  std::map<Index, std::string> mismatches;
+  for (int percent = 0; percent <= 100; ++percent)
   {
-    const std::string label = name + " " + std::to_string(percent) + "%";
+    const std::string at = std::to_string(percent) + "%";
     SimplificationOutput result;
-    if (!Check(simplification.Simplify(percent, result, error), label + " simplify", error))
+    if (!failures.Check(simplification.Simplify(percent, result, error), "Simplify succeeds", at + ": " + error))
     {
       continue;
     }
     const auto counts = result.Complex.CountByIndex();
-    Check(counts[0] <= last[0] && counts[1] <= last[1] && counts[2] <= last[2], name + " counts never increase");
+    failures.Check(counts[0] <= last[0] && counts[1] <= last[1] && counts[2] <= last[2], "counts never increase", at);
     last = counts;
     std::set<Index> kept;
     for (const CriticalPoint& cp : result.Complex.CriticalPoints)
     {
       kept.insert(cp.Id);
     }
-    Check(std::includes(previous.begin(), previous.end(), kept.begin(), kept.end()),
-      name + " survivors of a higher threshold survive every lower one");
+    failures.Check(std::includes(previous.begin(), previous.end(), kept.begin(), kept.end()),
+      "what survives a threshold survives every lower one", at);
     previous = kept;
-    Shape shape;
-    CheckComplex(label, field, extraction.Mesh, input, result, percent == 100, shape);
-    summary.NonSimpleArcs = std::max(summary.NonSimpleArcs, shape.NonSimpleArcs);
+    CheckComplex(failures, at, field, extraction.Mesh, input, result, percent == 100, nonSimpleArcs);
     if (percent == 25)
     {
-      summary.At25 = counts;
-      summary.Junctions25 = static_cast<Index>(result.JunctionPoints.size());
+      at25 = counts;
+      junctions25 = static_cast<Index>(result.JunctionPoints.size());
     }
 
-    // Extrema kept at threshold t vs. persistence pairs >= t. Comparable only away from the
-    // domain boundary: stage 1's boundary rule makes every local minimum of f along the
-    // boundary curve a critical point (the PL field has no such extremum), paired on its own
-    // vertex with an interior saddle that it may never cancel against (boundary-interior).
-    // So an interior basin that drains to the boundary is absorbed by a boundary minimum at
-    // the depth of the boundary exit, not at its join-tree persistence; boundary PL maxima
-    // sit on a boundary saddle with one ascending 1-cell and are never cancelled. The join
-    // (split) tree pairs are therefore compared for the interior extrema whose sublevel
-    // (superlevel) component never touched the boundary before the extremum died, and that
-    // died at an interior vertex; the global extrema and the others are not compared.
+    // The extrema kept at threshold t are those whose persistence pair is >= t, compared
+    // where the two computations can agree. Stage 1's boundary rule makes every minimum of f
+    // along the boundary curve a critical point (the PL field has no such extremum there),
+    // sharing its vertex with an interior saddle it may never be cancelled with (boundary-
+    // interior pair); an interior basin that drains across the boundary is then absorbed by
+    // that boundary minimum at the depth of its exit, not at its join-tree persistence.
+    // Likewise a PL maximum on the boundary sits on a boundary saddle (a single ascending
+    // 1-cell) and is never cancelled. So the comparison covers the interior extrema whose
+    // sublevel (superlevel) component had not touched the boundary when they died at an
+    // interior vertex; the global extrema and the boundary-affected ones are left out.
     const double t = result.AbsoluteThreshold;
     for (const CriticalPoint& cp : input.CriticalPoints)
     {
@@ -546,160 +514,174 @@ SweepSummary RunField(const std::string& name, const GridField& grid, bool fullS
       {
         continue;
       }
-      const auto& trees = cp.MorseIndex == 0 ? joinTree : splitTree;
-      const auto found = trees.find(cp.Vertex);
-      if (!Check(found != trees.end(), name + " interior extremum of the complex is a PL extremum"))
+      const auto& tree = cp.MorseIndex == 0 ? joinTree : splitTree;
+      const auto found = tree.find(cp.Vertex);
+      if (!failures.Check(found != tree.end(), "interior extrema of the complex are PL extrema", at) ||
+        found->second.SeesBoundary)
       {
         continue;
       }
-      if (found->second.SeesBoundary)
-      {
-        continue;
-      }
-      const bool expected = percent < 100 ? found->second.Persistence >= t : false;
+      ++compared;
+      const bool expected = percent < 100 && found->second.Persistence >= t;
       const bool survives = kept.count(cp.Id) > 0;
-      ++summary.Compared;
-      if (expected != survives)
+      if (expected != survives && mismatches.count(cp.Id) == 0)
       {
-        ++summary.Mismatches;
-        char text[160];
-        std::snprintf(text, sizeof(text), "extremum id %d (index %d) at %d%%: persistence %.6g, threshold %.6g, %s",
-          cp.Id, cp.MorseIndex, percent, found->second.Persistence, t, survives ? "kept" : "removed");
-        mismatchOf.emplace(cp.Id, text);
+        char text[200];
+        std::snprintf(text, sizeof(text), "%s extremum id %d at %d%%: merge-tree persistence %.6g, threshold %.6g, %s",
+          cp.MorseIndex == 0 ? "minimum" : "maximum", cp.Id, percent, found->second.Persistence, t,
+          survives ? "kept" : "removed");
+        mismatches[cp.Id] = text;
       }
     }
   }
-  for (const auto& entry : mismatchOf)
+  for (const auto& entry : mismatches)
   {
-    Check(false, name + " survivors match the merge-tree persistence", entry.second);
+    failures.Check(false, "survivors match the merge-tree persistence pairs", entry.second);
   }
-  if (mismatchOf.empty())
-  {
-    Check(true, name + " survivors match the merge-tree persistence");
-  }
+  failures.Check(nonSimpleArcs == 0, "1-cells are simple paths", std::to_string(nonSimpleArcs) + " 1-cells (all thresholds)");
 
-  // 100%: the whole hierarchy; what is left cannot be cancelled any more.
-  SimplificationOutput all;
-  Check(simplification.Simplify(100, all, error), name + " simplify 100%", error);
-  Check(all.Cancellations.size() == hierarchy.size(), name + " 100% performs the whole hierarchy");
-
-  // Replaying is deterministic.
-  SimplificationOutput again;
+  SimplificationOutput all, again;
+  failures.Check(simplification.Simplify(100, all, error) && all.Cancellations.size() == hierarchy.size(),
+    "100% performs the whole hierarchy");
+  simplification.Simplify(25, zero, error);
   simplification.Simplify(25, again, error);
-  SimplificationOutput once;
-  simplification.Simplify(25, once, error);
-  Check(SameComplex(again.Complex, once.Complex), name + " replay is deterministic");
-  return summary;
+  failures.Check(SameComplex(zero.Complex, again.Complex), "a replay is deterministic");
+
+  const auto counts = input.CountByIndex();
+  std::printf("  %s: %d/%d/%d min/saddle/max (%d critical points), at 25%%: %d/%d/%d (%d), %d junction points; "
+              "%zu cancellations, %d persistence inversions, %d elder-rule violations; %d merge-tree comparisons, "
+              "%zu extrema mismatched\n",
+    fieldCase.Name.c_str(), counts[0], counts[1], counts[2], counts[0] + counts[1] + counts[2], at25[0], at25[1],
+    at25[2], at25[0] + at25[1] + at25[2], junctions25, hierarchy.size(), inversions, elderViolations, compared,
+    mismatches.size());
+  failures.Report();
 }
 
-void CheckBadInput()
+TEST_CASE(TrigonometricField100)
+{
+  RunField({ "trig a=10 100x100", TrigonometricField(10, 100, -49) });
+}
+
+TEST_CASE(ShepardFields250)
+{
+  for (int seed = 1; seed <= 5; ++seed)
+  {
+    RunField({ "Shepard 50 sites p=2 250x250 seed " + std::to_string(seed), ShepardField(50, 2, 250, seed) });
+  }
+}
+
+TEST_CASE(SmallerShepardFields)
+{
+  RunField({ "Shepard 50 sites p=2 60x60 seed 1", ShepardField(50, 2, 60, 1) });
+  RunField({ "Shepard 50 sites p=2 120x120 seed 3", ShepardField(50, 2, 120, 3) });
+  RunField({ "Shepard 200 sites p=3 150x150 seed 9", ShepardField(200, 3, 150, 9) });
+  RunField({ "trig a=4 60x60", TrigonometricField(4, 60, -29) });
+}
+
+TEST_CASE(BadInput)
 {
   std::string error;
   MorseSmaleComplexSimplification simplification;
   MorseSmaleComplex output;
-  Check(!simplification.Simplify(10, output, error) && !error.empty(), "simplify before ComputeHierarchy fails");
+  CHECK(!simplification.Simplify(10, output, error) && !error.empty());
   error.clear();
-  Check(!simplification.ComputeHierarchy(MorseSmaleComplex(), error) && !error.empty(), "empty complex is refused");
+  CHECK(!simplification.ComputeHierarchy(MorseSmaleComplex(), error) && !error.empty());
 
   const PlanarScalarField field = FieldFromGrid(ShepardField(10, 2, 30, 7));
   MorseSmaleComplexExtraction extraction;
   MorseSmaleComplex input;
-  extraction.Extract(field, input, error);
+  CHECK(extraction.Extract(field, input, error));
+  auto refused = [&](MorseSmaleComplex broken, const char* what) {
+    error.clear();
+    const bool ok = simplification.ComputeHierarchy(broken, error);
+    std::printf("  %s -> \"%s\"\n", what, error.c_str());
+    CHECK(!ok && !error.empty());
+  };
   MorseSmaleComplex broken = input;
   broken.Separatrices[0].Source = static_cast<Index>(broken.CriticalPoints.size());
-  error.clear();
-  Check(!simplification.ComputeHierarchy(broken, error) && !error.empty(), "1-cell with a bad endpoint is refused", error);
+  refused(broken, "1-cell with an out-of-range endpoint");
   broken = input;
   broken.Separatrices.pop_back();
-  error.clear();
-  Check(!simplification.ComputeHierarchy(broken, error) && !error.empty(), "saddle missing a 1-cell is refused", error);
+  refused(broken, "saddle missing a 1-cell");
   broken = input;
   broken.TwoCellId.pop_back();
-  error.clear();
-  Check(!simplification.ComputeHierarchy(broken, error) && !error.empty(), "short per-vertex arrays are refused", error);
+  refused(broken, "short per-vertex array");
+  broken = input;
+  broken.Separatrices[1].Values.pop_back();
+  refused(broken, "1-cell with one value missing");
 
-  Check(simplification.ComputeHierarchy(input, error), "valid complex accepted", error);
+  CHECK(simplification.ComputeHierarchy(input, error));
   for (double percent : { -1.0, 100.5, std::numeric_limits<double>::quiet_NaN() })
   {
     error.clear();
-    Check(!simplification.Simplify(percent, output, error) && !error.empty(),
-      "threshold out of range is refused", std::to_string(percent));
+    CHECK(!simplification.Simplify(percent, output, error) && !error.empty());
   }
-  Check(simplification.Simplify(100, output, error), "100% accepted", error);
+  std::printf("  percent out of range -> \"%s\"\n", error.c_str());
+  CHECK(simplification.Simplify(100, output, error));
+}
 
-  // Simplifying an already simplified complex (chained filters) works too.
-  MorseSmaleComplex half;
-  simplification.Simplify(30, half, error);
-  MorseSmaleComplexSimplification chained;
-  Check(chained.ComputeHierarchy(half, error), "a simplified complex is a valid input", error);
-  MorseSmaleComplex same;
-  Check(chained.Simplify(0, same, error) && SameComplex(same, half), "chained 0% returns its input");
+// A simplified complex is again a valid input (two simplification filters in a row).
+TEST_CASE(ChainedSimplification)
+{
+  const PlanarScalarField field = FieldFromGrid(ShepardField(50, 2, 120, 2));
+  MorseSmaleComplexExtraction extraction;
+  MorseSmaleComplex input, half, same, chained, direct;
+  std::string error;
+  CHECK(extraction.Extract(field, input, error));
+  MorseSmaleComplexSimplification first, second;
+  CHECK(first.ComputeHierarchy(input, error));
+  CHECK(first.Simplify(10, half, error));
+  CHECK(second.ComputeHierarchy(half, error));
+  CHECK(second.Simplify(0, same, error));
+  CHECK(SameComplex(same, half));
+  CHECK(second.Simplify(100, chained, error));
+  CHECK(first.Simplify(100, direct, error));
+  // Both end where no valid cancellation is left; the counts agree on this field.
+  const auto a = chained.CountByIndex(), b = direct.CountByIndex();
+  std::printf("  chained 10%% then 100%%: %d/%d/%d, direct 100%%: %d/%d/%d\n", a[0], a[1], a[2], b[0], b[1], b[2]);
+  CHECK(a[0] - a[1] + a[2] == 1);
 }
 
 void Benchmark()
 {
-  const auto start = std::chrono::steady_clock::now();
+  auto start = std::chrono::steady_clock::now();
   const PlanarScalarField field = FieldFromGrid(ShepardField(50, 2, 1000, 1));
   const double generate = Milliseconds(start);
   MorseSmaleComplexExtraction extraction;
   MorseSmaleComplex input;
   std::string error;
-  auto t0 = std::chrono::steady_clock::now();
+  start = std::chrono::steady_clock::now();
   extraction.Extract(field, input, error);
-  const double extract = Milliseconds(t0);
+  const double extract = Milliseconds(start);
   MorseSmaleComplexSimplification simplification;
-  t0 = std::chrono::steady_clock::now();
-  Check(simplification.ComputeHierarchy(input, error), "benchmark hierarchy", error);
-  const double hierarchy = Milliseconds(t0);
-  double simplify[3];
-  const double percents[3] = { 2, 25, 100 };
-  SimplificationOutput result;
-  for (int k = 0; k < 3; ++k)
-  {
-    t0 = std::chrono::steady_clock::now();
-    Check(simplification.Simplify(percents[k], result, error), "benchmark simplify", error);
-    simplify[k] = Milliseconds(t0);
-  }
+  start = std::chrono::steady_clock::now();
+  const bool computed = simplification.ComputeHierarchy(input, error);
+  const double hierarchy = Milliseconds(start);
+  CHECK(computed);
   const auto counts = input.CountByIndex();
-  std::printf("benchmark Shepard 50 sites 1000x1000 seed 1: field %.0f ms, extraction %.0f ms, %d critical points;\n"
-              "  ComputeHierarchy %.2f ms (%zu cancellations); Simplify 2%% %.2f ms, 25%% %.2f ms, 100%% %.2f ms\n",
-    generate, extract, counts[0] + counts[1] + counts[2], hierarchy, simplification.Hierarchy().size(), simplify[0],
-    simplify[1], simplify[2]);
+  std::printf("Shepard 50 sites p=2 1000x1000 seed 1: field %.0f ms, extraction %.0f ms, %d/%d/%d critical points\n",
+    generate, extract, counts[0], counts[1], counts[2]);
+  std::printf("  ComputeHierarchy: %.2f ms (%zu cancellations)\n", hierarchy, simplification.Hierarchy().size());
+  for (double percent : { 0.0, 2.0, 25.0, 100.0 })
+  {
+    SimplificationOutput result;
+    start = std::chrono::steady_clock::now();
+    CHECK(simplification.Simplify(percent, result, error));
+    const double ms = Milliseconds(start);
+    const auto c = result.Complex.CountByIndex();
+    std::printf("  Simplify(%g%%): %.2f ms -> %d/%d/%d, %zu junction points\n", percent, ms, c[0], c[1], c[2],
+      result.JunctionPoints.size());
+  }
 }
 } // namespace
 
 int main(int argc, char** argv)
 {
-  const bool benchmark = argc > 1 && std::strcmp(argv[1], "--benchmark") == 0;
-  struct Case
+  auto& tests = testing_harness::Registry::Get().Tests;
+  if (argc > 1 && std::strcmp(argv[1], "--benchmark") == 0)
   {
-    std::string Name;
-    GridField Grid;
-    bool FullSweep;
-  };
-  std::vector<Case> cases;
-  cases.push_back({ "trig a=10 100x100", TrigonometricField(10, 100, -49), true });
-  for (int seed = 1; seed <= 5; ++seed)
-  {
-    cases.push_back({ "shepard seed " + std::to_string(seed) + " 250x250", ShepardField(50, 2, 250, seed), true });
+    tests.clear();
+    tests.emplace_back("Benchmark1000x1000", Benchmark);
   }
-  cases.push_back({ "shepard seed 1 60x60", ShepardField(50, 2, 60, 1), true });
-  cases.push_back({ "shepard seed 3 120x120", ShepardField(50, 2, 120, 3), true });
-  cases.push_back({ "shepard 200 sites power 3 seed 9 150x150", ShepardField(200, 3, 150, 9), true });
-  for (const Case& c : cases)
-  {
-    const SweepSummary s = RunField(c.Name, c.Grid, c.FullSweep);
-    std::printf("%s: input %d/%d/%d (min/saddle/max), at 25%%: %d/%d/%d, %d junction points; "
-                "merge-tree comparisons %d, mismatches %d; persistence inversions %d, elder-rule violations %d, "
-                "non-simple 1-cells %d\n",
-      c.Name.c_str(), s.Input[0], s.Input[1], s.Input[2], s.At25[0], s.At25[1], s.At25[2], s.Junctions25, s.Compared,
-      s.Mismatches, s.Inversions, s.ElderViolations, s.NonSimpleArcs);
-  }
-  CheckBadInput();
-  if (benchmark)
-  {
-    Benchmark();
-  }
-  std::printf("%d passed, %d failed\n", Passed, Failed);
-  return Failed == 0 ? 0 : 1;
+  return testing_harness::RunAll();
 }

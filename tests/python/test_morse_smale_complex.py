@@ -19,7 +19,7 @@ checks = tt.Checks()
 # the paper's interior 8 minima, 9 saddles and 8 maxima lie inside the domain.
 trig = tt.fetch_complex(MorseSmaleComplex(Input=TrigonometricField()))
 tt.check_complex(checks, trig, "trig")
-checks.equal(trig["blocks"], ["Critical Points", "1-Cells", "2-Cells", "Segmentation"], "block names")
+checks.equal(trig["blocks"], ["CriticalPoints", "OneCells", "TwoCells", "Segmentation"], "block names")
 checks.equal(tt.counts(trig), [18, 27, 10], "trig: critical points by index")
 checks.equal(tt.interior_counts(trig), [8, 9, 8], "trig: interior critical points by index")
 checks.equal(trig["cp_VertexId"][trig["cp_CriticalIndex"] == 0].tolist().count(0), 1, "trig: corner minimum")

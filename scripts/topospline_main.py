@@ -1,0 +1,164 @@
+"""TopoSpline main job (run by scripts/run-main.sh under pvbatch).
+
+Runs the pipeline on the built-in Shepard field (the paper's parameters) or on a given 2D
+field, and writes into the output folder: the input and every stage's result as VTK XML files
+(inline binary, readable everywhere), PNG pictures in the style of the paper's figures, and
+summary.json (counts, timings per stage)."""
+import argparse
+import json
+import os
+import sys
+import time
+
+from paraview.simple import *
+from paraview import servermanager as sm
+from vtkmodules.vtkCommonCore import vtkSMPTools
+
+parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+parser.add_argument("--input", help="a 2D .vti/.vtu/.vtp file (default: the built-in Shepard field)")
+parser.add_argument("--array", help="point scalar array of the input (default: the active scalars)")
+parser.add_argument("--output", default="output", help="output folder (default: ./output)")
+parser.add_argument("--threshold", type=float, default=25.0,
+                    help="persistence threshold in %% of the maximum persistence (default 25, the paper's Shepard)")
+parser.add_argument("--k", type=int, default=4, help="cubic segments per 1-cell piece (default 4)")
+parser.add_argument("--seed", type=int, default=1, help="seed of the built-in Shepard field")
+args = parser.parse_args([a for a in sys.argv[1:] if a != "--"])
+
+plugin = os.environ.get("TOPOSPLINE_PLUGIN")
+if not plugin or not os.path.exists(plugin):
+    sys.exit("TOPOSPLINE_PLUGIN must name the built TopoSpline.so (scripts/run-main.sh sets it)")
+LoadPlugin(plugin, remote=False, ns=globals())
+vtkSMPTools.SetBackend("STDThread")
+os.makedirs(args.output, exist_ok=True)
+summary = {"input": args.input or "built-in Shepard field (50 sites, mu = 2, 250 x 250, seed %d)" % args.seed,
+           "smp_backend": vtkSMPTools.GetBackend(), "threads": vtkSMPTools.GetEstimatedNumberOfThreads(),
+           "timings_s": {}, "stages_available": []}
+
+
+def timed(name, proxy):
+    start = time.perf_counter()
+    proxy.UpdatePipeline()
+    summary["timings_s"][name] = round(time.perf_counter() - start, 4)
+    return proxy
+
+
+# --- Input ---
+if args.input:
+    extension = os.path.splitext(args.input)[1].lower()
+    readers = {".vti": XMLImageDataReader, ".vtu": XMLUnstructuredGridReader, ".vtp": XMLPolyDataReader}
+    if extension not in readers:
+        sys.exit("unsupported input %s (use .vti, .vtu or .vtp)" % args.input)
+    source = readers[extension](FileName=[os.path.abspath(args.input)])
+else:
+    source = ShepardField(Seed=args.seed)
+timed("input", source)
+array = args.array or source.PointData.keys()[0]
+summary["scalar_field"] = array
+
+# --- Stage 1: the Morse-Smale complex ---
+complex_ = MorseSmaleComplex(Input=source)
+complex_.ScalarField = ["POINTS", array]
+timed("1 Morse-Smale complex", complex_)
+summary["stages_available"].append("Morse-Smale Complex")
+data = sm.Fetch(complex_)
+if data is None or data.GetNumberOfBlocks() != 4:
+    sys.exit("the Morse-Smale complex could not be computed (see the error above)")
+from vtkmodules.util.numpy_support import vtk_to_numpy
+import numpy as np
+index = vtk_to_numpy(data.GetBlock(0).GetPointData().GetArray("CriticalIndex"))
+summary["complex"] = {"minima": int(np.sum(index == 0)), "saddles": int(np.sum(index == 1)),
+                      "maxima": int(np.sum(index == 2)), "1-cells": data.GetBlock(1).GetNumberOfCells(),
+                      "2-cells": data.GetBlock(2).GetNumberOfPoints()}
+summary["complex"]["euler_characteristic"] = (summary["complex"]["minima"] - summary["complex"]["saddles"] +
+                                              summary["complex"]["maxima"])
+
+# Later stages, when this build has them.
+later = [("Simplify Morse-Smale Complex", "SimplifyMorseSmaleComplex"), ("Smooth 1-Cells", "Smooth1Cells"),
+         ("Reconstruct 2-Cells", "Reconstruct2Cells")]
+missing = [label for label, fn in later if fn not in globals()]
+if missing:
+    summary["stages_missing"] = missing
+    print("main: stages not in this build yet: %s" % ", ".join(missing), flush=True)
+
+# --- Files (inline binary XML: appended XML files are unreadable with Debian 12's expat) ---
+files = {}
+writers = [("input", source, ".vti" if not args.input or args.input.endswith(".vti") else
+            os.path.splitext(args.input)[1]), ("complex", complex_, ".vtm")]
+for name, proxy, ext in writers:
+    path = os.path.join(args.output, name + ext)
+    SaveData(path, proxy=proxy, DataMode="Binary", CompressorType="ZLib")
+    files[name] = path
+summary["files"] = files
+
+# --- Pictures in the style of the paper: colour map + isolines; ascending 1-cells red,
+# descending green; minima blue, saddles green, maxima red ---
+view = CreateRenderView()
+view.ViewSize = [1000, 1000]
+view.OrientationAxesVisibility = 0
+view.Background = [1, 1, 1]
+try:
+    view.UseColorPaletteForBackground = 0
+except AttributeError:
+    pass
+
+
+def solid(display, color):
+    display.ColorArrayName = ["POINTS", ""]
+    display.AmbientColor = display.DiffuseColor = color
+
+
+def show_field(proxy):
+    display = Show(proxy, view)
+    ColorBy(display, ("POINTS", array))
+    lut = GetColorTransferFunction(array)
+    lut.ApplyPreset("Viridis (matplotlib)", True)
+    display.SetScalarBarVisibility(view, False)
+    rng = proxy.PointData[array].GetRange()
+    contours = Contour(Input=proxy, ContourBy=["POINTS", array],
+                       Isosurfaces=list(np.linspace(rng[0], rng[1], 22)[1:-1]))
+    cdisplay = Show(contours, view)
+    solid(cdisplay, [0.1, 0.1, 0.1])
+    cdisplay.LineWidth = 1.0
+    return display
+
+
+def show_complex(ms_proxy):
+    arcs = ExtractBlock(Input=ms_proxy, Selectors=["/Root/OneCells"])
+    for kind, color in ((0, [0.0, 0.6, 0.0]), (1, [0.85, 0.0, 0.0])):
+        sel = Threshold(Input=arcs, Scalars=["CELLS", "SeparatrixType"], LowerThreshold=kind, UpperThreshold=kind)
+        d = Show(sel, view)
+        solid(d, color)
+        d.LineWidth = 3.0
+    cps = ExtractBlock(Input=ms_proxy, Selectors=["/Root/CriticalPoints"])
+    for kind, color in ((0, [0.0, 0.2, 1.0]), (1, [0.0, 0.7, 0.0]), (2, [1.0, 0.0, 0.0])):
+        sel = Threshold(Input=cps, Scalars=["POINTS", "CriticalIndex"], LowerThreshold=kind, UpperThreshold=kind)
+        d = Show(sel, view)
+        solid(d, color)
+        d.SetRepresentationType("Points")
+        d.RenderPointsAsSpheres = 1
+        d.PointSize = 12
+
+
+def save(name):
+    ResetCamera(view)
+    view.CameraParallelProjection = 1
+    Render(view)
+    path = os.path.join(args.output, name)
+    SaveScreenshot(path, view, ImageResolution=[1000, 1000])
+    pictures.append(path)
+    for proxy in list(GetSources().values()):
+        Hide(proxy, view)
+
+
+pictures = []
+show_field(source)
+save("1_input.png")
+show_field(source)
+show_complex(complex_)
+save("2_morse_smale_complex.png")
+summary["pictures"] = pictures
+
+with open(os.path.join(args.output, "summary.json"), "w") as f:
+    json.dump(summary, f, indent=2)
+print(json.dumps(summary, indent=2))
+print("main: results in %s" % os.path.abspath(args.output))
