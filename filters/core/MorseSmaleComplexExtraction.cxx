@@ -265,8 +265,8 @@ bool MorseSmaleComplexExtraction::Extract(
     }
   }
 
-  // Ascending manifolds (per vertex: the minimum its V-path reaches) and descending manifolds
-  // (per triangle: the maximum its dual V-path reaches).
+  // Ascending manifolds: per vertex, the minimum its V-path reaches. (Descending manifolds
+  // are read from the 2-cells below.)
   auto nextVertex = [&](Index v) {
     const Index e = grad.VertexEdge[v];
     return e == InvalidIndex ? InvalidIndex : mesh.OtherEdgeVertex(e, v);
@@ -275,10 +275,7 @@ bool MorseSmaleComplexExtraction::Extract(
     const Index e = grad.TriangleEdge[t];
     return e == InvalidIndex ? InvalidIndex : mesh.OtherEdgeTriangle(e, t);
   };
-  std::vector<Index> triangleMaximum;
-  if (!LabelByFlow(nV, complex.AscendingManifold, nextVertex, [&](Index v) { return minimumOfVertex[v]; }) ||
-    !LabelByFlow(mesh.NumberOfTriangles(), triangleMaximum, nextTriangle,
-      [&](Index t) { return maximumOfTriangle[t]; }))
+  if (!LabelByFlow(nV, complex.AscendingManifold, nextVertex, [&](Index v) { return minimumOfVertex[v]; }))
   {
     error = "internal error: the discrete gradient has a cycle";
     return false;
