@@ -16,8 +16,11 @@ enum BlockIndex
   SeparatricesIndex = 1,
   TwoCellsIndex = 2,
   SegmentationIndex = 3,
-  NumberOfBlocks = 4
+  NumberOfBlocks = 4,
+  // Only in simplified complexes: where 1-cells sharing an extremum merge.
+  JunctionPointsIndex = 4
 };
+constexpr const char* JunctionPointsBlock = "JunctionPoints";
 
 // Critical points (point data of the "CriticalPoints" block).
 constexpr const char* CriticalPointId = "CriticalPointId";

@@ -64,6 +64,36 @@ bool DetectEmbedding(vtkDataSet* data, PlanarEmbedding& embedding)
   return false;
 }
 
+// The plane of an image is its one-point axis; a mesh's, the axis with no extent. The image
+// rule is the same axes choice ToPlanarScalarField makes (the two axes with several points).
+PlanarEmbedding EmbeddingOf(vtkDataSet* domain)
+{
+  PlanarEmbedding embedding;
+  if (auto* image = vtkImageData::SafeDownCast(domain))
+  {
+    int dims[3];
+    image->GetDimensions(dims);
+    double origin[3];
+    image->GetOrigin(origin);
+    for (int w = 2; w >= 0; --w)
+    {
+      if (dims[w] == 1)
+      {
+        embedding.W = w;
+        embedding.U = w == 0 ? 1 : 0;
+        embedding.V = w == 2 ? 1 : 2;
+        embedding.WValue = origin[w];
+        break;
+      }
+    }
+  }
+  else
+  {
+    DetectEmbedding(domain, embedding);
+  }
+  return embedding;
+}
+
 struct CopyToDouble
 {
   template <typename ArrayT>
@@ -248,32 +278,15 @@ bool ToPlanarScalarField(vtkDataSet* input, vtkDataArray* scalars, topospline::P
   return true;
 }
 
+void PlanarToDomainPoint(vtkDataSet* domain, const double uv[2], double xyz[3])
+{
+  EmbeddingOf(domain).To3D(uv, xyz);
+}
+
 void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* domain, const char* scalarName,
   vtkMultiBlockDataSet* output)
 {
-  PlanarEmbedding embedding;
-  if (!vtkImageData::SafeDownCast(domain))
-  {
-    DetectEmbedding(domain, embedding);
-  }
-  else
-  {
-    int dims[3];
-    vtkImageData::SafeDownCast(domain)->GetDimensions(dims);
-    double origin[3];
-    vtkImageData::SafeDownCast(domain)->GetOrigin(origin);
-    for (int w = 2; w >= 0; --w)
-    {
-      if (dims[w] == 1)
-      {
-        embedding.W = w;
-        embedding.U = w == 0 ? 1 : 0;
-        embedding.V = w == 2 ? 1 : 2;
-        embedding.WValue = origin[w];
-        break;
-      }
-    }
-  }
+  const PlanarEmbedding embedding = EmbeddingOf(domain);
   const auto& cps = complex.CriticalPoints;
 
   // Critical points.
@@ -449,7 +462,7 @@ void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
 
 vtkDataSet* SegmentationOf(vtkMultiBlockDataSet* input)
 {
-  if (!input || input->GetNumberOfBlocks() != names::NumberOfBlocks)
+  if (!input || input->GetNumberOfBlocks() < names::NumberOfBlocks)
   {
     return nullptr;
   }
@@ -468,27 +481,7 @@ bool FromMultiBlock(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& 
     error = "the input is not a Morse-Smale complex (expected the output of the \"Morse-Smale Complex\" filter)";
     return false;
   }
-  PlanarEmbedding embedding;
-  if (!vtkImageData::SafeDownCast(segmentation) && !DetectEmbedding(segmentation, embedding))
-  {
-    error = "the segmentation block is not planar";
-    return false;
-  }
-  if (auto* image = vtkImageData::SafeDownCast(segmentation))
-  {
-    int dims[3];
-    image->GetDimensions(dims);
-    for (int w = 2; w >= 0; --w)
-    {
-      if (dims[w] == 1)
-      {
-        embedding.W = w;
-        embedding.U = w == 0 ? 1 : 0;
-        embedding.V = w == 2 ? 1 : 2;
-        break;
-      }
-    }
-  }
+  const PlanarEmbedding embedding = EmbeddingOf(segmentation);
 
   auto* pd = critical->GetPointData();
   vtkDataArray* id = RequireArray(pd, names::CriticalPointId, error);

@@ -38,6 +38,10 @@ void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
 // message when `input` is not such a complex.
 bool FromMultiBlock(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& complex, std::string& error);
 
+// A point of the field's plane, (u, v) as in PlanarScalarField::Points, in the 3D coordinates
+// of `domain` (the input geometry or the Segmentation block).
+void PlanarToDomainPoint(vtkDataSet* domain, const double uv[2], double xyz[3]);
+
 // The "Segmentation" block of a complex, or nullptr.
 vtkDataSet* SegmentationOf(vtkMultiBlockDataSet* input);
 }

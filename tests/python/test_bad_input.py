@@ -51,6 +51,15 @@ CASES = {
                  "fewer than two dimensions"),
     "non-planar mesh": ("s = Sphere()\ncalc = Calculator(Input=s, ResultArrayName='f', Function='coordsZ')\n"
                         "ms = MorseSmaleComplex(Input=calc)\nms.ScalarField = ['POINTS', 'f']", "coordinate plane"),
+    "threshold below 0": ("ms = MorseSmaleComplex(Input=TrigonometricField())\n"
+                          "s = SimplifyMorseSmaleComplex(Input=ms)\n"
+                          "s.PersistenceThreshold = -5\nms = s", "must be a percentage in [0, 100]"),
+    "threshold above 100": ("ms = MorseSmaleComplex(Input=TrigonometricField())\n"
+                            "s = SimplifyMorseSmaleComplex(Input=ms)\n"
+                            "s.PersistenceThreshold = 250\nms = s",
+                            "must be a percentage in [0, 100]"),
+    "simplify input is not a complex": ("s = SimplifyMorseSmaleComplex(Input=GroupDatasets(Input=[TrigonometricField()]))\n"
+                                        "ms = s", "not a Morse-Smale complex"),
 }
 # Not an error: a stale or mistyped array name falls back to the active scalars, with a warning.
 FALLBACKS = {

@@ -6,7 +6,7 @@ import sys
 
 import numpy as np
 from paraview import servermanager as sm
-from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: F401 (re-exported for tests)
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -78,10 +78,10 @@ def fetch_complex(proxy):
     """The complex produced by a TopoSpline filter, as numpy arrays."""
     proxy.UpdatePipeline()
     mb = sm.Fetch(proxy)
-    if mb is None or mb.GetNumberOfBlocks() != 4:
+    if mb is None or mb.GetNumberOfBlocks() < 4:
         return None
     cps, arcs, cells, seg = (mb.GetBlock(i) for i in range(4))
-    c = {"blocks": [mb.GetMetaData(i).Get(mb.NAME()) for i in range(4)]}
+    c = {"blocks": [mb.GetMetaData(i).Get(mb.NAME()) for i in range(mb.GetNumberOfBlocks())]}
     c.update({"cp_" + k: v for k, v in _arrays(cps, ["CriticalPointId", "CriticalIndex", "CriticalValue", "VertexId",
                                                       "IsOnBoundary"]).items()})
     c.update({"arc_" + k: v for k, v in _arrays(arcs, ["SourceId", "DestinationId", "SeparatrixType"], "cell").items()})
@@ -112,8 +112,10 @@ def interior_counts(c):
     return [len(np.unique(c["cp_VertexId"][(c["cp_CriticalIndex"] == k) & inner])) for k in range(3)]
 
 
-def check_complex(checks, c, name, disk=True):
-    """The invariants of a Morse-Smale complex on a planar domain."""
+def check_complex(checks, c, name, disk=True, simplified=False):
+    """The invariants of a Morse-Smale complex on a planar domain. A simplified complex's
+    1-cells are unions of 1-cells (the paper's trivial embedding): values along them need not
+    be monotone (stage 3 makes them so), but their ends are still the critical values."""
     if not checks.check(c is not None, "%s: output is a 4-block complex" % name):
         return
     n = counts(c)
@@ -122,15 +124,15 @@ def check_complex(checks, c, name, disk=True):
     index_of = dict(zip(c["cp_CriticalPointId"].tolist(), c["cp_CriticalIndex"].tolist()))
     value_of = dict(zip(c["cp_CriticalPointId"].tolist(), c["cp_CriticalValue"].tolist()))
     # 1-cells join consecutive indices, from the lower to the higher critical value.
-    bad_arcs = 0
+    bad_ends = bad_monotone = 0
     for a, (s, d, t) in enumerate(zip(c["arc_SourceId"], c["arc_DestinationId"], c["arc_SeparatrixType"])):
         vals = c["arc_values"][a]
         ok = index_of.get(int(s)) == t and index_of.get(int(d)) == t + 1
-        ok = ok and vals[0] == value_of[int(s)] and vals[-1] == value_of[int(d)]
-        if t == 0:  # descending 1-cells are vertex paths: values never decrease
-            ok = ok and bool(np.all(np.diff(vals) >= 0))
-        bad_arcs += not ok
-    checks.equal(bad_arcs, 0, "%s: 1-cells with wrong endpoints or non-monotone values" % name)
+        bad_ends += not (ok and vals[0] == value_of[int(s)] and vals[-1] == value_of[int(d)])
+        if t == 0 and not simplified:  # descending 1-cells are vertex paths: values never decrease
+            bad_monotone += not bool(np.all(np.diff(vals) >= 0))
+    checks.equal(bad_ends, 0, "%s: 1-cells with wrong end points" % name)
+    checks.equal(bad_monotone, 0, "%s: descending 1-cells with decreasing values" % name)
     # 2-cells are quads minimum-saddle-maximum-saddle with consistent sides.
     src, dst = c["arc_SourceId"], c["arc_DestinationId"]
     bad_cells = 0

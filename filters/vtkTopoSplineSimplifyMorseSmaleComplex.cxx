@@ -1,0 +1,205 @@
+#include "vtkTopoSplineSimplifyMorseSmaleComplex.h"
+
+#include "vtkTopoSplineArrayNames.h"
+#include "vtkTopoSplineDomainConversion.h"
+
+#include "MorseSmaleComplexSimplification.h" // core
+
+#include <vtkCellArray.h>
+#include <vtkDataSet.h>
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
+#include <vtkIntArray.h>
+#include <vtkLogger.h>
+#include <vtkMultiBlockDataSet.h>
+#include <vtkNew.h>
+#include <vtkObjectFactory.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkStringArray.h>
+
+#include <cmath>
+
+namespace names = vtkTopoSplineArrayNames;
+
+// The hierarchy of the last input, and what identifies that input.
+struct vtkTopoSplineSimplifyMorseSmaleComplex::Cache
+{
+  topospline::MorseSmaleComplexSimplification Simplification;
+  vtkMTimeType InputTime = 0;
+  const void* InputObject = nullptr;
+};
+
+vtkStandardNewMacro(vtkTopoSplineSimplifyMorseSmaleComplex);
+
+vtkTopoSplineSimplifyMorseSmaleComplex::vtkTopoSplineSimplifyMorseSmaleComplex()
+  : Hierarchy(new Cache)
+{
+}
+
+vtkTopoSplineSimplifyMorseSmaleComplex::~vtkTopoSplineSimplifyMorseSmaleComplex() = default;
+
+int vtkTopoSplineSimplifyMorseSmaleComplex::FillInputPortInformation(int, vtkInformation* info)
+{
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkMultiBlockDataSet");
+  return 1;
+}
+
+namespace
+{
+template <typename ArrayT>
+vtkSmartPointer<ArrayT> NamedArray(const char* name, int components = 1)
+{
+  auto array = vtkSmartPointer<ArrayT>::New();
+  array->SetName(name);
+  array->SetNumberOfComponents(components);
+  return array;
+}
+
+vtkSmartPointer<vtkPolyData> JunctionPointsBlock(
+  const topospline::SimplificationOutput& result, vtkDataSet* domain)
+{
+  const auto& cps = result.Complex.CriticalPoints;
+  auto block = vtkSmartPointer<vtkPolyData>::New();
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  vtkNew<vtkCellArray> verts;
+  auto type = NamedArray<vtkIntArray>(names::SeparatrixType);
+  auto extremum = NamedArray<vtkIntArray>("ExtremumId");
+  auto cell = NamedArray<vtkIntArray>(names::MeshCellId);
+  auto value = NamedArray<vtkDoubleArray>("JunctionValue");
+  auto critical = NamedArray<vtkIntArray>(names::CriticalPointId);
+  auto count = NamedArray<vtkIntArray>("NumberOfSeparatrices");
+  for (const auto& junction : result.JunctionPoints)
+  {
+    double xyz[3];
+    vtkTopoSplineDomainConversion::PlanarToDomainPoint(domain, junction.Position, xyz);
+    const vtkIdType id = points->InsertNextPoint(xyz);
+    verts->InsertNextCell(1, &id);
+    type->InsertNextValue(junction.Type);
+    extremum->InsertNextValue(cps[junction.Extremum].Id);
+    cell->InsertNextValue(junction.Cell);
+    value->InsertNextValue(junction.Value);
+    critical->InsertNextValue(
+      junction.CriticalPoint == topospline::InvalidIndex ? -1 : cps[junction.CriticalPoint].Id);
+    count->InsertNextValue(static_cast<int>(junction.Separatrices.size()));
+  }
+  block->SetPoints(points);
+  block->SetVerts(verts);
+  for (vtkDataArray* a : { static_cast<vtkDataArray*>(type), static_cast<vtkDataArray*>(extremum),
+         static_cast<vtkDataArray*>(cell), static_cast<vtkDataArray*>(value),
+         static_cast<vtkDataArray*>(critical), static_cast<vtkDataArray*>(count) })
+  {
+    block->GetPointData()->AddArray(a);
+  }
+  return block;
+}
+
+void AddCancellations(const topospline::SimplificationOutput& result, double maximumPersistence, vtkFieldData* fd)
+{
+  auto lower = NamedArray<vtkIntArray>("CancelledLowerId");
+  auto upper = NamedArray<vtkIntArray>("CancelledUpperId");
+  auto survivor = NamedArray<vtkIntArray>("SurvivorId");
+  auto persistence = NamedArray<vtkDoubleArray>("CancellationPersistence");
+  for (const auto& c : result.Cancellations)
+  {
+    lower->InsertNextValue(c.Lower);
+    upper->InsertNextValue(c.Upper);
+    survivor->InsertNextValue(c.Survivor);
+    persistence->InsertNextValue(c.Persistence);
+  }
+  auto absolute = NamedArray<vtkDoubleArray>("AbsolutePersistenceThreshold");
+  absolute->InsertNextValue(result.AbsoluteThreshold);
+  auto maximum = NamedArray<vtkDoubleArray>("MaximumPersistence");
+  maximum->InsertNextValue(maximumPersistence);
+  for (vtkAbstractArray* a : { static_cast<vtkAbstractArray*>(lower), static_cast<vtkAbstractArray*>(upper),
+         static_cast<vtkAbstractArray*>(survivor), static_cast<vtkAbstractArray*>(persistence),
+         static_cast<vtkAbstractArray*>(absolute), static_cast<vtkAbstractArray*>(maximum) })
+  {
+    fd->AddArray(a);
+  }
+}
+} // namespace
+
+int vtkTopoSplineSimplifyMorseSmaleComplex::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkLogScopeFunction(TRACE);
+  vtkMultiBlockDataSet* input = vtkMultiBlockDataSet::GetData(inputVector[0], 0);
+  vtkMultiBlockDataSet* output = vtkMultiBlockDataSet::GetData(outputVector, 0);
+  if (!input || !output)
+  {
+    vtkErrorMacro("Missing input or output.");
+    return 0;
+  }
+  if (!std::isfinite(this->PersistenceThreshold) || this->PersistenceThreshold < 0 ||
+    this->PersistenceThreshold > 100)
+  {
+    vtkErrorMacro("Simplify Morse-Smale Complex: the persistence threshold must be a percentage in [0, 100], not "
+      << this->PersistenceThreshold << ".");
+    return 1;
+  }
+  vtkDataSet* domain = vtkTopoSplineDomainConversion::SegmentationOf(input);
+  std::string error;
+  Cache& cache = *this->Hierarchy;
+  if (!cache.Simplification.HasHierarchy() || cache.InputObject != input || cache.InputTime != input->GetMTime())
+  {
+    vtkLogScopeF(TRACE, "compute cancellation hierarchy");
+    topospline::MorseSmaleComplex complex;
+    if (!vtkTopoSplineDomainConversion::FromMultiBlock(input, complex, error))
+    {
+      vtkErrorMacro("Simplify Morse-Smale Complex: " << error << ".");
+      cache.InputObject = nullptr;
+      return 1;
+    }
+    cache.Simplification = topospline::MorseSmaleComplexSimplification();
+    cache.Simplification.Hooks.Progress = [this](double f) { this->UpdateProgress(0.8 * f); };
+    cache.Simplification.Hooks.AbortRequested = [this]() { return this->GetAbortExecute() != 0; };
+    if (!cache.Simplification.ComputeHierarchy(complex, error))
+    {
+      vtkErrorMacro("Simplify Morse-Smale Complex: " << error << ".");
+      cache.InputObject = nullptr;
+      return 1;
+    }
+    cache.InputObject = input;
+    cache.InputTime = input->GetMTime();
+    ++this->HierarchyComputations;
+  }
+
+  topospline::SimplificationOutput result;
+  {
+    vtkLogScopeF(TRACE, "replay cancellations to %g%%", this->PersistenceThreshold);
+    if (!cache.Simplification.Simplify(this->PersistenceThreshold, result, error))
+    {
+      vtkErrorMacro("Simplify Morse-Smale Complex: " << error << ".");
+      return 1;
+    }
+  }
+  const auto before = static_cast<long long>(cache.Simplification.Hierarchy().size());
+  const auto counts = result.Complex.CountByIndex();
+  vtkLog(TRACE, "simplified to " << counts[0] << " minima, " << counts[1] << " saddles, " << counts[2]
+                                 << " maxima (" << result.Cancellations.size() << " of " << before
+                                 << " cancellations)");
+  {
+    vtkLogScopeF(TRACE, "build output");
+    auto* scalarName = vtkStringArray::SafeDownCast(input->GetFieldData()->GetAbstractArray(names::ScalarFieldName));
+    vtkTopoSplineDomainConversion::ToMultiBlock(result.Complex, domain,
+      scalarName && scalarName->GetNumberOfValues() ? scalarName->GetValue(0).c_str() : "", output);
+    output->SetNumberOfBlocks(names::NumberOfBlocks + 1);
+    output->SetBlock(names::JunctionPointsIndex, JunctionPointsBlock(result, domain));
+    output->GetMetaData(static_cast<unsigned int>(names::JunctionPointsIndex))
+      ->Set(vtkCompositeDataSet::NAME(), names::JunctionPointsBlock);
+    AddCancellations(result, cache.Simplification.MaximumPersistence(), output->GetFieldData());
+  }
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+void vtkTopoSplineSimplifyMorseSmaleComplex::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "PersistenceThreshold: " << this->PersistenceThreshold << "\n";
+}
