@@ -65,16 +65,35 @@ if data is None or data.GetNumberOfBlocks() != 4:
     sys.exit("the Morse-Smale complex could not be computed (see the error above)")
 from vtkmodules.util.numpy_support import vtk_to_numpy
 import numpy as np
-index = vtk_to_numpy(data.GetBlock(0).GetPointData().GetArray("CriticalIndex"))
-summary["complex"] = {"minima": int(np.sum(index == 0)), "saddles": int(np.sum(index == 1)),
-                      "maxima": int(np.sum(index == 2)), "1-cells": data.GetBlock(1).GetNumberOfCells(),
-                      "2-cells": data.GetBlock(2).GetNumberOfPoints()}
-summary["complex"]["euler_characteristic"] = (summary["complex"]["minima"] - summary["complex"]["saddles"] +
-                                              summary["complex"]["maxima"])
+
+
+def complex_counts(data):
+    index = vtk_to_numpy(data.GetBlock(0).GetPointData().GetArray("CriticalIndex"))
+    counts = {"minima": int(np.sum(index == 0)), "saddles": int(np.sum(index == 1)), "maxima": int(np.sum(index == 2)),
+              "1-cells": data.GetBlock(1).GetNumberOfCells(), "2-cells": data.GetBlock(2).GetNumberOfPoints()}
+    counts["critical_points"] = counts["minima"] + counts["saddles"] + counts["maxima"]
+    counts["euler_characteristic"] = counts["minima"] - counts["saddles"] + counts["maxima"]
+    if data.GetNumberOfBlocks() > 4:
+        counts["junction_points"] = data.GetBlock(4).GetNumberOfPoints()
+    return counts
+
+
+summary["complex"] = complex_counts(data)
+
+# --- Stage 2: persistence simplification ---
+simplified = SimplifyMorseSmaleComplex(Input=complex_, PersistenceThreshold=args.threshold)
+timed("2 simplification", simplified)
+summary["stages_available"].append("Simplify Morse-Smale Complex")
+simplified_data = sm.Fetch(simplified)
+if simplified_data is None or simplified_data.GetNumberOfBlocks() < 4:
+    sys.exit("the simplification failed (see the error above)")
+summary["simplified_complex"] = complex_counts(simplified_data)
+summary["simplified_complex"]["persistence_threshold_percent"] = args.threshold
+summary["simplified_complex"]["maximum_persistence"] = simplified_data.GetFieldData().GetArray(
+    "MaximumPersistence").GetValue(0)
 
 # Later stages, when this build has them.
-later = [("Simplify Morse-Smale Complex", "SimplifyMorseSmaleComplex"), ("Smooth 1-Cells", "Smooth1Cells"),
-         ("Reconstruct 2-Cells", "Reconstruct2Cells")]
+later = [("Smooth 1-Cells", "Smooth1Cells"), ("Reconstruct 2-Cells", "Reconstruct2Cells")]
 missing = [label for label, fn in later if fn not in globals()]
 if missing:
     summary["stages_missing"] = missing
@@ -83,7 +102,8 @@ if missing:
 # --- Files (inline binary XML: appended XML files are unreadable with Debian 12's expat) ---
 files = {}
 writers = [("input", source, ".vti" if not args.input or args.input.endswith(".vti") else
-            os.path.splitext(args.input)[1]), ("complex", complex_, ".vtm")]
+            os.path.splitext(args.input)[1]), ("complex", complex_, ".vtm"),
+           ("simplified_complex", simplified, ".vtm")]
 for name, proxy, ext in writers:
     path = os.path.join(args.output, name + ext)
     SaveData(path, proxy=proxy, DataMode="Binary", CompressorType="ZLib")
@@ -129,6 +149,13 @@ def show_complex(ms_proxy):
         d = Show(sel, view)
         solid(d, color)
         d.LineWidth = 3.0
+    if ms_proxy is simplified:
+        junctions = ExtractBlock(Input=ms_proxy, Selectors=["/Root/JunctionPoints"])
+        d = Show(junctions, view)
+        solid(d, [0.0, 0.0, 0.0])
+        d.SetRepresentationType("Points")
+        d.RenderPointsAsSpheres = 1
+        d.PointSize = 7
     cps = ExtractBlock(Input=ms_proxy, Selectors=["/Root/CriticalPoints"])
     for kind, color in ((0, [0.0, 0.2, 1.0]), (1, [0.0, 0.7, 0.0]), (2, [1.0, 0.0, 0.0])):
         sel = Threshold(Input=cps, Scalars=["POINTS", "CriticalIndex"], LowerThreshold=kind, UpperThreshold=kind)
@@ -156,6 +183,9 @@ save("1_input.png")
 show_field(source)
 show_complex(complex_)
 save("2_morse_smale_complex.png")
+show_field(source)
+show_complex(simplified)
+save("3_simplified_complex_%g_percent.png" % args.threshold)
 summary["pictures"] = pictures
 
 with open(os.path.join(args.output, "summary.json"), "w") as f:
