@@ -52,7 +52,7 @@ int main(int argc, char** argv)
     }
   }
   field.Values = grid.Values;
-  field.Triangles = GridTriangles(resolution, resolution);
+  field.GridDimensions[0] = field.GridDimensions[1] = resolution; // as for image data
   std::printf("Morse-Smale complex extraction (core only), Shepard %d x %d, median of %d runs\n", resolution,
     resolution, repeats);
   for (int threads : { 1, 2 })

@@ -14,6 +14,7 @@
 #include <vtkIdList.h>
 #include <vtkIdTypeArray.h>
 #include <vtkImageData.h>
+#include <vtkMatrix3x3.h>
 #include <vtkInformation.h>
 #include <vtkIntArray.h>
 #include <vtkMultiBlockDataSet.h>
@@ -227,14 +228,34 @@ bool ToPlanarScalarField(vtkDataSet* input, vtkDataArray* scalars, topospline::P
       return false;
     }
     const int n0 = dims[axes[0]], n1 = dims[axes[1]];
-    for (vtkIdType id = 0; id < nPoints; ++id)
-    {
-      double p[3];
-      image->GetPoint(id, p);
-      field.Points[2 * id] = p[axes[0]];
-      field.Points[2 * id + 1] = p[axes[1]];
-    }
-    field.Triangles = topospline::GridTriangles(n0, n1);
+    double origin[3], spacing[3];
+    image->GetOrigin(origin);
+    image->GetSpacing(spacing);
+    const bool axisAligned = image->GetDirectionMatrix()->IsIdentity();
+    vtkSMPTools::For(0, n1, [&](vtkIdType begin, vtkIdType end) {
+      for (vtkIdType b = begin; b < end; ++b)
+      {
+        for (vtkIdType a = 0; a < n0; ++a)
+        {
+          const vtkIdType id = b * n0 + a;
+          double p[3];
+          if (axisAligned)
+          {
+            p[axes[0]] = origin[axes[0]] + a * spacing[axes[0]];
+            p[axes[1]] = origin[axes[1]] + b * spacing[axes[1]];
+          }
+          else
+          {
+            image->GetPoint(id, p);
+          }
+          field.Points[2 * id] = p[axes[0]];
+          field.Points[2 * id + 1] = p[axes[1]];
+        }
+      }
+    });
+    // The quads are split along their (i+1,j)-(i,j+1) diagonal: GridTriangles(n0, n1).
+    field.GridDimensions[0] = n0;
+    field.GridDimensions[1] = n1;
     return true;
   }
 

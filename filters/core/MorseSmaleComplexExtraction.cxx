@@ -164,9 +164,14 @@ bool MorseSmaleComplexExtraction::Extract(
 {
   complex = MorseSmaleComplex();
   const Index nV = static_cast<Index>(field.Values.size());
-  if (nV == 0 || field.Triangles.empty())
+  if (nV == 0 || (field.Triangles.empty() && !field.IsGrid()))
   {
     error = "the input has no triangles";
+    return false;
+  }
+  if (field.IsGrid() && static_cast<long long>(field.GridDimensions[0]) * field.GridDimensions[1] != nV)
+  {
+    error = "the grid dimensions do not match the number of values";
     return false;
   }
   if (field.Points.size() != 2 * field.Values.size())
@@ -182,7 +187,11 @@ bool MorseSmaleComplexExtraction::Extract(
       return false;
     }
   }
-  if (!this->Mesh.Build(nV, field.Triangles, this->Parallel, error))
+  if (field.IsGrid())
+  {
+    this->Mesh.BuildGrid(field.GridDimensions[0], field.GridDimensions[1], this->Parallel);
+  }
+  else if (!this->Mesh.Build(nV, field.Triangles, this->Parallel, error))
   {
     return false;
   }

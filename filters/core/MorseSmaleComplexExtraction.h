@@ -16,8 +16,12 @@ namespace topospline
 struct PlanarScalarField
 {
   std::vector<double> Points;   // x, y per vertex
-  std::vector<Index> Triangles; // 3 vertex ids per triangle
+  std::vector<Index> Triangles; // 3 vertex ids per triangle (unused for a grid)
   std::vector<double> Values;   // one scalar per vertex
+  // For a grid (image data): nx, ny with vertex (i, j) = j * nx + i, triangulated as
+  // GridTriangles(nx, ny) without spelling the triangles out. {0, 0} for a general mesh.
+  int GridDimensions[2] = { 0, 0 };
+  bool IsGrid() const { return this->GridDimensions[0] > 1 && this->GridDimensions[1] > 1; }
 };
 
 struct CriticalPoint

@@ -42,6 +42,131 @@ Index TriangleMeshTopology::FindEdge(Index a, Index b) const
   return InvalidIndex;
 }
 
+void TriangleMeshTopology::BuildGrid(int nx, int ny, const ParallelFor& parallelFor)
+{
+  // Vertex v = (i, j) = j * nx + i; quad q = (i, j) = j * (nx - 1) + i holds triangles 2q =
+  // (p00, p10, p01) and 2q + 1 = (p10, p11, p01) (GridTriangles). The edges of v towards higher
+  // vertices, in increasing order of the other end: right (v + 1), the diagonal of the quad on
+  // its left (v + nx - 1), up (v + nx).
+  const Index nV = static_cast<Index>(nx) * ny;
+  const Index quadsX = nx - 1;
+  const Index nT = 2 * quadsX * (ny - 1);
+  this->NumVertices = nV;
+  auto has = [&](Index i, Index j, int which) {
+    switch (which)
+    {
+      case 0:
+        return i + 1 < nx;
+      case 1:
+        return i >= 1 && j + 1 < ny;
+      default:
+        return j + 1 < ny;
+    }
+  };
+  this->EdgeOffsets.assign(nV + 1, 0);
+  for (Index v = 0; v < nV; ++v)
+  {
+    const Index i = v % nx, j = v / nx;
+    this->EdgeOffsets[v + 1] = this->EdgeOffsets[v] + has(i, j, 0) + has(i, j, 1) + has(i, j, 2);
+  }
+  // Id of edge `which` (0 right, 1 diagonal, 2 up) of vertex (i, j).
+  auto edge = [&](Index i, Index j, int which) {
+    Index local = 0;
+    for (int w = 0; w < which; ++w)
+    {
+      local += has(i, j, w);
+    }
+    return this->EdgeOffsets[j * nx + i] + local;
+  };
+  auto triangle = [&](Index qi, Index qj, int half) { return 2 * (qj * quadsX + qi) + half; };
+
+  const Index nE = this->EdgeOffsets[nV];
+  this->EdgeVertices.resize(nE);
+  this->EdgeTriangles.assign(nE, { InvalidIndex, InvalidIndex });
+  this->BoundaryVertex.resize(nV);
+  this->VertexTriangleOffsets.resize(nV + 1);
+  this->VertexTriangleOffsets[0] = 0;
+  for (Index v = 0; v < nV; ++v)
+  {
+    const Index i = v % nx, j = v / nx;
+    // Triangles around (i, j), in increasing id: quads (i-1,j-1).1, (i,j-1).0, (i,j-1).1,
+    // (i-1,j).0, (i-1,j).1, (i,j).0 where they exist.
+    const bool left = i >= 1, right = i + 1 < nx, down = j >= 1, up = j + 1 < ny;
+    this->VertexTriangleOffsets[v + 1] = this->VertexTriangleOffsets[v] + (left && down) + 2 * (right && down) +
+      2 * (left && up) + (right && up);
+  }
+  this->VertexTriangles.resize(this->VertexTriangleOffsets[nV]);
+  this->TriangleVertices.resize(nT);
+  this->TriangleEdges.resize(nT);
+  parallelFor(0, nV, [&](Index begin, Index end) {
+    for (Index v = begin; v < end; ++v)
+    {
+      const Index i = v % nx, j = v / nx;
+      const bool left = i >= 1, right = i + 1 < nx, down = j >= 1, up = j + 1 < ny;
+      this->BoundaryVertex[v] = !(left && right && down && up);
+      Index* around = &this->VertexTriangles[this->VertexTriangleOffsets[v]];
+      if (left && down)
+      {
+        *around++ = triangle(i - 1, j - 1, 1);
+      }
+      if (right && down)
+      {
+        *around++ = triangle(i, j - 1, 0);
+        *around++ = triangle(i, j - 1, 1);
+      }
+      if (left && up)
+      {
+        *around++ = triangle(i - 1, j, 0);
+        *around++ = triangle(i - 1, j, 1);
+      }
+      if (right && up)
+      {
+        *around++ = triangle(i, j, 0);
+      }
+      // The edges of v and their triangles, lower-id triangle first.
+      if (right)
+      {
+        const Index e = edge(i, j, 0);
+        this->EdgeVertices[e] = { v, v + 1 };
+        this->EdgeTriangles[e] = { down ? triangle(i, j - 1, 1) : InvalidIndex, up ? triangle(i, j, 0) : InvalidIndex };
+      }
+      if (left && up)
+      {
+        const Index e = edge(i, j, 1);
+        this->EdgeVertices[e] = { v, v + nx - 1 };
+        this->EdgeTriangles[e] = { triangle(i - 1, j, 0), triangle(i - 1, j, 1) };
+      }
+      if (up)
+      {
+        const Index e = edge(i, j, 2);
+        this->EdgeVertices[e] = { v, v + nx };
+        this->EdgeTriangles[e] = { left ? triangle(i - 1, j, 1) : InvalidIndex, right ? triangle(i, j, 0) : InvalidIndex };
+      }
+      // Quad (i, j)'s two triangles.
+      if (right && up)
+      {
+        const Index p00 = v, p10 = v + 1, p01 = v + nx, p11 = v + nx + 1;
+        const Index t0 = triangle(i, j, 0);
+        this->TriangleVertices[t0] = { p00, p10, p01 };
+        this->TriangleEdges[t0] = { edge(i, j, 0), edge(i + 1, j, 1), edge(i, j, 2) };
+        this->TriangleVertices[t0 + 1] = { p10, p11, p01 };
+        this->TriangleEdges[t0 + 1] = { edge(i + 1, j, 2), edge(i, j + 1, 0), edge(i + 1, j, 1) };
+      }
+    }
+  });
+  // Boundary edges have a single triangle: keep it in the first slot, as Build does.
+  parallelFor(0, nE, [&](Index begin, Index end) {
+    for (Index e = begin; e < end; ++e)
+    {
+      auto& slots = this->EdgeTriangles[e];
+      if (slots[0] == InvalidIndex)
+      {
+        slots = { slots[1], InvalidIndex };
+      }
+    }
+  });
+}
+
 bool TriangleMeshTopology::Build(Index numberOfVertices, const std::vector<Index>& triangles,
   const ParallelFor& parallelFor, std::string& error)
 {

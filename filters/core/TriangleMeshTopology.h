@@ -18,6 +18,10 @@ public:
   bool Build(Index numberOfVertices, const std::vector<Index>& triangles, const ParallelFor& parallelFor,
     std::string& error);
 
+  // The same structure, numbered exactly as Build(nx * ny, GridTriangles(nx, ny)) numbers it,
+  // written in closed form: no searching or sorting. For image data.
+  void BuildGrid(int nx, int ny, const ParallelFor& parallelFor);
+
   Index NumberOfVertices() const { return this->NumVertices; }
   Index NumberOfEdges() const { return static_cast<Index>(this->EdgeVertices.size()); }
   Index NumberOfTriangles() const { return static_cast<Index>(this->TriangleVertices.size()); }

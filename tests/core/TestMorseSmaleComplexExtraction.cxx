@@ -187,6 +187,44 @@ TEST_CASE(SequentialAndThreadedAgree)
   CHECK(samePaths);
 }
 
+TEST_CASE(GridTopologyEqualsGeneralBuild)
+{
+  // The closed-form grid topology must number everything exactly as the general builder does
+  // on the grid's triangles: then an image and the same grid as a mesh give the same complex.
+  const int sizes[][2] = { { 2, 2 }, { 2, 5 }, { 5, 2 }, { 3, 3 }, { 17, 11 }, { 64, 40 } };
+  for (const auto& size : sizes)
+  {
+    TriangleMeshTopology general, grid;
+    std::string error;
+    CHECK(general.Build(size[0] * size[1], GridTriangles(size[0], size[1]), SequentialFor, error));
+    grid.BuildGrid(size[0], size[1], ThreadedFor);
+    CHECK(grid.NumberOfVertices() == general.NumberOfVertices());
+    CHECK(grid.EdgeVertices == general.EdgeVertices);
+    CHECK(grid.EdgeTriangles == general.EdgeTriangles);
+    CHECK(grid.TriangleVertices == general.TriangleVertices);
+    CHECK(grid.TriangleEdges == general.TriangleEdges);
+    CHECK(grid.BoundaryVertex == general.BoundaryVertex);
+    bool sameStars = true;
+    for (Index v = 0; v < general.NumberOfVertices(); ++v)
+    {
+      sameStars = sameStars && grid.VertexTriangleBegin(v) == general.VertexTriangleBegin(v) &&
+        grid.VertexTriangleEnd(v) == general.VertexTriangleEnd(v);
+      for (Index i = general.VertexTriangleBegin(v); sameStars && i < general.VertexTriangleEnd(v); ++i)
+      {
+        sameStars = grid.VertexTriangle(i) == general.VertexTriangle(i);
+      }
+      for (Index w : { v + 1, v + size[0], v + size[0] - 1 })
+      {
+        if (w < general.NumberOfVertices())
+        {
+          sameStars = sameStars && grid.FindEdge(v, w) == general.FindEdge(v, w);
+        }
+      }
+    }
+    CHECK(sameStars);
+  }
+}
+
 TEST_CASE(RegularVertexShortcutEqualsProcessLowerStars)
 {
   // The gradient's shortcut for regular interior vertices must give exactly the pairing of the
