@@ -115,6 +115,15 @@ vtkSmartPointer<ArrayT> MakeArray(const char* name, int components, vtkIdType tu
   return array;
 }
 
+// Adds the arrays (smart pointers or raw) to `data` in the given order.
+void AddArrays(vtkFieldData* data, std::initializer_list<vtkAbstractArray*> arrays)
+{
+  for (vtkAbstractArray* array : arrays)
+  {
+    data->AddArray(array);
+  }
+}
+
 vtkDataArray* RequireArray(vtkFieldData* data, const char* name, std::string& error)
 {
   vtkDataArray* array = data ? data->GetArray(name) : nullptr;
@@ -337,12 +346,7 @@ void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
     }
     critical->SetPoints(points);
     critical->SetVerts(verts);
-    for (vtkDataArray* a : { static_cast<vtkDataArray*>(id), static_cast<vtkDataArray*>(index),
-           static_cast<vtkDataArray*>(value), static_cast<vtkDataArray*>(vertex), static_cast<vtkDataArray*>(cell),
-           static_cast<vtkDataArray*>(boundary) })
-    {
-      critical->GetPointData()->AddArray(a);
-    }
+    AddArrays(critical->GetPointData(), { id, index, value, vertex, cell, boundary });
     critical->GetPointData()->SetActiveScalars(names::CriticalIndex);
   }
 
@@ -395,11 +399,7 @@ void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
     separatrices->GetPointData()->AddArray(along);
     separatrices->GetPointData()->AddArray(meshCell);
     separatrices->GetPointData()->SetActiveScalars(names::ScalarAlong);
-    for (vtkDataArray* a : { static_cast<vtkDataArray*>(id), static_cast<vtkDataArray*>(source),
-           static_cast<vtkDataArray*>(destination), static_cast<vtkDataArray*>(type) })
-    {
-      separatrices->GetCellData()->AddArray(a);
-    }
+    AddArrays(separatrices->GetCellData(), { id, source, destination, type });
   }
 
   // 2-cells: one point per cell at its centroid, carrying its corners and sides.
@@ -439,12 +439,7 @@ void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
     }
     twoCells->SetPoints(points);
     twoCells->SetVerts(verts);
-    for (vtkDataArray* a : { static_cast<vtkDataArray*>(id), static_cast<vtkDataArray*>(minimum),
-           static_cast<vtkDataArray*>(maximum), static_cast<vtkDataArray*>(saddles),
-           static_cast<vtkDataArray*>(arcs), static_cast<vtkDataArray*>(pouch), static_cast<vtkDataArray*>(size) })
-    {
-      twoCells->GetPointData()->AddArray(a);
-    }
+    AddArrays(twoCells->GetPointData(), { id, minimum, maximum, saddles, arcs, pouch, size });
   }
 
   // The input geometry with the per-vertex segmentation.

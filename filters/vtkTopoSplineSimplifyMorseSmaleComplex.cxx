@@ -89,9 +89,7 @@ vtkSmartPointer<vtkPolyData> JunctionPointsBlock(
   }
   block->SetPoints(points);
   block->SetVerts(verts);
-  for (vtkDataArray* a : { static_cast<vtkDataArray*>(type), static_cast<vtkDataArray*>(extremum),
-         static_cast<vtkDataArray*>(cell), static_cast<vtkDataArray*>(value),
-         static_cast<vtkDataArray*>(critical), static_cast<vtkDataArray*>(count) })
+  for (vtkAbstractArray* a : std::initializer_list<vtkAbstractArray*>{ type, extremum, cell, value, critical, count })
   {
     block->GetPointData()->AddArray(a);
   }
@@ -115,9 +113,7 @@ void AddCancellations(const topospline::SimplificationOutput& result, double max
   absolute->InsertNextValue(result.AbsoluteThreshold);
   auto maximum = NamedArray<vtkDoubleArray>("MaximumPersistence");
   maximum->InsertNextValue(maximumPersistence);
-  for (vtkAbstractArray* a : { static_cast<vtkAbstractArray*>(lower), static_cast<vtkAbstractArray*>(upper),
-         static_cast<vtkAbstractArray*>(survivor), static_cast<vtkAbstractArray*>(persistence),
-         static_cast<vtkAbstractArray*>(absolute), static_cast<vtkAbstractArray*>(maximum) })
+  for (vtkAbstractArray* a : std::initializer_list<vtkAbstractArray*>{ lower, upper, survivor, persistence, absolute, maximum })
   {
     fd->AddArray(a);
   }
