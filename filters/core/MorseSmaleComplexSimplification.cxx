@@ -5,7 +5,6 @@
 #include <limits>
 #include <numeric>
 #include <queue>
-#include <tuple>
 
 namespace topospline
 {
@@ -176,6 +175,10 @@ bool MorseSmaleComplexSimplification::Check(const MorseSmaleComplex& input, std:
       {
         return fail(name + " has a corner whose 1-cells do not belong to its saddle");
       }
+      if (arcs[d].Source != cell.Minimum || arcs[u].Destination != cell.Maximum)
+      {
+        return fail(name + " has a corner whose 1-cells do not reach its minimum and maximum");
+      }
     }
   }
   const size_t nV = input.AscendingManifold.size();
@@ -249,6 +252,31 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
       this->OnBoundaryCurve[this->ArcExtremum[this->SaddleArcs[s][1]]] = 1;
     }
   }
+
+  // The 2-cell at each corner of each saddle (a descending and an ascending 1-cell of it).
+  this->SaddleCorners.assign(nCP, { InvalidIndex, InvalidIndex, InvalidIndex, InvalidIndex });
+  for (Index c = 0; c < static_cast<Index>(this->Input.TwoCells.size()); ++c)
+  {
+    const TwoCell& cell = this->Input.TwoCells[c];
+    for (int k = 0; k < 2; ++k)
+    {
+      const Index s = cell.Saddles[k];
+      if (s != InvalidIndex)
+      {
+        const auto& slots = this->SaddleArcs[s];
+        const int d = slots[0] == cell.Arcs[2 * k] ? 0 : 1;
+        const int a = slots[2] == cell.Arcs[2 * k + 1] ? 0 : 1;
+        if (this->SaddleCorners[s][2 * d + a] != InvalidIndex)
+        {
+          error = "the input is not a Morse-Smale complex: 2-cells " +
+            std::to_string(this->SaddleCorners[s][2 * d + a]) + " and " + std::to_string(c) +
+            " share a corner of saddle " + std::to_string(s);
+          return false;
+        }
+        this->SaddleCorners[s][2 * d + a] = c;
+      }
+    }
+  }
   this->Hooks.Report(0.1);
 
   this->BuildForests();
@@ -256,7 +284,7 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
   this->ComputeSequence();
   if (this->Hooks.Aborted())
   {
-    error = "aborted";
+    error = "aborted on request";
     return false;
   }
   this->Hooks.Report(1.0);
@@ -273,12 +301,13 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
 // spikes of the concatenation (erasing its loops) leaves the unique path of that forest;
 // Simplify computes this path directly, which is equivalent, linear and needs no mesh.
 //
-// Descending 1-cells end with one step that is not a gradient step for one of the saddle's
-// two 1-cells: the saddle edge itself, from its lower vertex to its highest vertex (where the
-// saddle sits). So a descending 1-cell is stored as a forest path (minimum .. its next-to-last
-// vertex) plus its last vertex, and the last steps join the forest only when the saddle is
-// cancelled against a minimum. Ascending 1-cells are triangle V-paths throughout; cancelling
-// a saddle against a maximum joins the two triangles of the saddle edge.
+// For one of a saddle's two descending 1-cells, the last step is not a gradient step but the
+// saddle edge itself, from its lower vertex up to the vertex where the saddle sits. So every
+// descending 1-cell is stored as a forest path (minimum .. next-to-last vertex) plus its last
+// vertex, and these last steps join the forest only when their saddle is cancelled against a
+// minimum. (A 1-cell of a single vertex, a boundary minimum whose vertex also owns an interior
+// saddle, is just the root of its tree.) Ascending 1-cells are triangle V-paths throughout;
+// cancelling a saddle against a maximum joins the two triangles of the saddle edge.
 void MorseSmaleComplexSimplification::BuildForests()
 {
   const auto& cps = this->Input.CriticalPoints;
@@ -386,11 +415,36 @@ void MorseSmaleComplexSimplification::BuildForests()
 }
 
 //------------------------------------------------------------------------------
+// Cancelling saddle s with the extremum reached by its 1-cell `side` (of the extremum's kind)
+// removes s's 1-cells, so the 2-cells on both sides of each of them merge: for a minimum, per
+// ascending 1-cell a, the corners (to the minimum, a) and (to the survivor, a); for a
+// maximum, per descending 1-cell d, the corners (d, to the maximum) and (d, to the survivor).
+int MorseSmaleComplexSimplification::CellMerges(
+  Index saddle, bool minimum, int side, std::array<std::array<Index, 2>, 2>& pairs) const
+{
+  const auto& corner = this->SaddleCorners[saddle];
+  int n = 0;
+  for (int k = 0; k < 2; ++k)
+  {
+    if (minimum && this->SaddleArcs[saddle][2 + k] != InvalidIndex)
+    {
+      pairs[n++] = { corner[2 * side + k], corner[2 * (1 - side) + k] };
+    }
+    else if (!minimum)
+    {
+      pairs[n++] = { corner[2 * k + side], corner[2 * k + 1 - side] };
+    }
+  }
+  return n;
+}
+
+//------------------------------------------------------------------------------
 // Greedy cancellation in order of increasing persistence with a lazy priority queue
 // (Shivashankar's mscomplex-tri): every saddle-extremum pair joined by a 1-cell is a
 // candidate; validity is checked when a candidate is popped. Pairs are never re-validated
-// later because validity can only be lost: an extremum's 1-cells only ever gain saddles, and
-// a saddle's 1-cells only ever move to the survivor of a cancelled extremum. The threshold is
+// later because validity can only be lost: an extremum's 1-cells only ever gain saddles, a
+// saddle's 1-cells only ever move to the survivor of a cancelled extremum, and 2-cells only
+// ever merge. The threshold is
 // infinite, so the sequence holds every cancellation any threshold can perform; each valid
 // pop removes two critical points, so the loop ends.
 void MorseSmaleComplexSimplification::ComputeSequence()
@@ -459,6 +513,11 @@ void MorseSmaleComplexSimplification::ComputeSequence()
   std::vector<Index> forward(nCP);
   std::iota(forward.begin(), forward.end(), 0);
   std::vector<Index> stamp(nCP, InvalidIndex);
+  std::vector<Index> cellForward(this->Input.TwoCells.size());
+  std::iota(cellForward.begin(), cellForward.end(), 0);
+  auto cellClass = [&cellForward](Index cell) {
+    return cell == InvalidIndex ? InvalidIndex : FollowForwarding(cellForward, cell);
+  };
   double threshold = 0;
   size_t pops = 0;
   while (!queue.empty())
@@ -506,9 +565,38 @@ void MorseSmaleComplexSimplification::ComputeSequence()
     {
       continue;
     }
+    // Each merge of 2-cells must join two different ones. In a planar complex they always
+    // do; a merge inside one 2-cell would leave a 2-cell without corners. That happens only
+    // when the two 2-cells on both sides of a loop of s are both pouches of s, which no
+    // planar complex has: it flags a wrong sector pairing of stage 1, and the pair is kept.
+    const bool minimum = cps[x].MorseIndex == 0;
+    std::array<std::array<Index, 2>, 2> merges;
+    const int numberOfMerges = this->CellMerges(s, minimum, side, merges);
+    std::array<Index, 2> firstMerge{ cellClass(merges[0][0]), cellClass(merges[0][1]) };
+    std::array<Index, 2> secondMerge{ InvalidIndex, InvalidIndex };
+    if (numberOfMerges == 2)
+    {
+      secondMerge = { cellClass(merges[1][0]), cellClass(merges[1][1]) };
+    }
+    std::sort(firstMerge.begin(), firstMerge.end());
+    std::sort(secondMerge.begin(), secondMerge.end());
+    const bool cellsKnown = firstMerge[0] != InvalidIndex && (numberOfMerges == 1 || secondMerge[0] != InvalidIndex);
+    if (cellsKnown &&
+      (firstMerge[0] == firstMerge[1] ||
+        (numberOfMerges == 2 && (secondMerge[0] == secondMerge[1] || firstMerge == secondMerge))))
+    {
+      continue;
+    }
     const Index survivor = FollowForwarding(forward, this->ArcExtremum[slots[first + 1 - side]]);
     threshold = std::max(threshold, candidate.Persistence);
-    const bool minimum = cps[x].MorseIndex == 0;
+    for (int k = 0; k < numberOfMerges; ++k)
+    {
+      const Index a = cellClass(merges[k][0]), b = cellClass(merges[k][1]);
+      if (a != InvalidIndex && b != InvalidIndex && a != b)
+      {
+        cellForward[std::max(a, b)] = std::min(a, b);
+      }
+    }
     this->Sequence.push_back({ minimum ? cps[x].Id : cps[s].Id, minimum ? cps[s].Id : cps[x].Id,
       cps[survivor].Id, candidate.Persistence, threshold });
     this->Steps.push_back({ s, x, survivor, side });
@@ -752,11 +840,12 @@ bool MorseSmaleComplexSimplification::Simplify(
   }
 
   // Junction points. Followed from the extremum, each 1-cell is a path down its tree; a node
-  // is a junction when the 1-cells through it do not all continue the same way: to the same
-  // next node, or all end there. An ascending 1-cell ends at its saddle's vertex (encoded
-  // below zero); a descending one ends at its last node, which belongs to the extremum's tree
-  // only when that vertex lies in the tree (then a saddle sits on the junction). Nodes of
-  // other trees are skipped: a tree is the only place the 1-cells of one extremum share.
+  // is a junction when the 1-cells through it do not all continue the same way (to the same
+  // next node, or all ending there). An ascending 1-cell goes on from its first triangle to
+  // its saddle's vertex (encoded below zero). A descending one ends at its saddle's vertex,
+  // which lies either in another tree (a saddle edge joins two trees: skipped, as the 1-cells
+  // of one extremum share nothing outside its tree) or in this one, where other 1-cells may
+  // go on through it: then the junction is also where that saddle sits.
   for (int pass = 0; pass < 2; ++pass)
   {
     const bool descending = pass == 0;
@@ -840,62 +929,21 @@ bool MorseSmaleComplexSimplification::Simplify(
   // (s, 1-cell to x, that 1-cell) and (s, 1-cell to the survivor, that 1-cell).
   const auto& cells = in.TwoCells;
   const Index nCells = static_cast<Index>(cells.size());
-  struct Corner
-  {
-    Index Saddle, Descending, Ascending, Cell;
-    bool operator<(const Corner& o) const
-    {
-      return std::tie(this->Saddle, this->Descending, this->Ascending) < std::tie(o.Saddle, o.Descending, o.Ascending);
-    }
-  };
-  std::vector<Corner> corners;
-  for (Index c = 0; c < nCells; ++c)
-  {
-    for (int k = 0; k < 2; ++k)
-    {
-      if (cells[c].Saddles[k] != InvalidIndex)
-      {
-        corners.push_back({ cells[c].Saddles[k], cells[c].Arcs[2 * k], cells[c].Arcs[2 * k + 1], c });
-      }
-    }
-  }
-  std::sort(corners.begin(), corners.end());
-  auto cellAt = [&corners](Index saddle, Index descending, Index ascending) {
-    const Corner key{ saddle, descending, ascending, InvalidIndex };
-    const auto it = std::lower_bound(corners.begin(), corners.end(), key);
-    return it != corners.end() && !(key < *it) ? it->Cell : InvalidIndex;
-  };
   std::vector<Index> cellForward(nCells);
   std::iota(cellForward.begin(), cellForward.end(), 0);
-  auto mergeCells = [&](Index a, Index b) {
-    if (a == InvalidIndex || b == InvalidIndex)
-    {
-      return;
-    }
-    a = FollowForwarding(cellForward, a);
-    b = FollowForwarding(cellForward, b);
-    // The first cell represents the union, so unmerged cells keep their relative order.
-    cellForward[std::max(a, b)] = std::min(a, b);
-  };
   for (Index j = 0; j < performed; ++j)
   {
     const Step& step = this->Steps[j];
-    const auto& slots = this->SaddleArcs[step.Saddle];
-    if (cps[step.Extremum].MorseIndex == 0)
+    std::array<std::array<Index, 2>, 2> merges;
+    const int numberOfMerges = this->CellMerges(step.Saddle, cps[step.Extremum].MorseIndex == 0, step.Side, merges);
+    for (int k = 0; k < numberOfMerges; ++k)
     {
-      for (int k = 2; k < 4; ++k)
+      if (merges[k][0] != InvalidIndex && merges[k][1] != InvalidIndex)
       {
-        if (slots[k] != InvalidIndex)
-        {
-          mergeCells(cellAt(step.Saddle, slots[step.Side], slots[k]), cellAt(step.Saddle, slots[1 - step.Side], slots[k]));
-        }
-      }
-    }
-    else
-    {
-      for (int k = 0; k < 2; ++k)
-      {
-        mergeCells(cellAt(step.Saddle, slots[k], slots[2 + step.Side]), cellAt(step.Saddle, slots[k], slots[3 - step.Side]));
+        // The first cell represents the union, so unmerged cells keep their relative order.
+        const Index a = FollowForwarding(cellForward, merges[k][0]);
+        const Index b = FollowForwarding(cellForward, merges[k][1]);
+        cellForward[std::max(a, b)] = std::min(a, b);
       }
     }
   }

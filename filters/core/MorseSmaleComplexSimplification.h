@@ -6,6 +6,11 @@
 // s (the other extremum x' of s, of x's kind) to every other neighbour of x (the other saddles
 // of x). Every 1-cell keeps its saddle, so this amounts to "every 1-cell that ended at x now
 // ends at x'": x' inherits x's region, 1-cells and 2-cells.
+// A pair is cancellable (checked when it is popped, in order of increasing persistence) when
+// neither point is cancelled yet, exactly one 1-cell joins them, both or neither lie on the
+// boundary curve (boundary minima and saddles of boundary edges; see the .cxx for why), and
+// no 2-cell would lose all its corners (only stage-1 inputs that are not planar-consistent
+// trigger this last rule).
 //
 // Threshold semantics (saved states depend on them; never change them):
 //  * persistence of a pair = |f(saddle) - f(extremum)|;
@@ -111,6 +116,7 @@ private:
   };
 
   bool Check(const MorseSmaleComplex& input, std::string& error) const;
+  int CellMerges(Index saddle, bool minimum, int side, std::array<std::array<Index, 2>, 2>& pairs) const;
   void BuildForests();
   void ComputeSequence();
 
@@ -125,6 +131,9 @@ private:
   std::vector<std::array<Index, 4>> SaddleArcs;
   std::vector<Index> ArcExtremum; // per input 1-cell: its minimum or maximum (position)
   std::vector<unsigned char> OnBoundaryCurve; // per critical point: a cell of the boundary curve
+  // Per saddle, the input 2-cell at each corner: [2 d + a] for its descending 1-cell d and
+  // ascending 1-cell a (0 or 1, in SaddleArcs order); InvalidIndex if the input has none.
+  std::vector<std::array<Index, 4>> SaddleCorners;
 
   NodeSet DescendingNodes; // vertices
   NodeSet AscendingNodes;  // triangles

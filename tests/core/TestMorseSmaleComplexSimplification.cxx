@@ -393,20 +393,69 @@ void CheckComplex(Failures& failures, const std::string& at, const PlanarScalarF
   }
   failures.Check(counted, "2-cell vertex counts match the per-vertex 2-cell ids", at);
 
-  // Junction points: a mesh cell on 2+ of the listed 1-cells, all of its extremum.
+  // Junction points. Each 1-cell, read from its extremum: mesh cells, then (ascending) its
+  // saddle's vertex, encoded below zero. Wherever two 1-cells of one extremum part, the last
+  // cell they share (other than the extremum's own) is a junction point; and at a junction
+  // point the 1-cells through it do not all go on the same way.
+  std::vector<std::vector<Index>> fromExtremum(c.Separatrices.size());
+  for (size_t a = 0; a < c.Separatrices.size(); ++a)
+  {
+    const Separatrix& arc = c.Separatrices[a];
+    auto& path = fromExtremum[a];
+    path = arc.MeshCells;
+    if (arc.Type == Separatrix::Ascending)
+    {
+      std::reverse(path.begin(), path.end());
+      path.push_back(-2 - cps[arc.Source].Vertex);
+    }
+  }
+  std::set<std::tuple<int, Index, Index>> junctionAt;
   bool junctionsValid = true;
   for (const JunctionPoint& j : result.JunctionPoints)
   {
+    junctionAt.insert({ j.Type, j.Extremum, j.Cell });
     bool ok = j.Separatrices.size() >= 2 && j.Extremum >= 0 && j.Extremum < nCP;
+    std::set<Index> following;
     for (Index a : j.Separatrices)
     {
       const Separatrix& arc = c.Separatrices[a];
+      const auto& path = fromExtremum[a];
+      const auto it = std::find(path.begin(), path.end(), j.Cell);
       ok = ok && arc.Type == j.Type && (j.Type == Separatrix::Descending ? arc.Source : arc.Destination) == j.Extremum &&
-        std::find(arc.MeshCells.begin(), arc.MeshCells.end(), j.Cell) != arc.MeshCells.end();
+        it != path.end();
+      if (ok)
+      {
+        following.insert(it + 1 == path.end() ? -1 : *(it + 1));
+      }
     }
-    junctionsValid = junctionsValid && ok;
+    junctionsValid = junctionsValid && ok && following.size() >= 2;
   }
-  failures.Check(junctionsValid, "junction points lie on 2+ 1-cells of their extremum", at);
+  failures.Check(junctionsValid, "junction points lie on 2+ 1-cells of their extremum that part there", at);
+  std::map<std::pair<int, Index>, std::vector<Index>> arcsOfExtremum;
+  for (size_t a = 0; a < c.Separatrices.size(); ++a)
+  {
+    const Separatrix& arc = c.Separatrices[a];
+    arcsOfExtremum[{ arc.Type, arc.Type == Separatrix::Descending ? arc.Source : arc.Destination }].push_back(a);
+  }
+  bool junctionsComplete = true;
+  for (const auto& entry : arcsOfExtremum)
+  {
+    const auto& list = entry.second;
+    for (size_t p = 0; p < list.size(); ++p)
+    {
+      for (size_t q = p + 1; q < list.size(); ++q)
+      {
+        const auto& a = fromExtremum[list[p]];
+        const auto& b = fromExtremum[list[q]];
+        const size_t shared = std::mismatch(a.begin(), a.begin() + std::min(a.size(), b.size()), b.begin()).first - a.begin();
+        if (shared >= 2 && !(a.size() == shared && b.size() == shared))
+        {
+          junctionsComplete = junctionsComplete && junctionAt.count({ entry.first.first, entry.first.second, a[shared - 1] });
+        }
+      }
+    }
+  }
+  failures.Check(junctionsComplete, "every place where two 1-cells of an extremum part is a junction point", at);
 }
 
 //------------------------------------------------------------------------------
@@ -469,6 +518,7 @@ void RunField(const FieldCase& fieldCase)
   }
   std::array<Index, 3> last = input.CountByIndex(), at25{};
   Index junctions25 = 0, compared = 0;
+  std::set<Index> comparedExtrema;
   int nonSimpleArcs = 0;
   std::map<Index, std::string> mismatches;
   for (int percent = 0; percent <= 100; ++percent)
@@ -522,6 +572,7 @@ void RunField(const FieldCase& fieldCase)
         continue;
       }
       ++compared;
+      comparedExtrema.insert(cp.Id);
       const bool expected = percent < 100 && found->second.Persistence >= t;
       const bool survives = kept.count(cp.Id) > 0;
       if (expected != survives && mismatches.count(cp.Id) == 0)
@@ -549,11 +600,11 @@ void RunField(const FieldCase& fieldCase)
 
   const auto counts = input.CountByIndex();
   std::printf("  %s: %d/%d/%d min/saddle/max (%d critical points), at 25%%: %d/%d/%d (%d), %d junction points; "
-              "%zu cancellations, %d persistence inversions, %d elder-rule violations; %d merge-tree comparisons, "
-              "%zu extrema mismatched\n",
+              "%zu cancellations, %d persistence inversions, %d elder-rule violations; merge trees: %zu extrema "
+              "compared at 101 thresholds (%d comparisons), %zu mismatched\n",
     fieldCase.Name.c_str(), counts[0], counts[1], counts[2], counts[0] + counts[1] + counts[2], at25[0], at25[1],
-    at25[2], at25[0] + at25[1] + at25[2], junctions25, hierarchy.size(), inversions, elderViolations, compared,
-    mismatches.size());
+    at25[2], at25[0] + at25[1] + at25[2], junctions25, hierarchy.size(), inversions, elderViolations,
+    comparedExtrema.size(), compared, mismatches.size());
   failures.Report();
 }
 
