@@ -4,6 +4,8 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <vector>
 
 namespace topospline
 {
@@ -25,6 +27,34 @@ inline void SequentialFor(Index begin, Index end, const RangeBody& body)
     body(begin, end);
   }
 }
+
+// An allocator whose resize() leaves new elements uninitialized (default- rather than value-
+// initialized). For the large per-cell arrays that a parallel pass fills completely anyway:
+// it saves a sequential zero-fill and lets each thread touch its own pages first.
+template <typename T>
+struct DefaultInitAllocator : std::allocator<T>
+{
+  template <typename U>
+  struct rebind
+  {
+    using other = DefaultInitAllocator<U>;
+  };
+  using std::allocator<T>::allocator;
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args)
+  {
+    if constexpr (sizeof...(Args) == 0)
+    {
+      ::new (static_cast<void*>(p)) U;
+    }
+    else
+    {
+      ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+  }
+};
+template <typename T>
+using FilledByPassVector = std::vector<T, DefaultInitAllocator<T>>;
 
 // Cooperative cancellation and progress, also injected by the VTK layer.
 struct ProgressHooks

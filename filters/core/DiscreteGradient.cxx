@@ -198,6 +198,16 @@ struct LowerStarProcessor
       }
     }
 
+    this->Gradient.VertexEdge[v] = InvalidIndex;
+    for (const StarCell& edge : this->Edges)
+    {
+      this->Gradient.EdgeVertex[edge.Id] = InvalidIndex;
+      this->Gradient.EdgeTriangle[edge.Id] = InvalidIndex;
+    }
+    for (const StarCell& tri : this->Triangles)
+    {
+      this->Gradient.TriangleEdge[tri.Id] = InvalidIndex;
+    }
     if (!boundaryVertex && !this->Edges.empty() && this->Triangles.size() + 1 == this->Edges.size() &&
       !DiscreteGradient::GeneralPathOnly)
     {
@@ -309,10 +319,11 @@ Index DiscreteGradient::TriangleOwner(const TriangleMeshTopology& mesh, const Ve
 
 void DiscreteGradient::Compute(const TriangleMeshTopology& mesh, const double* values, const ParallelFor& parallelFor)
 {
-  this->VertexEdge.assign(mesh.NumberOfVertices(), InvalidIndex);
-  this->EdgeVertex.assign(mesh.NumberOfEdges(), InvalidIndex);
-  this->EdgeTriangle.assign(mesh.NumberOfEdges(), InvalidIndex);
-  this->TriangleEdge.assign(mesh.NumberOfTriangles(), InvalidIndex);
+  // No fill here: each lower star sets its own cells (every cell is in exactly one).
+  this->VertexEdge.resize(mesh.NumberOfVertices());
+  this->EdgeVertex.resize(mesh.NumberOfEdges());
+  this->EdgeTriangle.resize(mesh.NumberOfEdges());
+  this->TriangleEdge.resize(mesh.NumberOfTriangles());
   // Each lower star owns its cells, so the per-vertex tasks write disjoint slots.
   parallelFor(0, mesh.NumberOfVertices(), [&](Index begin, Index end) {
     LowerStarProcessor processor{ mesh, VertexOrder{ values }, *this, {}, {}, {}, {} };

@@ -36,10 +36,11 @@ public:
   void Compute(const TriangleMeshTopology& mesh, const double* values, const ParallelFor& parallelFor);
 
   // Pairings; InvalidIndex means "not paired by this relation".
-  std::vector<Index> VertexEdge;   // vertex -> paired edge
-  std::vector<Index> EdgeVertex;   // edge -> paired vertex
-  std::vector<Index> EdgeTriangle; // edge -> paired triangle
-  std::vector<Index> TriangleEdge; // triangle -> paired edge
+  // Every cell lies in exactly one lower star, which initializes and fills its entries.
+  FilledByPassVector<Index> VertexEdge;   // vertex -> paired edge
+  FilledByPassVector<Index> EdgeVertex;   // edge -> paired vertex
+  FilledByPassVector<Index> EdgeTriangle; // edge -> paired triangle
+  FilledByPassVector<Index> TriangleEdge; // triangle -> paired edge
 
   bool IsCriticalVertex(Index v) const { return this->VertexEdge[v] == InvalidIndex; }
   bool IsCriticalEdge(Index e) const

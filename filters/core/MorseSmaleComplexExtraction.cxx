@@ -16,6 +16,15 @@ struct UnionFind
   {
     std::iota(this->Parent.begin(), this->Parent.end(), 0);
   }
+  // Without path compression: safe to call from several threads at once.
+  Index Root(Index x) const
+  {
+    while (this->Parent[x] != x)
+    {
+      x = this->Parent[x];
+    }
+    return x;
+  }
   Index Find(Index x)
   {
     while (this->Parent[x] != x)
@@ -684,10 +693,15 @@ bool MorseSmaleComplexExtraction::Extract(
   // minimum, then through any neighbour.
   complex.TwoCellId.assign(nV, InvalidIndex);
   std::vector<unsigned char> hasRegion(complex.TwoCells.size(), 0);
+  this->Parallel(0, nV, [&](Index begin, Index end) {
+    for (Index v = begin; v < end; ++v)
+    {
+      complex.TwoCellId[v] = cellOfRoot[components.Root(v)];
+    }
+  });
   std::vector<Index> unassigned;
   for (Index v = 0; v < nV; ++v)
   {
-    complex.TwoCellId[v] = cellOfRoot[components.Find(v)];
     if (complex.TwoCellId[v] != InvalidIndex)
     {
       hasRegion[complex.TwoCellId[v]] = 1;

@@ -81,8 +81,9 @@ void TriangleMeshTopology::BuildGrid(int nx, int ny, const ParallelFor& parallel
   auto triangle = [&](Index qi, Index qj, int half) { return 2 * (qj * quadsX + qi) + half; };
 
   const Index nE = this->EdgeOffsets[nV];
+  // Every entry of these arrays is written by the parallel pass below.
   this->EdgeVertices.resize(nE);
-  this->EdgeTriangles.assign(nE, { InvalidIndex, InvalidIndex });
+  this->EdgeTriangles.resize(nE);
   this->BoundaryVertex.resize(nV);
   this->VertexTriangleOffsets.resize(nV + 1);
   this->VertexTriangleOffsets[0] = 0;

@@ -48,16 +48,16 @@ public:
     return static_cast<long long>(this->NumVertices) - this->NumberOfEdges() + this->NumberOfTriangles();
   }
 
-  std::vector<std::array<Index, 3>> TriangleVertices;
-  std::vector<std::array<Index, 3>> TriangleEdges; // edge opposite nothing: (v0v1, v1v2, v2v0)
-  std::vector<std::array<Index, 2>> EdgeVertices;  // sorted: [0] < [1]
-  std::vector<std::array<Index, 2>> EdgeTriangles; // [1] == InvalidIndex on the domain boundary
-  std::vector<unsigned char> BoundaryVertex;
+  FilledByPassVector<std::array<Index, 3>> TriangleVertices;
+  FilledByPassVector<std::array<Index, 3>> TriangleEdges; // edges (v0v1, v1v2, v2v0)
+  FilledByPassVector<std::array<Index, 2>> EdgeVertices;  // sorted: [0] < [1]
+  FilledByPassVector<std::array<Index, 2>> EdgeTriangles; // [1] == InvalidIndex on the domain boundary
+  FilledByPassVector<unsigned char> BoundaryVertex;
 
 private:
   Index NumVertices = 0;
   std::vector<Index> VertexTriangleOffsets;
-  std::vector<Index> VertexTriangles;
+  FilledByPassVector<Index> VertexTriangles;
   // Edges (v, w) with w > v are numbered consecutively per v: [EdgeOffsets[v], EdgeOffsets[v+1]).
   std::vector<Index> EdgeOffsets;
 };

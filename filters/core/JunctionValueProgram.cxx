@@ -1,0 +1,379 @@
+#include "JunctionValueProgram.h"
+
+#ifndef CGAL_USE_GLPK
+#error "JunctionValueProgram needs GLPK through CGAL's solver interface: define CGAL_USE_GLPK and link glpk"
+#endif
+#include <CGAL/GLPK_mixed_integer_program_traits.h>
+#include <glpk.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace topospline
+{
+namespace
+{
+using LinearProgram = CGAL::GLPK_mixed_integer_program_traits<double>;
+using LinearVariable = CGAL::Variable<double>;
+using LinearConstraint = CGAL::Linear_constraint<double>;
+
+Index FindRoot(std::vector<Index>& parent, Index x)
+{
+  while (parent[x] != x)
+  {
+    parent[x] = parent[parent[x]];
+    x = parent[x];
+  }
+  return x;
+}
+
+std::string DescribeNode(const std::vector<JunctionValueNode>& nodes, Index n)
+{
+  return std::string(nodes[n].Fixed ? "critical node " : "junction node ") + std::to_string(n) + " (value " +
+    std::to_string(nodes[n].Value) + ")";
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+bool JunctionValueProgram::Solve(const std::vector<JunctionValueNode>& nodes,
+  const std::vector<std::array<Index, 2>>& lowerThan, std::vector<double>& values, std::string& error)
+{
+  if (!(this->MarginFraction > 0) || !(this->MarginSafety > 0 && this->MarginSafety < 1))
+  {
+    error = "the junction program needs MarginFraction > 0 and MarginSafety in (0, 1)";
+    return false;
+  }
+  const Index count = static_cast<Index>(nodes.size());
+  for (const auto& node : nodes)
+  {
+    if (!std::isfinite(node.Value))
+    {
+      error = "the junction program got a non-finite node value";
+      return false;
+    }
+  }
+  // Several 1-cells sharing a stretch give the same relation several times: keep one.
+  std::vector<std::array<Index, 2>> relations = lowerThan;
+  for (const auto& r : relations)
+  {
+    if (r[0] < 0 || r[0] >= count || r[1] < 0 || r[1] >= count)
+    {
+      error = "the junction program got a relation with a node index out of range";
+      return false;
+    }
+    if (r[0] == r[1])
+    {
+      error = "the junction program got a relation of " + DescribeNode(nodes, r[0]) + " with itself";
+      return false;
+    }
+  }
+  std::sort(relations.begin(), relations.end());
+  relations.erase(std::unique(relations.begin(), relations.end()), relations.end());
+
+  // Out-lists in compressed rows.
+  std::vector<Index> offsets(static_cast<std::size_t>(count) + 1, 0);
+  for (const auto& r : relations)
+  {
+    ++offsets[r[0] + 1];
+  }
+  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+  std::vector<Index> successors(relations.size());
+  {
+    std::vector<Index> cursor(offsets.begin(), offsets.end() - 1);
+    for (const auto& r : relations)
+    {
+      successors[cursor[r[0]]++] = r[1];
+    }
+  }
+
+  // Topological order (Kahn); leftover nodes lie on or behind a cycle.
+  std::vector<Index> order;
+  std::vector<Index> position(count, 0);
+  {
+    std::vector<Index> inDegree(count, 0);
+    for (const auto& r : relations)
+    {
+      ++inDegree[r[1]];
+    }
+    order.reserve(count);
+    for (Index n = 0; n < count; ++n)
+    {
+      if (inDegree[n] == 0)
+      {
+        order.push_back(n);
+      }
+    }
+    for (std::size_t head = 0; head < order.size(); ++head)
+    {
+      const Index v = order[head];
+      for (Index e = offsets[v]; e < offsets[v + 1]; ++e)
+      {
+        if (--inDegree[successors[e]] == 0)
+        {
+          order.push_back(successors[e]);
+        }
+      }
+    }
+    if (static_cast<Index>(order.size()) != count)
+    {
+      Index blocked = 0;
+      while (inDegree[blocked] == 0)
+      {
+        ++blocked;
+      }
+      error = "the 'lower than' relations of the 1-cells contain a cycle (reaching " + DescribeNode(nodes, blocked) +
+        "): no strictly monotone values exist";
+      return false;
+    }
+    for (Index i = 0; i < count; ++i)
+    {
+      position[order[i]] = i;
+    }
+  }
+
+  double minimumValue = std::numeric_limits<double>::infinity();
+  double maximumValue = -minimumValue;
+  for (const auto& node : nodes)
+  {
+    minimumValue = std::min(minimumValue, node.Value);
+    maximumValue = std::max(maximumValue, node.Value);
+  }
+  double range = count > 0 ? maximumValue - minimumValue : 1.0;
+  if (!(range > 0))
+  {
+    // All values equal: fall back to their magnitude (or 1) as the scale of the margin.
+    range = std::max(std::abs(minimumValue), 1.0);
+    minimumValue = count > 0 ? minimumValue : 0.0;
+  }
+
+  // Chains between fixed nodes through free ones: d relations from f_a to f_b need
+  // f_b - f_a >= d * margin. Longest paths from each fixed node over the free nodes it
+  // reaches (in topological order) give the tightest chain for every pair.
+  double tightestRatio = std::numeric_limits<double>::infinity();
+  {
+    std::vector<Index> stamp(count, InvalidIndex);
+    std::vector<Index> longest(count, 0);
+    std::vector<Index> reached;
+    for (Index a = 0; a < count; ++a)
+    {
+      if (!nodes[a].Fixed || offsets[a] == offsets[a + 1])
+      {
+        continue;
+      }
+      reached.assign(1, a);
+      stamp[a] = a;
+      longest[a] = 0;
+      for (std::size_t head = 0; head < reached.size(); ++head)
+      {
+        const Index v = reached[head];
+        for (Index e = offsets[v]; e < offsets[v + 1]; ++e)
+        {
+          const Index w = successors[e];
+          if (!nodes[w].Fixed && stamp[w] != a)
+          {
+            stamp[w] = a;
+            longest[w] = 0;
+            reached.push_back(w);
+          }
+        }
+      }
+      std::sort(reached.begin() + 1, reached.end(),
+        [&position](Index x, Index y) { return position[x] < position[y]; });
+      for (const Index v : reached)
+      {
+        for (Index e = offsets[v]; e < offsets[v + 1]; ++e)
+        {
+          const Index w = successors[e];
+          const Index chain = longest[v] + 1;
+          if (!nodes[w].Fixed)
+          {
+            longest[w] = std::max(longest[w], chain);
+            continue;
+          }
+          const double rise = nodes[w].Value - nodes[a].Value;
+          if (!(rise > 0))
+          {
+            error = "the 1-cells require " + DescribeNode(nodes, a) + " to be strictly lower than " +
+              DescribeNode(nodes, w) + " (through " + std::to_string(chain) + " relations): no monotone values exist";
+            return false;
+          }
+          tightestRatio = std::min(tightestRatio, rise / chain);
+        }
+      }
+    }
+  }
+  const double margin = std::min(this->MarginFraction * range, this->MarginSafety * tightestRatio);
+  if (!(margin > 0) || !std::isfinite(margin))
+  {
+    error = "the junction program found no positive margin for the value range " + std::to_string(range);
+    return false;
+  }
+
+  // Bounds of the free nodes from their fixed neighbours, and components of the free nodes
+  // linked by relations.
+  const double infinity = std::numeric_limits<double>::infinity();
+  std::vector<double> lower(count, -infinity);
+  std::vector<double> upper(count, infinity);
+  std::vector<Index> parent(count);
+  std::iota(parent.begin(), parent.end(), 0);
+  for (const auto& r : relations)
+  {
+    const bool lowFixed = nodes[r[0]].Fixed;
+    const bool highFixed = nodes[r[1]].Fixed;
+    if (lowFixed && !highFixed)
+    {
+      lower[r[1]] = std::max(lower[r[1]], nodes[r[0]].Value + margin);
+    }
+    else if (!lowFixed && highFixed)
+    {
+      upper[r[0]] = std::min(upper[r[0]], nodes[r[1]].Value - margin);
+    }
+    else if (!lowFixed && !highFixed)
+    {
+      parent[FindRoot(parent, r[0])] = FindRoot(parent, r[1]);
+    }
+  }
+
+  values.resize(count);
+  std::vector<std::vector<Index>> components;
+  {
+    std::vector<Index> componentOf(count, InvalidIndex);
+    for (Index n = 0; n < count; ++n)
+    {
+      values[n] = nodes[n].Value;
+      if (nodes[n].Fixed)
+      {
+        continue;
+      }
+      const Index root = this->SplitIntoComponents ? FindRoot(parent, n) : 0;
+      if (componentOf[root] == InvalidIndex)
+      {
+        componentOf[root] = static_cast<Index>(components.size());
+        components.emplace_back();
+      }
+      components[componentOf[root]].push_back(n);
+    }
+  }
+
+  this->NumberOfPrograms = 0;
+  this->LargestProgram = 0;
+  std::vector<Index> variableOf(count, InvalidIndex);
+  for (const auto& component : components)
+  {
+    if (component.size() == 1)
+    {
+      // min |x - f| within [lower, upper]: the clamp (lower <= upper, see the chains above).
+      const Index n = component[0];
+      values[n] = std::min(std::max(nodes[n].Value, lower[n]), upper[n]);
+      continue;
+    }
+    // In normalized values y = (x - min) / range, so the program is well scaled whatever
+    // the units of the field.
+    LinearProgram program;
+    const double programInfinity = LinearVariable::infinity();
+    auto* objective = program.create_objective(CGAL::Linear_objective<double>::MINIMIZE);
+    std::vector<LinearVariable*> variables;
+    variables.reserve(component.size());
+    for (const Index n : component)
+    {
+      const double lo = std::isfinite(lower[n]) ? (lower[n] - minimumValue) / range : -programInfinity;
+      const double hi = std::isfinite(upper[n]) ? (upper[n] - minimumValue) / range : programInfinity;
+      variableOf[n] = static_cast<Index>(variables.size());
+      variables.push_back(program.create_variable(LinearVariable::CONTINUOUS, lo, hi));
+    }
+    for (const Index n : component)
+    {
+      // |y_n - f_n| <= d_n as two rows.
+      const double target = (nodes[n].Value - minimumValue) / range;
+      LinearVariable* deviation = program.create_variable(LinearVariable::CONTINUOUS, 0.0, programInfinity);
+      objective->add_coefficient(deviation, 1.0);
+      LinearConstraint* above = program.create_constraint(target, programInfinity);
+      above->add_coefficient(deviation, 1.0);
+      above->add_coefficient(variables[variableOf[n]], 1.0);
+      LinearConstraint* below = program.create_constraint(-target, programInfinity);
+      below->add_coefficient(deviation, 1.0);
+      below->add_coefficient(variables[variableOf[n]], -1.0);
+    }
+    for (const Index n : component)
+    {
+      for (Index e = offsets[n]; e < offsets[n + 1]; ++e)
+      {
+        const Index w = successors[e];
+        if (!nodes[w].Fixed)
+        {
+          LinearConstraint* rise = program.create_constraint(margin / range, programInfinity);
+          rise->add_coefficient(variables[variableOf[w]], 1.0);
+          rise->add_coefficient(variables[variableOf[n]], -1.0);
+        }
+      }
+    }
+    glp_term_out(GLP_OFF);
+    if (!program.solve())
+    {
+      error = "the linear program of the junction values failed: " + program.error_message();
+      return false;
+    }
+    const std::vector<double>& solution = program.solution();
+    for (const Index n : component)
+    {
+      values[n] = minimumValue + range * solution[variables[variableOf[n]]->index()];
+    }
+    ++this->NumberOfPrograms;
+    this->LargestProgram = std::max(this->LargestProgram, static_cast<int>(component.size()));
+  }
+
+  // GLPK meets the constraints to its tolerance (1e-7 of the range), not exactly. Raise
+  // every free node to its predecessors + margin (topological order), then lower it to its
+  // successors - margin (reverse order): the second pass keeps the first one's lower bounds
+  // because the chains are feasible (checked above), and nothing moves when the solution
+  // already satisfies the constraints.
+  for (const Index v : order)
+  {
+    for (Index e = offsets[v]; e < offsets[v + 1]; ++e)
+    {
+      const Index w = successors[e];
+      if (!nodes[w].Fixed)
+      {
+        values[w] = std::max(values[w], values[v] + margin);
+      }
+    }
+  }
+  for (auto it = order.rbegin(); it != order.rend(); ++it)
+  {
+    const Index v = *it;
+    if (nodes[v].Fixed)
+    {
+      continue;
+    }
+    for (Index e = offsets[v]; e < offsets[v + 1]; ++e)
+    {
+      values[v] = std::min(values[v], values[successors[e]] - margin);
+    }
+  }
+  for (const auto& r : relations)
+  {
+    if (!(values[r[1]] - values[r[0]] >= 0.5 * margin))
+    {
+      error = "the junction values violate the relation " + DescribeNode(nodes, r[0]) + " < " +
+        DescribeNode(nodes, r[1]) + " after solving";
+      return false;
+    }
+  }
+
+  this->Margin = margin;
+  this->TotalChange = 0;
+  this->MaximumChange = 0;
+  for (Index n = 0; n < count; ++n)
+  {
+    if (!nodes[n].Fixed)
+    {
+      const double change = std::abs(values[n] - nodes[n].Value);
+      this->TotalChange += change;
+      this->MaximumChange = std::max(this->MaximumChange, change);
+    }
+  }
+  return true;
+}
+} // namespace topospline

@@ -1,0 +1,152 @@
+// Stage 3 of the paper (section 4, step 2 and 3), for one piece of a 1-cell between two
+// consecutive critical/junction points: a strictly increasing height function and a smooth
+// planar curve, both uniform quadratic B-splines with k segments on [0, 1], and their exact
+// conversion into k cubic Bezier segments (knot insertion, then degree elevation).
+//
+// Conventions shared by everything here (algorithms.md 2.2-2.4):
+// - knots 0 = u_-2 = u_-1 = u_0 < u_1 < ... < u_k = u_k+1 = u_k+2 = 1, u_j = j / k;
+// - coefficients alpha_0 .. alpha_k+1 (k + 2 of them); segment j covers [j / k, (j + 1) / k]
+//   and depends on alpha_j, alpha_j+1, alpha_j+2 only;
+// - multi-component splines (the planar curve) store coefficient i, component d at
+//   [i * Dimension + d].
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace topospline
+{
+// k cubic Bezier segments of a curve on [0, 1], segment j on [j / k, (j + 1) / k]. Every
+// segment stores its own 4 control points (the end point of segment j repeats as the start
+// point of segment j + 1), which is the layout of one VTK_BEZIER_CURVE cell per segment.
+struct CubicBezierSpline
+{
+  int Segments = 0;
+  int Dimension = 1;
+  // Segment j, control point m (0..3), component d at [(j * 4 + m) * Dimension + d].
+  std::vector<double> ControlPoints;
+
+  const double* Segment(int j) const { return this->ControlPoints.data() + 4 * j * this->Dimension; }
+
+  // Value and derivative with respect to the global parameter t in [0, 1].
+  void Evaluate(double t, double* value) const;
+  void EvaluateDerivative(double t, double* derivative) const;
+  // Shortcuts for Dimension == 1.
+  double Value(double t) const;
+  double Slope(double t) const;
+
+  // One cubic (4 control points of `dimension` components) at its local parameter s.
+  static void EvaluateSegment(const double* control, int dimension, double s, double* value);
+  // d/ds of one cubic.
+  static void EvaluateSegmentDerivative(const double* control, int dimension, double s, double* derivative);
+  // de Casteljau split of one cubic at s: `left` covers [0, s], `right` [s, 1], each 4 points.
+  static void Subdivide(const double* control, int dimension, double s, double* left, double* right);
+};
+
+// A clamped uniform quadratic B-spline on [0, 1] with k segments (see the conventions above).
+struct UniformQuadraticBSpline
+{
+  int Segments = 0;  // k
+  int Dimension = 1; // 1 for a height, 2 for a planar curve
+  std::vector<double> Coefficients; // (k + 2) * Dimension
+
+  void Evaluate(double t, double* value) const;
+  void EvaluateDerivative(double t, double* derivative) const;
+  double Value(double t) const; // Dimension == 1
+  double Slope(double t) const; // Dimension == 1
+
+  // The weights of alpha_first, alpha_first+1, alpha_first+2 in the value at t, i.e.
+  // N_first^2(t), N_first+1^2(t), N_first+2^2(t); first is the segment that holds t.
+  static void BasisWeights(int segments, double t, int& first, double weights[3]);
+  // The segment j that holds t (the last one for t = 1) and the local parameter s in [0, 1].
+  static int LocateSegment(int segments, double t, double& s);
+
+  // Knot insertion (every interior knot to multiplicity 2): k quadratic Bezier segments,
+  // segment j, control point m (0..2), component d at [(j * 3 + m) * Dimension + d].
+  std::vector<double> ToQuadraticBezier() const;
+  // Knot insertion then degree elevation: the same curve as k cubic Bezier segments.
+  CubicBezierSpline ToCubicBezier() const;
+};
+
+// Degree elevation of quadratic Bezier segments (3 control points each, as produced by
+// UniformQuadraticBSpline::ToQuadraticBezier) to cubic ones: c0 = b0, c1 = (b0 + 2 b1) / 3,
+// c2 = (2 b1 + b2) / 3, c3 = b2.
+CubicBezierSpline ElevateQuadraticBezier(const std::vector<double>& quadratic, int segments, int dimension);
+
+// The height fitted along one piece.
+struct HeightFit
+{
+  UniformQuadraticBSpline Spline; // Dimension 1
+  double L1Error = 0;             // sum over the interior samples of |f_i - g(t_i)|
+  double MaximumError = 0;        // max over the interior samples of |f_i - g(t_i)|
+  double MinimumStep = 0;         // delta: alpha_j+1 - alpha_j >= delta for j = 1..k-1 (0 if unconstrained)
+  int ProgramVariables = 0;       // size of the linear program (0 when none was needed)
+  int ProgramConstraints = 0;
+};
+
+// The planar curve fitted along one piece.
+struct PlanarCurveFit
+{
+  UniformQuadraticBSpline Spline; // Dimension 2
+  double RootMeanSquareError = 0; // over all samples, of |x_i - c(t_i)|
+  double MaximumError = 0;
+};
+
+class MonotoneBSplineFit
+{
+public:
+  // k, the number of segments (the paper's "Curve Segments"; it uses 4 and 7). k = 2 leaves
+  // no freedom (alpha_1 = a, alpha_2 = b); k = 1 would force a constant, so k >= 2.
+  int Segments = 4;
+  static constexpr int MaximumSegments = 1000;
+
+  // Strictness: alpha_j+1 - alpha_j >= delta for j = 1..k-1 with
+  //   delta = MinimumSlopeFraction * (b - a) / k.
+  // g' is piecewise linear and equals k (alpha_j+1 - alpha_j) at the interior knots, so the
+  // slope at every interior knot is at least MinimumSlopeFraction times the mean slope
+  // (b - a) of the piece, and g' > 0 on the open interval (0, 1). The k - 1 steps sum to
+  // b - a, so any fraction below k / (k - 1) is feasible; 1% keeps the fit free to follow
+  // plateaus in the data while staying far above double-precision resolution.
+  double MinimumSlopeFraction = 0.01;
+
+  // L1 fits are often not unique (e.g. a segment without samples leaves its coefficients
+  // free). The monotone fit adds TieBreakWeight * sum_j |(alpha_j+1 - alpha_j) - (b - a) /
+  // (k - 1)| / (b - a) to the objective (whose residuals are also measured in units of
+  // b - a), which picks the most evenly spaced optimum. It can raise the L1 error by at
+  // most 2 * TieBreakWeight * (b - a); 1e-5 is 100 times GLPK's optimality tolerance, so
+  // the tie-break is effective. 0 disables it. The unconstrained fit never uses it, so its
+  // error is a true lower bound for the monotone one.
+  double TieBreakWeight = 1e-5;
+
+  // Height g along the piece, fitted in the L1 sense (He & Shi) to the samples
+  // (parameters[i], values[i]), i = 0..n (n >= 1), parameters non-decreasing in [0, 1]:
+  // g(0) = startValue < g(1) = endValue exactly, g'(0) = g'(1) = 0 (alpha_0 = alpha_1,
+  // alpha_k = alpha_k+1), and only the interior samples 1..n-1 enter the objective (the
+  // end values come from the junction program, not from values[0] and values[n]).
+  // monotone = true adds alpha_j+1 - alpha_j >= delta (strictly increasing g); false gives
+  // the unconstrained L1 fit with the same end conditions, for comparison.
+  // Returns false with a message for bad input (k out of range, startValue >= endValue,
+  // sizes, non-finite numbers) or a solver failure.
+  bool FitHeight(const std::vector<double>& parameters, const std::vector<double>& values, double startValue,
+    double endValue, bool monotone, HeightFit& fit, std::string& error) const;
+
+  // Least-squares planar curve c(t) = sum c_i N_i^2(t) through the polyline points
+  // (points[2 i], points[2 i + 1]) at parameters[i], i = 0..n: c_0 = first point and
+  // c_k+1 = last point exactly (so c(0), c(1) are the critical/junction points), c_1..c_k
+  // free (the paper does not fix the end tangents). A ridge term of 1e-6 of the mean
+  // diagonal of the normal matrix pulls c_1..c_k towards the polyline at the Greville
+  // abscissae (j - 1/2) / k: negligible for well-sampled pieces, it keeps pieces with fewer
+  // samples than coefficients well-posed (and reproduces a straight polyline exactly).
+  bool FitPlanarCurve(const std::vector<double>& parameters, const std::vector<double>& points,
+    PlanarCurveFit& fit, std::string& error) const;
+
+  // Normalized arc length of a polyline (x, y pairs): t_0 = 0, t_n = 1. A polyline of zero
+  // length gets uniform parameters i / n.
+  static std::vector<double> NormalizedArcLength(const std::vector<double>& points);
+
+private:
+  bool CheckSamples(const std::vector<double>& parameters, std::size_t valuesPerSample,
+    const std::vector<double>& values, std::string& error) const;
+};
+} // namespace topospline
