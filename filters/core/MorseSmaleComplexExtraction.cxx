@@ -108,13 +108,8 @@ double TurningAngle(double rx, double ry, double dx, double dy)
 std::vector<Index> MorseSmaleComplexExtraction::SeparatricesAround(
   const MorseSmaleComplex& complex, Index extremum)
 {
-  // The 1-cells of an extremum form a planar tree rooted at it (V-paths merge and never
-  // split): descending ones as vertex paths, ascending ones as triangle paths (through the
-  // centroids). Order its leaves counter-clockwise: compare two paths where they diverge by
-  // the turning angle of their next step from the way back (from +x at the root).
-  const bool minimum = complex.CriticalPoints[extremum].MorseIndex == 0;
   std::vector<Index> arcs;
-  std::vector<std::vector<std::array<double, 2>>> paths(complex.Separatrices.size());
+  const bool minimum = complex.CriticalPoints[extremum].MorseIndex == 0;
   for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
   {
     const Separatrix& arc = complex.Separatrices[a];
@@ -122,18 +117,38 @@ std::vector<Index> MorseSmaleComplexExtraction::SeparatricesAround(
                 : (arc.Type == Separatrix::Ascending && arc.Destination == extremum))
     {
       arcs.push_back(a);
-      auto& path = paths[a];
-      // From the extremum outwards; ascending 1-cells are stored from the saddle.
-      for (size_t k = 0; k < arc.Values.size(); ++k)
-      {
-        const size_t i = minimum ? k : arc.Values.size() - 1 - k;
-        path.push_back({ arc.Points[2 * i], arc.Points[2 * i + 1] });
-      }
     }
   }
+  SortAroundExtremum(complex, extremum, arcs);
+  return arcs;
+}
+
+void MorseSmaleComplexExtraction::SortAroundExtremum(
+  const MorseSmaleComplex& complex, Index extremum, std::vector<Index>& arcs)
+{
+  // The 1-cells of an extremum form a planar tree rooted at it (V-paths merge and never
+  // split): descending ones as vertex paths, ascending ones as triangle paths (through the
+  // centroids). Order its leaves counter-clockwise: compare two paths where they diverge by
+  // the turning angle of their next step from the way back (from +x at the root).
+  const bool minimum = complex.CriticalPoints[extremum].MorseIndex == 0;
+  std::sort(arcs.begin(), arcs.end());
+  std::vector<std::vector<std::array<double, 2>>> paths(arcs.size());
+  for (size_t k = 0; k < arcs.size(); ++k)
+  {
+    const Separatrix& arc = complex.Separatrices[arcs[k]];
+    // From the extremum outwards; ascending 1-cells are stored from the saddle.
+    for (size_t p = 0; p < arc.Values.size(); ++p)
+    {
+      const size_t i = minimum ? p : arc.Values.size() - 1 - p;
+      paths[k].push_back({ arc.Points[2 * i], arc.Points[2 * i + 1] });
+    }
+  }
+  auto pathOf = [&](Index a) -> const std::vector<std::array<double, 2>>& {
+    return paths[std::lower_bound(arcs.begin(), arcs.end(), a) - arcs.begin()];
+  };
   auto less = [&](Index ia, Index ib) {
-    const auto& pa = paths[ia];
-    const auto& pb = paths[ib];
+    const auto& pa = pathOf(ia);
+    const auto& pb = pathOf(ib);
     size_t k = 1;
     while (k < pa.size() && k < pb.size() && pa[k] == pb[k])
     {
@@ -154,8 +169,9 @@ std::vector<Index> MorseSmaleComplexExtraction::SeparatricesAround(
     const double ab = TurningAngle(rx, ry, pb[k][0] - node[0], pb[k][1] - node[1]);
     return aa != ab ? aa < ab : ia < ib;
   };
-  std::sort(arcs.begin(), arcs.end(), less);
-  return arcs;
+  std::vector<Index> sorted = arcs;
+  std::sort(sorted.begin(), sorted.end(), less);
+  arcs = sorted;
 }
 
 std::array<Index, 3> MorseSmaleComplex::CountByIndex() const
@@ -530,6 +546,13 @@ bool MorseSmaleComplexExtraction::Extract(
     }
     return sectors[a].Component < sectors[b].Component;
   });
+  // The 1-cells of each extremum: descending ones for minima, ascending ones for maxima.
+  std::vector<std::vector<Index>> arcsOfExtremum(cps.size());
+  for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
+  {
+    const Separatrix& arc = complex.Separatrices[a];
+    arcsOfExtremum[arc.Type == Separatrix::Descending ? arc.Source : arc.Destination].push_back(a);
+  }
   std::vector<std::array<Index, 2>> cellSectors;
   std::vector<Index> unpairedSectors;
   for (size_t i = 0; i < bySector.size();)
@@ -586,7 +609,8 @@ bool MorseSmaleComplexExtraction::Extract(
         std::vector<std::array<Index, 2>> tryPairs;
         std::vector<Index> tryRest;
         const Index extremum = end == 0 ? groupKey(group[0]).first : groupKey(group[0]).second;
-        const std::vector<Index> around = SeparatricesAround(complex, extremum);
+        std::vector<Index> around = arcsOfExtremum[extremum];
+        SortAroundExtremum(complex, extremum, around);
         auto arcOf = [&](const Sector& sector) { return end == 0 ? sector.Descending : sector.Ascending; };
         std::vector<unsigned char> used(group.size(), 0);
         for (size_t a = 0; a < group.size(); ++a)
@@ -732,24 +756,30 @@ bool MorseSmaleComplexExtraction::Extract(
   };
   // Breadth-first from the assigned vertices that touch unassigned ones (the only ones that
   // can spread), in vertex order: linear in the unassigned part, deterministic.
+  std::vector<unsigned char> queued(nV, 0);
   for (int pass = 0; pass < 2; ++pass)
   {
+    unassigned.erase(std::remove_if(unassigned.begin(), unassigned.end(),
+                       [&](Index u) { return complex.TwoCellId[u] != InvalidIndex; }),
+      unassigned.end());
+    if (unassigned.empty())
+    {
+      break;
+    }
     std::vector<Index> queue;
+    std::fill(queued.begin(), queued.end(), 0);
+    auto enqueue = [&](Index w) {
+      if (complex.TwoCellId[w] != InvalidIndex && !queued[w])
+      {
+        queued[w] = 1;
+        queue.push_back(w);
+      }
+    };
     for (Index u : unassigned)
     {
-      forNeighbours(u, [&](Index w) {
-        if (complex.TwoCellId[w] != InvalidIndex)
-        {
-          queue.push_back(w);
-        }
-      });
-      if (complex.TwoCellId[u] != InvalidIndex)
-      {
-        queue.push_back(u);
-      }
+      enqueue(u);
+      forNeighbours(u, enqueue);
     }
-    std::sort(queue.begin(), queue.end());
-    queue.erase(std::unique(queue.begin(), queue.end()), queue.end());
     for (size_t head = 0; head < queue.size(); ++head)
     {
       const Index u = queue[head];
