@@ -18,9 +18,14 @@ enum BlockIndex
   SegmentationIndex = 3,
   NumberOfBlocks = 4,
   // Only in simplified complexes: where 1-cells sharing an extremum merge.
-  JunctionPointsIndex = 4
+  JunctionPointsIndex = 4,
+  // Only after "Smooth 1-Cells".
+  SmoothedOneCellsIndex = 5,
+  SampledOneCellsIndex = 6
 };
 constexpr const char* JunctionPointsBlock = "JunctionPoints";
+constexpr const char* SmoothedOneCellsBlock = "SmoothedOneCells";
+constexpr const char* SampledOneCellsBlock = "SampledOneCells";
 
 // Critical points (point data of the "CriticalPoints" block).
 constexpr const char* CriticalPointId = "CriticalPointId";

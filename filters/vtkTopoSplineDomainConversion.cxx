@@ -313,6 +313,24 @@ void PlanarToDomainPoint(vtkDataSet* domain, const double uv[2], double xyz[3])
   EmbeddingOf(domain).To3D(uv, xyz);
 }
 
+void DomainToPlanarPoint(vtkDataSet* domain, const double xyz[3], double uv[2])
+{
+  const PlanarEmbedding embedding = EmbeddingOf(domain);
+  uv[0] = xyz[embedding.U];
+  uv[1] = xyz[embedding.V];
+}
+
+void PlanarBounds(vtkDataSet* domain, double bounds[4])
+{
+  const PlanarEmbedding embedding = EmbeddingOf(domain);
+  double b[6];
+  domain->GetBounds(b);
+  bounds[0] = b[2 * embedding.U];
+  bounds[1] = b[2 * embedding.U + 1];
+  bounds[2] = b[2 * embedding.V];
+  bounds[3] = b[2 * embedding.V + 1];
+}
+
 void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* domain, const char* scalarName,
   vtkMultiBlockDataSet* output)
 {

@@ -42,6 +42,10 @@ bool FromMultiBlock(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& 
 // of `domain` (the input geometry or the Segmentation block).
 void PlanarToDomainPoint(vtkDataSet* domain, const double uv[2], double xyz[3]);
 
+// The inverse of PlanarToDomainPoint, and the bounds (umin, umax, vmin, vmax) in the plane.
+void DomainToPlanarPoint(vtkDataSet* domain, const double xyz[3], double uv[2]);
+void PlanarBounds(vtkDataSet* domain, double bounds[4]);
+
 // The "Segmentation" block of a complex, or nullptr.
 vtkDataSet* SegmentationOf(vtkMultiBlockDataSet* input);
 }

@@ -71,7 +71,8 @@ struct UniformQuadraticBSpline
 
 // Degree elevation of quadratic Bezier segments (3 control points each, as produced by
 // UniformQuadraticBSpline::ToQuadraticBezier) to cubic ones: c0 = b0, c1 = (b0 + 2 b1) / 3,
-// c2 = (2 b1 + b2) / 3, c3 = b2.
+// c2 = (2 b1 + b2) / 3, c3 = b2 (evaluated as b0 + 2 (b1 - b0) / 3 and b2 + 2 (b1 - b2) / 3,
+// so that a zero end derivative stays exactly zero).
 CubicBezierSpline ElevateQuadraticBezier(const std::vector<double>& quadratic, int segments, int dimension);
 
 // The height fitted along one piece.
@@ -81,8 +82,9 @@ struct HeightFit
   double L1Error = 0;             // sum over the interior samples of |f_i - g(t_i)|
   double MaximumError = 0;        // max over the interior samples of |f_i - g(t_i)|
   double MinimumStep = 0;         // delta: alpha_j+1 - alpha_j >= delta for j = 1..k-1 (0 if unconstrained)
-  int ProgramVariables = 0;       // size of the linear program (0 when none was needed)
+  int ProgramVariables = 0;       // size of the linear program solved last (0 when none was needed)
   int ProgramConstraints = 0;
+  bool SolvedThroughDual = false; // x came from the dual program (see UseDualProgram)
 };
 
 // The planar curve fitted along one piece.
@@ -118,6 +120,15 @@ public:
   // the tie-break is effective. 0 disables it. The unconstrained fit never uses it, so its
   // error is a true lower bound for the monotone one.
   double TieBreakWeight = 1e-5;
+
+  // How the L1 program is solved (both with GLPK through CGAL's solver interface). The
+  // primal has one row per interior sample and GLPK's primal simplex needs about as many
+  // pivots, so it grows like n^2 (about 2 ms for n = 200). The dual has one row per free
+  // coefficient (k - 2); the coefficients are recovered from its solution by complementary
+  // slackness and accepted only with an optimality certificate (feasible, zero duality
+  // gap), else the primal is solved instead (degenerate data such as constant samples).
+  // Same optimum either way; false always solves the primal.
+  bool UseDualProgram = true;
 
   // Height g along the piece, fitted in the L1 sense (He & Shi) to the samples
   // (parameters[i], values[i]), i = 0..n (n >= 1), parameters non-decreasing in [0, 1]:

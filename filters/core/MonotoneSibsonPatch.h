@@ -149,14 +149,18 @@ struct MonotoneSurfaceOptions
   double ConsistencyTolerance = 1e-9;
   // Lower bound sigma of p + q at interior nodes (and at boundary nodes whose tangential
   // derivative is below sigma), as this fraction of the smallest per-cell spare rise.
-  double MinimumSlopeFraction = 0.25;
+  double MinimumSlopeFraction = 0.1;
   // Fraction of the rise of each cell kept free when limiting derivatives (per cell, then per
   // diagonal relative to the best achievable spare rise).
   double LimiterMargin = 0.1;
   // Share of a diagonal's spare rise that every cell of it gets on top of its requirement
   // when values have to be moved.
   double RiseShare = 0.05;
-  int LimiterSweeps = 8;
+  // Rounds of the per-cell derivative limiter (keeps the Laplace values where it can) and of
+  // the per-diagonal one (makes every diagonal fixable); if the latter does not settle, all
+  // free derivatives take the minimal choice, which always works when anything does.
+  int CellLimiterSweeps = 8;
+  int DiagonalLimiterRounds = 8;
 };
 
 // What the construction had to do, for the filter's reports.

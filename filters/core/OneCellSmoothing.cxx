@@ -1,0 +1,432 @@
+#include <cstdio>
+#include <cstdlib>
+#include "OneCellSmoothing.h"
+
+#include "JunctionValueProgram.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <unordered_map>
+
+namespace topospline
+{
+namespace
+{
+// Where along a 1-cell its mesh cell `cell` sits, as an index into its Points; -1 if absent.
+long PointIndexOfCell(const Separatrix& arc, Index cell)
+{
+  const auto it = std::find(arc.MeshCells.begin(), arc.MeshCells.end(), cell);
+  if (it == arc.MeshCells.end())
+  {
+    return -1;
+  }
+  // Ascending 1-cells carry the saddle's vertex before their first triangle.
+  return static_cast<long>(it - arc.MeshCells.begin()) + (arc.Type == Separatrix::Ascending ? 1 : 0);
+}
+
+struct Segment2
+{
+  double A[2], B[2];
+  Index Piece;
+  int Index_;   // position along the piece's sampled polyline
+  int Count;    // number of segments of that polyline
+};
+
+double Cross(const double* o, const double* a, const double* b)
+{
+  return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+}
+
+// Proper crossing or overlap of two segments (touching end points excluded by the caller).
+bool SegmentsIntersect(const Segment2& s, const Segment2& t)
+{
+  const double d1 = Cross(s.A, s.B, t.A), d2 = Cross(s.A, s.B, t.B);
+  const double d3 = Cross(t.A, t.B, s.A), d4 = Cross(t.A, t.B, s.B);
+  return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
+}
+} // namespace
+
+bool OneCellSmoothing::FitPiece(
+  SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments, std::string& error) const
+{
+  MonotoneBSplineFit fitter;
+  fitter.Segments = segments;
+  HeightFit height, free;
+  const double a = nodes[piece.StartNode].Value, b = nodes[piece.EndNode].Value;
+  if (!fitter.FitHeight(piece.Parameters, piece.Values, a, b, true, height, error) ||
+    !fitter.FitHeight(piece.Parameters, piece.Values, a, b, false, free, error))
+  {
+    return false;
+  }
+  PlanarCurveFit curve;
+  if (!fitter.FitPlanarCurve(piece.Parameters, piece.Points, curve, error))
+  {
+    return false;
+  }
+  piece.Segments = segments;
+  piece.Height = height.Spline.ToCubicBezier();
+  piece.Curve = curve.Spline.ToCubicBezier();
+  piece.L1Error = height.L1Error;
+  piece.UnconstrainedL1Error = free.L1Error;
+  return true;
+}
+
+bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
+  const double domainBounds[4], OneCellSmoothingResult& result, std::string& error) const
+{
+  result = OneCellSmoothingResult();
+  if (this->Segments < 2 || this->Segments > MonotoneBSplineFit::MaximumSegments)
+  {
+    error = "the number of curve segments must be in [2, " + std::to_string(MonotoneBSplineFit::MaximumSegments) +
+      "], not " + std::to_string(this->Segments);
+    return false;
+  }
+  if (complex.Separatrices.empty())
+  {
+    error = "the complex has no 1-cells";
+    return false;
+  }
+  const auto& cps = complex.CriticalPoints;
+
+  // Nodes: every critical point, every junction point, and the domain corners met.
+  auto& nodes = result.Nodes;
+  for (Index c = 0; c < static_cast<Index>(cps.size()); ++c)
+  {
+    SmoothingNode node;
+    node.Type = SmoothingNode::Critical;
+    node.Source = c;
+    node.FieldValue = node.Value = cps[c].Value;
+    nodes.push_back(node);
+  }
+  // Ties between critical values (plateaus, broken by vertex id in stage 1) would make a
+  // strictly increasing height impossible: separate tied values by at most 1e-9 of the range,
+  // in the order of simulation of simplicity (value, then vertex, then index).
+  {
+    double low = cps.empty() ? 0 : cps[0].Value, high = low;
+    for (const auto& cp : cps)
+    {
+      low = std::min(low, cp.Value);
+      high = std::max(high, cp.Value);
+    }
+    std::vector<Index> order(cps.size());
+    for (Index i = 0; i < static_cast<Index>(order.size()); ++i)
+    {
+      order[i] = i;
+    }
+    // A vertex can hold several critical cells (a boundary corner: a saddle edge and a
+    // maximum triangle); the higher-dimensional cell is the higher one.
+    std::sort(order.begin(), order.end(), [&](Index x, Index y) {
+      if (cps[x].Value != cps[y].Value)
+      {
+        return cps[x].Value < cps[y].Value;
+      }
+      return cps[x].Vertex != cps[y].Vertex ? cps[x].Vertex < cps[y].Vertex : cps[x].MorseIndex < cps[y].MorseIndex;
+    });
+    const double step = 1e-9 * std::max(high - low, 1e-300) / std::max<size_t>(cps.size(), 1);
+    for (size_t i = 1; i < order.size(); ++i)
+    {
+      SmoothingNode& node = nodes[order[i]];
+      node.Value = std::max(node.Value, nodes[order[i - 1]].Value + step);
+    }
+  }
+  std::vector<Index> junctionNode(junctions.size());
+  for (size_t j = 0; j < junctions.size(); ++j)
+  {
+    if (junctions[j].CriticalPoint != InvalidIndex)
+    {
+      junctionNode[j] = junctions[j].CriticalPoint; // a saddle on it: the critical node
+      continue;
+    }
+    SmoothingNode node;
+    node.Type = SmoothingNode::Junction;
+    node.Source = static_cast<Index>(j);
+    node.Position[0] = junctions[j].Position[0];
+    node.Position[1] = junctions[j].Position[1];
+    node.FieldValue = node.Value = junctions[j].Value;
+    junctionNode[j] = static_cast<Index>(nodes.size());
+    nodes.push_back(node);
+  }
+  std::map<std::pair<double, double>, Index> cornerNode;
+  const double corners[4][2] = { { domainBounds[0], domainBounds[2] }, { domainBounds[1], domainBounds[2] },
+    { domainBounds[1], domainBounds[3] }, { domainBounds[0], domainBounds[3] } };
+
+  // Cut every 1-cell at its nodes; identical pieces (merged 1-cells) are kept once.
+  std::vector<std::vector<std::pair<long, Index>>> cuts(complex.Separatrices.size());
+  for (size_t j = 0; j < junctions.size(); ++j)
+  {
+    for (Index a : junctions[j].Separatrices)
+    {
+      const long at = PointIndexOfCell(complex.Separatrices[a], junctions[j].Cell);
+      if (at > 0 && at + 1 < static_cast<long>(complex.Separatrices[a].Values.size()))
+      {
+        cuts[a].push_back({ at, junctionNode[j] });
+      }
+    }
+  }
+  std::map<std::vector<double>, Index> pieceOfGeometry;
+  result.PiecesOfSeparatrix.resize(complex.Separatrices.size());
+  for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
+  {
+    const Separatrix& arc = complex.Separatrices[a];
+    const long n = static_cast<long>(arc.Values.size());
+    auto& at = cuts[a];
+    for (long p = 1; p + 1 < n; ++p)
+    {
+      for (int c = 0; c < 4; ++c)
+      {
+        if (arc.Points[2 * p] == corners[c][0] && arc.Points[2 * p + 1] == corners[c][1])
+        {
+          auto found = cornerNode.find({ corners[c][0], corners[c][1] });
+          if (found == cornerNode.end())
+          {
+            SmoothingNode node;
+            node.Type = SmoothingNode::DomainCorner;
+            node.Position[0] = corners[c][0];
+            node.Position[1] = corners[c][1];
+            node.FieldValue = node.Value = arc.Values[p];
+            found = cornerNode.insert({ { corners[c][0], corners[c][1] }, static_cast<Index>(nodes.size()) }).first;
+            nodes.push_back(node);
+          }
+          at.push_back({ p, found->second });
+        }
+      }
+    }
+    at.push_back({ 0, arc.Source });
+    at.push_back({ n - 1, arc.Destination });
+    std::sort(at.begin(), at.end());
+    at.erase(std::unique(at.begin(), at.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
+      at.end());
+    for (size_t k = 0; k + 1 < at.size(); ++k)
+    {
+      const long from = at[k].first, to = at[k + 1].first;
+      std::vector<double> key(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
+      key.push_back(arc.Type);
+      auto found = pieceOfGeometry.find(key);
+      if (found == pieceOfGeometry.end())
+      {
+        SmoothedPiece piece;
+        piece.Type = arc.Type;
+        piece.StartNode = at[k].second;
+        piece.EndNode = at[k + 1].second;
+        piece.Points.assign(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
+        piece.Values.assign(arc.Values.begin() + from, arc.Values.begin() + to + 1);
+        if (arc.Type == Separatrix::Ascending && to == n - 1 && piece.Values.size() > 2)
+        {
+          // Every ascending 1-cell into a maximum ends "centroid of the maximum's triangle,
+          // maximum's vertex": a segment they would all share. Go straight to the vertex.
+          piece.Points.erase(piece.Points.end() - 4, piece.Points.end() - 2);
+          piece.Values.erase(piece.Values.end() - 2);
+        }
+        found = pieceOfGeometry.insert({ key, static_cast<Index>(result.Pieces.size()) }).first;
+        result.Pieces.push_back(std::move(piece));
+      }
+      result.Pieces[found->second].Separatrices.push_back(a);
+      result.PiecesOfSeparatrix[a].push_back(found->second);
+    }
+  }
+  // Node positions: the ends of the pieces that meet there.
+  for (const SmoothedPiece& piece : result.Pieces)
+  {
+    for (int end = 0; end < 2; ++end)
+    {
+      SmoothingNode& node = nodes[end == 0 ? piece.StartNode : piece.EndNode];
+      const size_t p = end == 0 ? 0 : piece.Values.size() - 1;
+      node.Position[0] = piece.Points[2 * p];
+      node.Position[1] = piece.Points[2 * p + 1];
+    }
+  }
+  this->Hooks.Report(0.1);
+
+  // Junction (and corner) values: one global program, strictly increasing along every piece.
+  {
+    std::vector<JunctionValueNode> programNodes(nodes.size());
+    for (size_t i = 0; i < nodes.size(); ++i)
+    {
+      programNodes[i].Value = nodes[i].Type == SmoothingNode::Critical ? nodes[i].Value : nodes[i].FieldValue;
+      programNodes[i].Fixed = nodes[i].Type == SmoothingNode::Critical;
+    }
+    std::vector<std::array<Index, 2>> lowerThan;
+    for (const SmoothedPiece& piece : result.Pieces)
+    {
+      lowerThan.push_back({ piece.StartNode, piece.EndNode });
+    }
+    std::sort(lowerThan.begin(), lowerThan.end());
+    lowerThan.erase(std::unique(lowerThan.begin(), lowerThan.end()), lowerThan.end());
+    JunctionValueProgram program;
+    std::vector<double> values;
+    if (!program.Solve(programNodes, lowerThan, values, error))
+    {
+      error = "junction values: " + error;
+      return false;
+    }
+    for (size_t i = 0; i < nodes.size(); ++i)
+    {
+      nodes[i].Value = values[i];
+    }
+    result.JunctionMargin = program.Margin;
+    result.JunctionTotalChange = program.TotalChange;
+  }
+  this->Hooks.Report(0.2);
+
+  // Fit every piece.
+  for (size_t p = 0; p < result.Pieces.size(); ++p)
+  {
+    SmoothedPiece& piece = result.Pieces[p];
+    piece.Parameters = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
+    if (!this->FitPiece(piece, nodes, this->Segments, error))
+    {
+      error = "1-cell piece " + std::to_string(p) + ": " + error;
+      return false;
+    }
+    if (p % 64 == 0)
+    {
+      this->Hooks.Report(0.2 + 0.5 * static_cast<double>(p) / result.Pieces.size());
+      if (this->Hooks.Aborted())
+      {
+        error = "aborted";
+        return false;
+      }
+    }
+  }
+
+  // Crossings: sample every curve, bucket the segments in a grid, test pairs of segments of
+  // different pieces (and non-adjacent segments of one piece). Pieces meeting at a node may
+  // touch there. Where pieces cross, raise their k and fit again.
+  auto findCrossings = [&](std::set<Index>& crossing) {
+    std::vector<Segment2> segments;
+    for (Index p = 0; p < static_cast<Index>(result.Pieces.size()); ++p)
+    {
+      const SmoothedPiece& piece = result.Pieces[p];
+      const int count = piece.Segments * this->SamplesPerSegment;
+      double previous[2];
+      piece.Curve.Evaluate(0.0, previous);
+      for (int s = 1; s <= count; ++s)
+      {
+        Segment2 seg;
+        seg.A[0] = previous[0];
+        seg.A[1] = previous[1];
+        piece.Curve.Evaluate(static_cast<double>(s) / count, seg.B);
+        seg.Piece = p;
+        seg.Index_ = s - 1;
+        seg.Count = count;
+        previous[0] = seg.B[0];
+        previous[1] = seg.B[1];
+        segments.push_back(seg);
+      }
+    }
+    const double width = std::max(domainBounds[1] - domainBounds[0], 1e-12);
+    const double height = std::max(domainBounds[3] - domainBounds[2], 1e-12);
+    const double cell = std::max(std::sqrt(width * height / std::max<size_t>(segments.size(), 1)), 1e-12);
+    const long nx = static_cast<long>(width / cell) + 1, ny = static_cast<long>(height / cell) + 1;
+    std::unordered_map<long, std::vector<Index>> grid;
+    auto bucket = [&](double x, double y) {
+      const long i = std::clamp(static_cast<long>((x - domainBounds[0]) / cell), 0L, nx - 1);
+      const long j = std::clamp(static_cast<long>((y - domainBounds[2]) / cell), 0L, ny - 1);
+      return std::make_pair(i, j);
+    };
+    for (Index s = 0; s < static_cast<Index>(segments.size()); ++s)
+    {
+      const auto a = bucket(std::min(segments[s].A[0], segments[s].B[0]), std::min(segments[s].A[1], segments[s].B[1]));
+      const auto b = bucket(std::max(segments[s].A[0], segments[s].B[0]), std::max(segments[s].A[1], segments[s].B[1]));
+      for (long i = a.first; i <= b.first; ++i)
+      {
+        for (long j = a.second; j <= b.second; ++j)
+        {
+          grid[i * ny + j].push_back(s);
+        }
+      }
+    }
+    int pairs = 0;
+    std::set<std::pair<Index, Index>> reported;
+    for (const auto& entry : grid)
+    {
+      const auto& list = entry.second;
+      for (size_t x = 0; x < list.size(); ++x)
+      {
+        for (size_t y = x + 1; y < list.size(); ++y)
+        {
+          const Segment2& s = segments[list[x]];
+          const Segment2& t = segments[list[y]];
+          if (s.Piece == t.Piece && std::abs(s.Index_ - t.Index_) <= 1)
+          {
+            continue;
+          }
+          if (!SegmentsIntersect(s, t))
+          {
+            continue;
+          }
+          const auto key = std::make_pair(std::min(s.Piece, t.Piece), std::max(s.Piece, t.Piece));
+          if (reported.insert(key).second)
+          {
+            if (getenv("TS_DEBUG"))
+            {
+              const auto& P = result.Pieces[s.Piece];
+              const auto& Q = result.Pieces[t.Piece];
+              fprintf(stderr, "cross %d(type %d nodes %d-%d k%d seg %d/%d) x %d(type %d nodes %d-%d k%d seg %d/%d) at %.2f,%.2f\n",
+                s.Piece, P.Type, P.StartNode, P.EndNode, P.Segments, s.Index_, s.Count, t.Piece, Q.Type, Q.StartNode, Q.EndNode,
+                Q.Segments, t.Index_, t.Count, s.A[0], s.A[1]);
+            }
+            ++pairs;
+            crossing.insert(s.Piece);
+            crossing.insert(t.Piece);
+          }
+        }
+      }
+    }
+    return pairs;
+  };
+
+  std::set<Index> crossing;
+  int pairs = findCrossings(crossing);
+  std::set<Index> adapted;
+  while (pairs > 0)
+  {
+    bool raised = false;
+    for (Index p : crossing)
+    {
+      SmoothedPiece& piece = result.Pieces[p];
+      // Up to MaximumSegments, or to the piece's number of samples for long pieces: with about
+      // one segment per sample the least-squares curve follows the jagged 1-cell, which does
+      // not cross the others.
+      const int cap = std::max(this->MaximumSegments, static_cast<int>(piece.Values.size()) - 1);
+      const int next = std::min(cap, piece.Segments + std::max(2, piece.Segments / 2));
+      if (next > piece.Segments && next <= MonotoneBSplineFit::MaximumSegments)
+      {
+        if (!this->FitPiece(piece, nodes, next, error))
+        {
+          error = "1-cell piece " + std::to_string(p) + ": " + error;
+          return false;
+        }
+        adapted.insert(p);
+        raised = true;
+      }
+    }
+    if (!raised)
+    {
+      break;
+    }
+    crossing.clear();
+    pairs = findCrossings(crossing);
+  }
+  result.AdaptedPieces = static_cast<int>(adapted.size());
+  result.RemainingCrossings = pairs;
+  for (const SmoothedPiece& piece : result.Pieces)
+  {
+    bool outside = false;
+    const int count = piece.Segments * this->SamplesPerSegment;
+    for (int s = 0; s <= count && !outside; ++s)
+    {
+      double xy[2];
+      piece.Curve.Evaluate(static_cast<double>(s) / count, xy);
+      const double tolerance = 1e-9 * std::max(domainBounds[1] - domainBounds[0], domainBounds[3] - domainBounds[2]);
+      outside = xy[0] < domainBounds[0] - tolerance || xy[0] > domainBounds[1] + tolerance ||
+        xy[1] < domainBounds[2] - tolerance || xy[1] > domainBounds[3] + tolerance;
+    }
+    result.PiecesOutsideDomain += outside;
+  }
+  this->Hooks.Report(1.0);
+  return true;
+}
+} // namespace topospline

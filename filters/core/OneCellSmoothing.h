@@ -1,0 +1,83 @@
+// Stage 3 of the paper (section 4): smooth, strictly monotone 1-cells. Cuts the 1-cells of a
+// (simplified) complex into pieces at their junction points, gives the junction points new
+// values with one global linear program (JunctionValueProgram), fits on every piece a
+// strictly increasing height and a planar curve (MonotoneBSplineFit), both k cubic Beziers,
+// and checks that the smoothed curves do not cross (adapting k where they do).
+#pragma once
+
+#include "CoreTypes.h"
+#include "MonotoneBSplineFit.h"
+#include "MorseSmaleComplexSimplification.h" // JunctionPoint
+
+#include <string>
+#include <vector>
+
+namespace topospline
+{
+// A critical point, a junction point or a corner of the domain: where pieces start and end.
+struct SmoothingNode
+{
+  enum Kind : int
+  {
+    Critical = 0,
+    Junction = 1,
+    DomainCorner = 2
+  };
+  Kind Type = Critical;
+  Index Source = InvalidIndex; // critical point (position in the complex) or junction index
+  double Position[2] = { 0, 0 };
+  double FieldValue = 0; // f at the node (critical value, or the junction's sampled value)
+  double Value = 0;      // the smoothed value: f for critical points, else the program's
+};
+
+// One piece of 1-cell between two consecutive nodes; merged 1-cells share their pieces.
+struct SmoothedPiece
+{
+  Separatrix::Kind Type = Separatrix::Descending;
+  Index StartNode = InvalidIndex; // the lower end
+  Index EndNode = InvalidIndex;   // the higher end
+  std::vector<Index> Separatrices; // 1-cells that run through it
+  std::vector<double> Points;      // the jagged samples (x, y), start to end
+  std::vector<double> Values;      // the field along them
+  std::vector<double> Parameters;  // normalized arc length
+  int Segments = 0;                // k used (more than asked where crossings forced it)
+  CubicBezierSpline Curve;         // Dimension 2
+  CubicBezierSpline Height;        // Dimension 1, strictly increasing
+  double L1Error = 0;              // monotone fit, over the interior samples
+  double UnconstrainedL1Error = 0; // the same fit without monotonicity, for comparison
+};
+
+struct OneCellSmoothingResult
+{
+  std::vector<SmoothingNode> Nodes;
+  std::vector<SmoothedPiece> Pieces;
+  std::vector<std::vector<Index>> PiecesOfSeparatrix; // per 1-cell, its pieces in order
+  int AdaptedPieces = 0;       // pieces whose k was raised to remove crossings
+  int RemainingCrossings = 0;  // pairs of pieces that still cross (0 is the goal)
+  int PiecesOutsideDomain = 0; // pieces whose curve leaves the domain's bounding box
+  double JunctionMargin = 0;
+  double JunctionTotalChange = 0;
+};
+
+class OneCellSmoothing
+{
+public:
+  // k: cubic segments per piece (the paper's "Curve Segments": 4 or 7).
+  int Segments = 4;
+  // Crossings are removed by raising k on the pieces involved, up to this many segments (or
+  // up to the piece's number of samples, if larger).
+  int MaximumSegments = 32;
+  // Points per Bezier segment used to check crossings.
+  int SamplesPerSegment = 8;
+
+  // domainBounds: xmin, xmax, ymin, ymax of the domain (its corners become nodes when 1-cells
+  // run through them, so that the boundary keeps its corners). Returns false with a message.
+  bool Smooth(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
+    const double domainBounds[4], OneCellSmoothingResult& result, std::string& error) const;
+
+  ProgressHooks Hooks;
+
+private:
+  bool FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments, std::string& error) const;
+};
+} // namespace topospline

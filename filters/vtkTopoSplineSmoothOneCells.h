@@ -1,0 +1,57 @@
+/**
+ * @class vtkTopoSplineSmoothOneCells
+ * @brief Stage 3 of TopoSpline: smooth, strictly monotone 1-cells (the paper's section 4).
+ *
+ * Input: a complex from "Morse-Smale Complex" or "Simplify Morse-Smale Complex". The 1-cells
+ * are cut into pieces at their junction points (where 1-cells sharing an extremum merge); the
+ * junction values come from one global linear program (minimum L1 change, strictly
+ * increasing along every 1-cell); every piece gets a strictly increasing uniform quadratic
+ * B-spline height (L1 fit, He & Shi) and a least-squares quadratic B-spline curve in the
+ * plane with the same CurveSegments knots, both converted to CurveSegments cubic Beziers.
+ * Where smoothed curves would cross, the pieces involved get more segments.
+ *
+ * Output: the input blocks, plus "SmoothedOneCells" (one VTK_BEZIER_CURVE cell of degree 3
+ * per Bezier segment, control points in the plane of the input, point data "Height": the
+ * height's Bezier ordinates) and "SampledOneCells" (every 1-cell densely sampled as a
+ * polyline with "Height"). Field data: CurveSegments, AdaptedPieces, RemainingCrossings,
+ * PiecesOutsideDomain, L1Error and UnconstrainedL1Error (sums over the pieces).
+ */
+#pragma once
+
+#include "TopoSplineFiltersModule.h"
+
+#include <vtkMultiBlockDataSetAlgorithm.h>
+
+class TOPOSPLINEFILTERS_EXPORT vtkTopoSplineSmoothOneCells : public vtkMultiBlockDataSetAlgorithm
+{
+public:
+  static vtkTopoSplineSmoothOneCells* New();
+  vtkTypeMacro(vtkTopoSplineSmoothOneCells, vtkMultiBlockDataSetAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  //@{
+  /** k, cubic Bezier segments per piece of 1-cell (the paper uses 4 and 7). In [2, 1000]. */
+  vtkSetMacro(CurveSegments, int);
+  vtkGetMacro(CurveSegments, int);
+  //@}
+
+  //@{
+  /** Points per Bezier segment of the "SampledOneCells" polylines. */
+  vtkSetClampMacro(SamplesPerSegment, int, 1, 1000);
+  vtkGetMacro(SamplesPerSegment, int);
+  //@}
+
+protected:
+  vtkTopoSplineSmoothOneCells() = default;
+  ~vtkTopoSplineSmoothOneCells() override = default;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  int CurveSegments = 4;
+  int SamplesPerSegment = 16;
+
+private:
+  vtkTopoSplineSmoothOneCells(const vtkTopoSplineSmoothOneCells&) = delete;
+  void operator=(const vtkTopoSplineSmoothOneCells&) = delete;
+};
