@@ -265,8 +265,16 @@ int vtkTopoSplineSmoothOneCells::RequestData(
           height->InsertNextValue(smoothed.Height.Value(t));
         }
       }
-      lines->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
       const auto& arc = complex.Separatrices[a];
+      if (ids.empty())
+      {
+        // A 1-cell of one point (a saddle on its minimum's vertex, zero persistence).
+        double xyz[3];
+        vtkTopoSplineDomainConversion::PlanarToDomainPoint(domain, arc.Points.data(), xyz);
+        ids.push_back(points->InsertNextPoint(xyz));
+        height->InsertNextValue(arc.Values.front());
+      }
+      lines->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
       id->InsertNextValue(a);
       source->InsertNextValue(complex.CriticalPoints[arc.Source].Id);
       destination->InsertNextValue(complex.CriticalPoints[arc.Destination].Id);

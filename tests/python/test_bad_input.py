@@ -60,6 +60,12 @@ CASES = {
                             "must be a percentage in [0, 100]"),
     "simplify input is not a complex": ("s = SimplifyMorseSmaleComplex(Input=GroupDatasets(Input=[TrigonometricField()]))\n"
                                         "ms = s", "not a Morse-Smale complex"),
+    "curve segments below 2": ("ms = Smooth1Cells(Input=MorseSmaleComplex(Input=TrigonometricField()), CurveSegments=1)",
+                               "Curve Segments must be in [2, 1000]"),
+    "curve segments absurd": ("ms = Smooth1Cells(Input=MorseSmaleComplex(Input=TrigonometricField()), CurveSegments=100000)",
+                              "Curve Segments must be in [2, 1000]"),
+    "smoothing input is not a complex": ("ms = Smooth1Cells(Input=GroupDatasets(Input=[TrigonometricField()]))",
+                                         "not a Morse-Smale complex"),
 }
 # Not an error: a stale or mistyped array name falls back to the active scalars, with a warning.
 FALLBACKS = {

@@ -1,0 +1,103 @@
+"""Stage 3 through ParaView: strictly increasing heights checked on their Bezier ordinates,
+exact end values and zero end slopes, one value per junction point shared by all 1-cells
+through it, L1 errors, crossings, on the synthetic fields and the small terrains at 2, 5 and
+25 % with k = 4 and 7."""
+import numpy as np
+from paraview.simple import *
+from paraview import servermanager as sm
+from vtkmodules.util.numpy_support import vtk_to_numpy
+
+import topospline_testing as tt
+
+LoadPlugin(tt.plugin_path(), remote=False, ns=globals())
+checks = tt.Checks()
+
+inputs = [("shepard", ShepardField()), ("trig", TrigonometricField())]
+for filename in ("r_volcano_maunga_whau.vti", "rainier_ned1_1970_crop458x306.vti", "sainthelens_usgs_dem_crop.vti",
+                 "msh_crater_2007_10m.vti", "ttk_happi_tas_anomaly.vti"):
+    path = tt.find_dataset(filename)
+    if path:
+        inputs.append((filename, XMLImageDataReader(FileName=[path])))
+    else:
+        checks.skip("%s absent" % filename)
+# Known: on the climate field at 2 and 5 % a few smoothed pieces still cross after adaptation
+# (reported in the output and in docs/OneCellSmoothing.md); elsewhere none may cross.
+KNOWN_CROSSINGS = {("ttk_happi_tas_anomaly.vti", 2), ("ttk_happi_tas_anomaly.vti", 5)}
+
+
+def check_smoothing(c, data, name, k):
+    fd = data.GetFieldData()
+    value_of = dict(zip(c["cp_CriticalPointId"].tolist(), c["cp_CriticalValue"].tolist()))
+    value_range = max(value_of.values()) - min(value_of.values())
+    bezier = data.GetBlock(5)
+    checks.equal(bezier.GetCellType(0) if bezier.GetNumberOfCells() else 75, 75, "%s: cells are VTK_BEZIER_CURVE" % name)
+    # Bezier ordinates of the heights, back in curve order (VTK stores the ends first).
+    h = vtk_to_numpy(bezier.GetPointData().GetArray("Height")).reshape(-1, 4)[:, [0, 2, 3, 1]]
+    piece = vtk_to_numpy(bezier.GetCellData().GetArray("PieceId"))
+    first = np.r_[True, piece[1:] != piece[:-1]]
+    last = np.r_[piece[1:] != piece[:-1], True]
+    steps = np.diff(h, axis=1)
+    # Strictly increasing: every ordinate step positive, except the zero end slopes.
+    inner_ok = (steps[:, 1] > 0) & ((steps[:, 0] > 0) | first) & ((steps[:, 2] > 0) | last)
+    checks.check(bool(np.all(inner_ok)), "%s: heights strictly increasing on their Bezier ordinates" % name)
+    checks.check(bool(np.all(steps[first, 0] == 0) and np.all(steps[last, 2] == 0)),
+                 "%s: zero derivative at both ends of every piece (exactly)" % name)
+    checks.check(bool(np.all(h[:-1, 3][~last[:-1]] == h[1:, 0][~last[:-1]])), "%s: C0 between segments" % name)
+    # Along every sampled 1-cell: strictly increasing, from the source's to the destination's
+    # critical value (ties of critical values are separated by at most 1e-9 of the range).
+    sampled = data.GetBlock(6)
+    heights = vtk_to_numpy(sampled.GetPointData().GetArray("Height"))
+    points = vtk_to_numpy(sampled.GetPoints().GetData())
+    lines = sampled.GetLines()
+    offsets = vtk_to_numpy(lines.GetOffsetsArray())
+    conn = vtk_to_numpy(lines.GetConnectivityArray())
+    src = vtk_to_numpy(sampled.GetCellData().GetArray("SourceId"))
+    dst = vtk_to_numpy(sampled.GetCellData().GetArray("DestinationId"))
+    bad_monotone = bad_ends = 0
+    at_point = {}
+    shared_bad = 0
+    for i in range(len(offsets) - 1):
+        ids = conn[offsets[i]:offsets[i + 1]]
+        hv = heights[ids]
+        if len(ids) < 2:  # a 1-cell of one point: a saddle on its minimum's vertex
+            continue
+        # Strictness is proven on the ordinates above; dense samples next to a zero end slope
+        # differ by less than a double's resolution (and evaluation rounds): never decreasing,
+        # up to rounding.
+        bad_monotone += not bool(np.all(np.diff(hv) >= -1e-12 * np.abs(hv[1:])))
+        tolerance = 1e-9 * value_range + 1e-12 * abs(hv[0])
+        bad_ends += abs(hv[0] - value_of[int(src[i])]) > tolerance or abs(hv[-1] - value_of[int(dst[i])]) > tolerance
+        for p, value in zip(map(tuple, np.round(points[ids], 9)), hv):
+            if p in at_point and at_point[p][1] != i and abs(at_point[p][0] - value) > 1e-9 * value_range:
+                shared_bad += 1
+            at_point.setdefault(p, (value, i))
+    checks.equal(bad_monotone, 0, "%s: sampled heights never decrease along any 1-cell" % name)
+    checks.equal(bad_ends, 0, "%s: 1-cells start and end at the critical values" % name)
+    checks.equal(shared_bad, 0, "%s: 1-cells through one point (junctions) agree on its value" % name)
+    l1, free = fd.GetArray("L1Error").GetValue(0), fd.GetArray("UnconstrainedL1Error").GetValue(0)
+    checks.check(l1 >= free * (1 - 1e-9), "%s: monotone L1 error >= unconstrained (%g vs %g)" % (name, l1, free))
+    checks.equal(fd.GetArray("PiecesOutsideDomain").GetValue(0), 0, "%s: curves stay in the domain" % name)
+    return fd.GetArray("RemainingCrossings").GetValue(0), fd.GetArray("AdaptedPieces").GetValue(0), l1, free
+
+
+for name, source in inputs:
+    source.UpdatePipeline()
+    ms = MorseSmaleComplex(Input=source)
+    for percent in (2, 5, 25):
+        simplified = SimplifyMorseSmaleComplex(Input=ms, PersistenceThreshold=percent)
+        for k in (4, 7):
+            smooth = Smooth1Cells(Input=simplified, CurveSegments=k)
+            smooth.UpdatePipeline()
+            data = sm.Fetch(smooth)
+            label = "%s %d%% k=%d" % (name, percent, k)
+            if not checks.check(data is not None and data.GetNumberOfBlocks() == 7, "%s: 7 output blocks" % label):
+                continue
+            c = tt.fetch_complex(smooth)
+            crossings, adapted, l1, free = check_smoothing(c, data, label, k)
+            if (name, percent) in KNOWN_CROSSINGS:
+                print("%s: %d crossing pair(s) left (known)" % (label, crossings), flush=True)
+            else:
+                checks.equal(crossings, 0, "%s: smoothed 1-cells do not cross" % label)
+            print("%s: adapted %d pieces, L1 %.6g (unconstrained %.6g)" % (label, adapted, l1, free), flush=True)
+            Delete(smooth)
+checks.finish()
