@@ -123,7 +123,7 @@ public:
 
   // How the L1 program is solved (both with GLPK through CGAL's solver interface). The
   // primal has one row per interior sample and GLPK's primal simplex needs about as many
-  // pivots, so it grows like n^2 (about 2 ms for n = 200). The dual has one row per free
+  // pivots, so it grows like n^2 (about 4 ms for n = 200, k = 7). The dual has one row per free
   // coefficient (k - 2); the coefficients are recovered from its solution by complementary
   // slackness and accepted only with an optimality certificate (feasible, zero duality
   // gap), else the primal is solved instead (degenerate data such as constant samples).
