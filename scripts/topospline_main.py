@@ -92,8 +92,23 @@ summary["simplified_complex"]["persistence_threshold_percent"] = args.threshold
 summary["simplified_complex"]["maximum_persistence"] = simplified_data.GetFieldData().GetArray(
     "MaximumPersistence").GetValue(0)
 
+# --- Stage 3: smooth, strictly monotone 1-cells ---
+if not 2 <= args.k <= 1000:
+    sys.exit("--k must be in [2, 1000]")
+smoothed = Smooth1Cells(Input=simplified, CurveSegments=args.k)
+timed("3 1-cell smoothing (time I)", smoothed)
+summary["stages_available"].append("Smooth 1-Cells")
+smoothed_data = sm.Fetch(smoothed)
+if smoothed_data is None or smoothed_data.GetNumberOfBlocks() < 7:
+    sys.exit("the 1-cell smoothing failed (see the error above)")
+sfd = smoothed_data.GetFieldData()
+summary["smoothed_1_cells"] = {name: sfd.GetArray(name).GetValue(0) for name in (
+    "CurveSegments", "NumberOfPieces", "AdaptedPieces", "RemainingCrossings", "PiecesOutsideDomain", "L1Error",
+    "UnconstrainedL1Error")}
+summary["smoothed_1_cells"]["bezier_segments"] = smoothed_data.GetBlock(5).GetNumberOfCells()
+
 # Later stages, when this build has them.
-later = [("Smooth 1-Cells", "Smooth1Cells"), ("Reconstruct 2-Cells", "Reconstruct2Cells")]
+later = [("Reconstruct 2-Cells", "Reconstruct2Cells")]
 missing = [label for label, fn in later if fn not in globals()]
 if missing:
     summary["stages_missing"] = missing
@@ -103,7 +118,7 @@ if missing:
 files = {}
 writers = [("input", source, ".vti" if not args.input or args.input.endswith(".vti") else
             os.path.splitext(args.input)[1]), ("complex", complex_, ".vtm"),
-           ("simplified_complex", simplified, ".vtm")]
+           ("simplified_complex", simplified, ".vtm"), ("smoothed_1_cells", smoothed, ".vtm")]
 for name, proxy, ext in writers:
     path = os.path.join(args.output, name + ext)
     SaveData(path, proxy=proxy, DataMode="Binary", CompressorType="ZLib")
@@ -142,14 +157,14 @@ def show_field(proxy):
     return display
 
 
-def show_complex(ms_proxy):
-    arcs = ExtractBlock(Input=ms_proxy, Selectors=["/Root/OneCells"])
+def show_complex(ms_proxy, smooth=False):
+    arcs = ExtractBlock(Input=ms_proxy, Selectors=["/Root/SampledOneCells" if smooth else "/Root/OneCells"])
     for kind, color in ((0, [0.0, 0.6, 0.0]), (1, [0.85, 0.0, 0.0])):
         sel = Threshold(Input=arcs, Scalars=["CELLS", "SeparatrixType"], LowerThreshold=kind, UpperThreshold=kind)
         d = Show(sel, view)
         solid(d, color)
         d.LineWidth = 3.0
-    if ms_proxy is simplified:
+    if ms_proxy is not complex_:
         junctions = ExtractBlock(Input=ms_proxy, Selectors=["/Root/JunctionPoints"])
         d = Show(junctions, view)
         solid(d, [0.0, 0.0, 0.0])
@@ -186,6 +201,9 @@ save("2_morse_smale_complex.png")
 show_field(source)
 show_complex(simplified)
 save("3_simplified_complex_%g_percent.png" % args.threshold)
+show_field(source)
+show_complex(smoothed, smooth=True)
+save("4_smoothed_1_cells_k%d.png" % args.k)
 summary["pictures"] = pictures
 
 with open(os.path.join(args.output, "summary.json"), "w") as f:
