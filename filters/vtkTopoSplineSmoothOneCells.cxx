@@ -309,6 +309,7 @@ int vtkTopoSplineSmoothOneCells::RequestData(
   addNumber("AdaptedPieces", result.AdaptedPieces);
   addNumber("RemainingCrossings", result.RemainingCrossings);
   addNumber("PiecesOutsideDomain", result.PiecesOutsideDomain);
+  addNumber("ClampedPieces", result.ClampedPieces);
   addNumber("L1Error", l1);
   addNumber("UnconstrainedL1Error", free);
   addNumber("JunctionMargin", result.JunctionMargin);

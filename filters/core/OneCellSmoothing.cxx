@@ -1,5 +1,3 @@
-#include <cstdio>
-#include <cstdlib>
 #include "OneCellSmoothing.h"
 
 #include "JunctionValueProgram.h"
@@ -48,8 +46,8 @@ bool SegmentsIntersect(const Segment2& s, const Segment2& t)
 }
 } // namespace
 
-bool OneCellSmoothing::FitPiece(
-  SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments, std::string& error) const
+bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments,
+  const double bounds[4], std::string& error) const
 {
   MonotoneBSplineFit fitter;
   fitter.Segments = segments;
@@ -68,6 +66,18 @@ bool OneCellSmoothing::FitPiece(
   piece.Segments = segments;
   piece.Height = height.Spline.ToCubicBezier();
   piece.Curve = curve.Spline.ToCubicBezier();
+  // A least-squares curve fitted to a 1-cell that runs along the boundary and then turns
+  // inwards can overshoot the boundary slightly. A Bezier curve lies in the convex hull of its
+  // control points: clamping them into the domain's box keeps it inside (the ends, data
+  // points, never move).
+  piece.Clamped = false;
+  for (double& coordinate : piece.Curve.ControlPoints)
+  {
+    const size_t axis = (&coordinate - piece.Curve.ControlPoints.data()) % 2;
+    const double clamped = std::clamp(coordinate, bounds[2 * axis], bounds[2 * axis + 1]);
+    piece.Clamped = piece.Clamped || clamped != coordinate;
+    coordinate = clamped;
+  }
   piece.L1Error = height.L1Error;
   piece.UnconstrainedL1Error = free.L1Error;
   return true;
@@ -193,10 +203,18 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
         }
       }
     }
+    // A merged 1-cell may pass its own end's vertex before it ends there (the trivial
+    // embedding): no cut at its own ends' nodes, nor twice in a row at one node, which would
+    // make a piece from a node to itself.
+    at.erase(std::remove_if(at.begin(), at.end(),
+               [&](const auto& cut) { return cut.second == arc.Source || cut.second == arc.Destination; }),
+      at.end());
     at.push_back({ 0, arc.Source });
     at.push_back({ n - 1, arc.Destination });
     std::sort(at.begin(), at.end());
     at.erase(std::unique(at.begin(), at.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
+      at.end());
+    at.erase(std::unique(at.begin(), at.end(), [](const auto& x, const auto& y) { return x.second == y.second; }),
       at.end());
     for (size_t k = 0; k + 1 < at.size(); ++k)
     {
@@ -275,7 +293,7 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
   {
     SmoothedPiece& piece = result.Pieces[p];
     piece.Parameters = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
-    if (!this->FitPiece(piece, nodes, this->Segments, error))
+    if (!this->FitPiece(piece, nodes, this->Segments, domainBounds, error))
     {
       error = "1-cell piece " + std::to_string(p) + ": " + error;
       return false;
@@ -294,6 +312,39 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
   // Crossings: sample every curve, bucket the segments in a grid, test pairs of segments of
   // different pieces (and non-adjacent segments of one piece). Pieces meeting at a node may
   // touch there. Where pieces cross, raise their k and fit again.
+  // Curves that end at one point (the same node, or two nodes on one vertex: a boundary
+  // saddle and a maximum share their vertex, and the 1-cell between them is a loop) may touch
+  // right next to it: within two samples of such a shared end, a contact is their meeting.
+  auto endPosition = [&](Index p, bool atEnd) {
+    return nodes[atEnd ? result.Pieces[p].EndNode : result.Pieces[p].StartNode].Position;
+  };
+  auto MeetAtSharedEnd = [&](const Segment2& s, const Segment2& t) {
+    for (int es = 0; es < 2; ++es)
+    {
+      const bool nearS = es == 0 ? s.Index_ < 2 : s.Index_ >= s.Count - 2;
+      for (int et = 0; et < 2 && nearS; ++et)
+      {
+        const bool nearT = et == 0 ? t.Index_ < 2 : t.Index_ >= t.Count - 2;
+        const double* a = endPosition(s.Piece, es == 1);
+        const double* b = endPosition(t.Piece, et == 1);
+        if (nearT && a[0] == b[0] && a[1] == b[1])
+        {
+          return true;
+        }
+      }
+    }
+    return false;
+  };
+  // Two pieces that close a loop (a boundary saddle and a maximum on one vertex, joined by
+  // the saddle's only ascending 1-cell, cut at a junction) start where the other ends: often
+  // the loop has no area and both are one segment, traversed both ways. They may touch.
+  auto closeALoop = [&](Index p, Index q) {
+    const double* ps = nodes[result.Pieces[p].StartNode].Position;
+    const double* pe = nodes[result.Pieces[p].EndNode].Position;
+    const double* qs = nodes[result.Pieces[q].StartNode].Position;
+    const double* qe = nodes[result.Pieces[q].EndNode].Position;
+    return ps[0] == qe[0] && ps[1] == qe[1] && pe[0] == qs[0] && pe[1] == qs[1];
+  };
   auto findCrossings = [&](std::set<Index>& crossing) {
     std::vector<Segment2> segments;
     for (Index p = 0; p < static_cast<Index>(result.Pieces.size()); ++p)
@@ -353,21 +404,13 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
           {
             continue;
           }
-          if (!SegmentsIntersect(s, t))
+          if (!SegmentsIntersect(s, t) || MeetAtSharedEnd(s, t) || closeALoop(s.Piece, t.Piece))
           {
             continue;
           }
           const auto key = std::make_pair(std::min(s.Piece, t.Piece), std::max(s.Piece, t.Piece));
           if (reported.insert(key).second)
           {
-            if (getenv("TS_DEBUG"))
-            {
-              const auto& P = result.Pieces[s.Piece];
-              const auto& Q = result.Pieces[t.Piece];
-              fprintf(stderr, "cross %d(type %d nodes %d-%d k%d seg %d/%d) x %d(type %d nodes %d-%d k%d seg %d/%d) at %.2f,%.2f\n",
-                s.Piece, P.Type, P.StartNode, P.EndNode, P.Segments, s.Index_, s.Count, t.Piece, Q.Type, Q.StartNode, Q.EndNode,
-                Q.Segments, t.Index_, t.Count, s.A[0], s.A[1]);
-            }
             ++pairs;
             crossing.insert(s.Piece);
             crossing.insert(t.Piece);
@@ -394,7 +437,7 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
       const int next = std::min(cap, piece.Segments + std::max(2, piece.Segments / 2));
       if (next > piece.Segments && next <= MonotoneBSplineFit::MaximumSegments)
       {
-        if (!this->FitPiece(piece, nodes, next, error))
+        if (!this->FitPiece(piece, nodes, next, domainBounds, error))
         {
           error = "1-cell piece " + std::to_string(p) + ": " + error;
           return false;
@@ -411,6 +454,10 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
     pairs = findCrossings(crossing);
   }
   result.AdaptedPieces = static_cast<int>(adapted.size());
+  for (const SmoothedPiece& piece : result.Pieces)
+  {
+    result.ClampedPieces += piece.Clamped;
+  }
   result.RemainingCrossings = pairs;
   for (const SmoothedPiece& piece : result.Pieces)
   {

@@ -45,6 +45,7 @@ struct SmoothedPiece
   CubicBezierSpline Height;        // Dimension 1, strictly increasing
   double L1Error = 0;              // monotone fit, over the interior samples
   double UnconstrainedL1Error = 0; // the same fit without monotonicity, for comparison
+  bool Clamped = false;            // control points were clamped into the domain's box
 };
 
 struct OneCellSmoothingResult
@@ -55,6 +56,7 @@ struct OneCellSmoothingResult
   int AdaptedPieces = 0;       // pieces whose k was raised to remove crossings
   int RemainingCrossings = 0;  // pairs of pieces that still cross (0 is the goal)
   int PiecesOutsideDomain = 0; // pieces whose curve leaves the domain's bounding box
+  int ClampedPieces = 0;       // pieces kept inside it by clamping control points
   double JunctionMargin = 0;
   double JunctionTotalChange = 0;
 };
@@ -78,6 +80,7 @@ public:
   ProgressHooks Hooks;
 
 private:
-  bool FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments, std::string& error) const;
+  bool FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments, const double bounds[4],
+    std::string& error) const;
 };
 } // namespace topospline
