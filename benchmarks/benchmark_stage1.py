@@ -11,11 +11,7 @@ import subprocess
 import sys
 import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-REPO = os.path.dirname(HERE)
-PLUGIN = os.environ.get("TOPOSPLINE_PLUGIN", os.path.join(REPO, "build", "lib", "paraview-plugins", "TopoSpline",
-                                                          "TopoSpline.so"))
-SHARED = os.environ.get("TOPOSPLINE_SHARED_DATA", os.path.join(REPO, "..", "shared", "data"))
+from benchmark_common import PLUGIN, data_file
 
 CHILD = r"""
 import json, resource, sys, time
@@ -43,8 +39,8 @@ print("RESULT", json.dumps({"times": times, "base_rss_mb": base / 1024, "peak_rs
 
 inputs = [("Shepard 1000 x 1000", "shepard", "1000")]
 for name in ("rainier_ned1_1970_full.vti", "argudo_glaciers_sthelens_10m.vti"):
-    path = os.path.join(SHARED, name)
-    if os.path.exists(path):
+    path = data_file(name)
+    if path:
         inputs.append((name, "file", path))
     else:
         print("skip %s: absent" % name)

@@ -8,16 +8,10 @@ import time
 
 from paraview.simple import *
 from paraview import servermanager as sm
-from vtkmodules.vtkCommonCore import vtkSMPTools
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-REPO = os.path.dirname(HERE)
-PLUGIN = os.environ.get("TOPOSPLINE_PLUGIN", os.path.join(REPO, "build", "lib", "paraview-plugins", "TopoSpline",
-                                                          "TopoSpline.so"))
-SHARED = os.environ.get("TOPOSPLINE_SHARED_DATA", os.path.join(REPO, "..", "shared", "data"))
-LoadPlugin(PLUGIN, remote=False, ns=globals())
-vtkSMPTools.SetBackend("STDThread")
-vtkSMPTools.Initialize(2)
+import benchmark_common
+
+benchmark_common.start(globals())
 
 
 def count(proxy):
@@ -27,8 +21,8 @@ def count(proxy):
 
 inputs = [("Shepard 1000 x 1000", lambda: ShepardField(Resolution=1000))]
 for name in ("rainier_ned1_1970_crop458x306.vti", "rainier_ned1_1970_full.vti", "argudo_glaciers_sthelens_10m.vti"):
-    path = os.path.join(SHARED, name)
-    if os.path.exists(path):
+    path = benchmark_common.data_file(name)
+    if path:
         inputs.append((name, lambda p=path: XMLImageDataReader(FileName=[p])))
     else:
         print("skip %s: absent" % name)

@@ -8,23 +8,16 @@ import time
 
 from paraview.simple import *
 from paraview import servermanager as sm
-from vtkmodules.vtkCommonCore import vtkSMPTools
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-REPO = os.path.dirname(HERE)
-PLUGIN = os.environ.get("TOPOSPLINE_PLUGIN", os.path.join(REPO, "build", "lib", "paraview-plugins", "TopoSpline",
-                                                          "TopoSpline.so"))
-SHARED = os.environ.get("TOPOSPLINE_SHARED_DATA", os.path.join(REPO, "..", "shared", "data"))
-LoadPlugin(PLUGIN, remote=False, ns=globals())
-vtkSMPTools.SetBackend("STDThread")
-vtkSMPTools.Initialize(2)
+import benchmark_common
+
+benchmark_common.start(globals())
 
 cases = [("Shepard 250 x 250", lambda: ShepardField(), 25, 4, 0.13),
          ("Shepard 250 x 250", lambda: ShepardField(), 25, 7, 0.13)]
 for name, percent, k, paper in (("rainier_ned1_1970_crop458x306.vti", 2, 7, 0.31), ("rainier_ned1_1970_full.vti", 2, 7, None)):
-    path = os.path.join(REPO, "tests", "data", name)
-    path = path if os.path.exists(path) else os.path.join(SHARED, name)
-    if os.path.exists(path):
+    path = benchmark_common.data_file(name)
+    if path:
         cases.append((name, lambda p=path: XMLImageDataReader(FileName=[p]), percent, k, paper))
     else:
         print("skip %s: absent" % name)

@@ -1,10 +1,6 @@
 #include "JunctionValueProgram.h"
 
-#ifndef CGAL_USE_GLPK
-#error "JunctionValueProgram needs GLPK through CGAL's solver interface: define CGAL_USE_GLPK and link glpk"
-#endif
-#include <CGAL/GLPK_mixed_integer_program_traits.h>
-#include <glpk.h>
+#include "GlpkLinearProgram.h"
 
 #include <algorithm>
 #include <cmath>
@@ -15,9 +11,6 @@ namespace topospline
 {
 namespace
 {
-using LinearProgram = CGAL::GLPK_mixed_integer_program_traits<double>;
-using LinearVariable = CGAL::Variable<double>;
-using LinearConstraint = CGAL::Linear_constraint<double>;
 
 Index FindRoot(std::vector<Index>& parent, Index x)
 {

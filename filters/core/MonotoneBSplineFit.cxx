@@ -1,10 +1,6 @@
 #include "MonotoneBSplineFit.h"
 
-#ifndef CGAL_USE_GLPK
-#error "MonotoneBSplineFit needs GLPK through CGAL's solver interface: define CGAL_USE_GLPK and link glpk"
-#endif
-#include <CGAL/GLPK_mixed_integer_program_traits.h>
-#include <glpk.h>
+#include "GlpkLinearProgram.h"
 
 #include <Eigen/Dense>
 
@@ -15,9 +11,6 @@ namespace topospline
 {
 namespace
 {
-using LinearProgram = CGAL::GLPK_mixed_integer_program_traits<double>;
-using LinearVariable = CGAL::Variable<double>;
-using LinearConstraint = CGAL::Linear_constraint<double>;
 
 // Bernstein polynomials of degree 2 and 3 at s.
 void QuadraticBernstein(double s, double b[3])
