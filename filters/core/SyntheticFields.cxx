@@ -1,32 +1,17 @@
 #include "SyntheticFields.h"
 
+#include "DeterministicRandom.h"
+
 #include <cmath>
 
 namespace topospline
 {
-namespace
-{
-// SplitMix64: tiny, well-distributed and identical everywhere.
-struct SplitMix64
-{
-  std::uint64_t State;
-  std::uint64_t Next()
-  {
-    std::uint64_t z = (this->State += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  double Uniform() { return static_cast<double>(this->Next() >> 11) * 0x1.0p-53; }
-};
-} // namespace
-
 GridField ShepardField(int sites, double power, int resolution, std::uint64_t seed, const ParallelFor& parallelFor)
 {
   GridField grid;
   grid.Dimensions[0] = grid.Dimensions[1] = resolution;
   grid.Values.assign(static_cast<size_t>(resolution) * resolution, 0.0);
-  SplitMix64 random{ seed };
+  DeterministicRandom random(seed);
   const double extent = resolution - 1;
   std::vector<double> sx(sites), sy(sites), sv(sites);
   for (int k = 0; k < sites; ++k)

@@ -3,6 +3,7 @@
 // used is proven here numerically (interpolation, C1 continuity, the D_(1,1)F coefficient
 // table, sufficiency of (C0)-(C3), and that violations show up).
 #include "MonotoneSibsonPatch.h"
+#include "DeterministicRandom.h"
 #include "TestHarness.h"
 
 #include <algorithm>
@@ -16,24 +17,8 @@ using namespace topospline;
 
 namespace
 {
-// Deterministic generator (splitmix64), so every run tests the same cases.
-struct Random
-{
-  std::uint64_t State;
-  explicit Random(std::uint64_t seed)
-    : State(seed)
-  {
-  }
-  std::uint64_t Next()
-  {
-    std::uint64_t z = (this->State += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  double Uniform(double a = 0, double b = 1) { return a + (b - a) * ((this->Next() >> 11) * 0x1.0p-53); }
-  int Integer(int n) { return static_cast<int>(this->Next() % static_cast<std::uint64_t>(n)); }
-};
+// Deterministic cases: every run tests the same ones.
+using Random = DeterministicRandom;
 
 SibsonCellData RandomCell(Random& random)
 {

@@ -2,6 +2,7 @@
 // cell with the boundary samples as the only boundary vertices, mean value coordinates onto
 // the unit square, the one-to-one check with its dividing-edge fix, point location, and
 // graceful failure on degenerate input.
+#include "DeterministicRandom.h"
 #include "TestHarness.h"
 #include "TwoCellParameterization.h"
 
@@ -21,23 +22,8 @@ namespace
 {
 const double Pi = 3.14159265358979323846;
 
-// Deterministic generator (splitmix64), so every run tests the same cases.
-struct Random
-{
-  std::uint64_t State;
-  explicit Random(std::uint64_t seed)
-    : State(seed)
-  {
-  }
-  std::uint64_t Next()
-  {
-    std::uint64_t z = (this->State += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  double Uniform(double a = 0, double b = 1) { return a + (b - a) * ((this->Next() >> 11) * 0x1.0p-53); }
-};
+// Deterministic cases: every run tests the same ones.
+using Random = DeterministicRandom;
 
 struct Cell
 {
