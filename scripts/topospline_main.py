@@ -14,6 +14,10 @@ from paraview.simple import *
 from paraview import servermanager as sm
 from vtkmodules.vtkCommonCore import vtkSMPTools
 
+# The paper's figure style, shared with the states.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "states"))
+import topospline_state_style as style  # noqa: E402
+
 parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 parser.add_argument("--input", help="a 2D .vti/.vtu/.vtp file (default: the built-in Shepard field)")
 parser.add_argument("--array", help="point scalar array of the input (default: the active scalars)")
@@ -137,48 +141,19 @@ except AttributeError:
     pass
 
 
-def solid(display, color):
-    display.ColorArrayName = ["POINTS", ""]
-    display.AmbientColor = display.DiffuseColor = color
-
-
 def show_field(proxy):
-    display = Show(proxy, view)
-    ColorBy(display, ("POINTS", array))
-    lut = GetColorTransferFunction(array)
-    lut.ApplyPreset("Viridis (matplotlib)", True)
-    display.SetScalarBarVisibility(view, False)
-    rng = proxy.PointData[array].GetRange()
-    contours = Contour(Input=proxy, ContourBy=["POINTS", array],
-                       Isosurfaces=list(np.linspace(rng[0], rng[1], 22)[1:-1]))
-    cdisplay = Show(contours, view)
-    solid(cdisplay, [0.1, 0.1, 0.1])
-    cdisplay.LineWidth = 1.0
-    return display
+    style.field_with_isolines(proxy, array, view)
 
 
 def show_complex(ms_proxy, smooth=False):
-    arcs = ExtractBlock(Input=ms_proxy, Selectors=["/Root/SampledOneCells" if smooth else "/Root/OneCells"])
-    for kind, color in ((0, [0.0, 0.6, 0.0]), (1, [0.85, 0.0, 0.0])):
-        sel = Threshold(Input=arcs, Scalars=["CELLS", "SeparatrixType"], LowerThreshold=kind, UpperThreshold=kind)
-        d = Show(sel, view)
-        solid(d, color)
-        d.LineWidth = 3.0
+    style.complex_lines(ms_proxy, view, block="SampledOneCells" if smooth else "OneCells")
     if ms_proxy is not complex_:
         junctions = ExtractBlock(Input=ms_proxy, Selectors=["/Root/JunctionPoints"])
-        d = Show(junctions, view)
-        solid(d, [0.0, 0.0, 0.0])
-        d.SetRepresentationType("Points")
-        d.RenderPointsAsSpheres = 1
-        d.PointSize = 7
-    cps = ExtractBlock(Input=ms_proxy, Selectors=["/Root/CriticalPoints"])
-    for kind, color in ((0, [0.0, 0.2, 1.0]), (1, [0.0, 0.7, 0.0]), (2, [1.0, 0.0, 0.0])):
-        sel = Threshold(Input=cps, Scalars=["POINTS", "CriticalIndex"], LowerThreshold=kind, UpperThreshold=kind)
-        d = Show(sel, view)
-        solid(d, color)
-        d.SetRepresentationType("Points")
-        d.RenderPointsAsSpheres = 1
-        d.PointSize = 12
+        display = Show(junctions, view)
+        style.solid(display, [0.0, 0.0, 0.0])
+        display.SetRepresentationType("Points")
+        display.RenderPointsAsSpheres = 1
+        display.PointSize = 7
 
 
 def save(name):

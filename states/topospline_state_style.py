@@ -34,7 +34,7 @@ def complex_lines(complex_proxy, view, block="SampledOneCells", width=3.0):
         solid(display, color)
         display.SetRepresentationType("Points")
         display.RenderPointsAsSpheres = 1
-        display.PointSize = 10
+        display.PointSize = 12
 
 
 def view_from_above(view):

@@ -1,5 +1,6 @@
 #include "JunctionValueProgram.h"
 
+#include "DisjointSets.h"
 #include "GlpkLinearProgram.h"
 
 #include <algorithm>
@@ -11,17 +12,6 @@ namespace topospline
 {
 namespace
 {
-
-Index FindRoot(std::vector<Index>& parent, Index x)
-{
-  while (parent[x] != x)
-  {
-    parent[x] = parent[parent[x]];
-    x = parent[x];
-  }
-  return x;
-}
-
 std::string DescribeNode(const std::vector<JunctionValueNode>& nodes, Index n)
 {
   return std::string(nodes[n].Fixed ? "critical node " : "junction node ") + std::to_string(n) + " (value " +
@@ -225,7 +215,7 @@ bool JunctionValueProgram::Solve(const std::vector<JunctionValueNode>& nodes,
     }
     else if (!lowFixed && !highFixed)
     {
-      parent[FindRoot(parent, r[0])] = FindRoot(parent, r[1]);
+      parent[FindRepresentative(parent, r[0])] = FindRepresentative(parent, r[1]);
     }
   }
 
@@ -240,7 +230,7 @@ bool JunctionValueProgram::Solve(const std::vector<JunctionValueNode>& nodes,
       {
         continue;
       }
-      const Index root = this->SplitIntoComponents ? FindRoot(parent, n) : 0;
+      const Index root = this->SplitIntoComponents ? FindRepresentative(parent, n) : 0;
       if (componentOf[root] == InvalidIndex)
       {
         componentOf[root] = static_cast<Index>(components.size());

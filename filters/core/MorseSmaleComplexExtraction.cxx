@@ -1,5 +1,7 @@
 #include "MorseSmaleComplexExtraction.h"
 
+#include "DisjointSets.h"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -8,44 +10,6 @@ namespace topospline
 {
 namespace
 {
-struct UnionFind
-{
-  std::vector<Index> Parent;
-  explicit UnionFind(Index n)
-    : Parent(n)
-  {
-    std::iota(this->Parent.begin(), this->Parent.end(), 0);
-  }
-  // Without path compression: safe to call from several threads at once.
-  Index Root(Index x) const
-  {
-    while (this->Parent[x] != x)
-    {
-      x = this->Parent[x];
-    }
-    return x;
-  }
-  Index Find(Index x)
-  {
-    while (this->Parent[x] != x)
-    {
-      this->Parent[x] = this->Parent[this->Parent[x]];
-      x = this->Parent[x];
-    }
-    return x;
-  }
-  void Union(Index a, Index b)
-  {
-    a = this->Find(a);
-    b = this->Find(b);
-    if (a != b)
-    {
-      // The smaller root wins: the result does not depend on the order of the unions.
-      this->Parent[std::max(a, b)] = std::min(a, b);
-    }
-  }
-};
-
 // Follows a deterministic successor function until a fixed point, labelling every visited
 // element with the label of the fixed point. Linear overall; `limit` guards against a cycle,
 // which a valid gradient cannot have.

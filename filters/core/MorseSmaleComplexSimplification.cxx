@@ -1,5 +1,7 @@
 #include "MorseSmaleComplexSimplification.h"
 
+#include "DisjointSets.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -15,12 +17,7 @@ namespace
 // representative is always the survivor (not whichever root union-by-rank would pick).
 Index FollowForwarding(std::vector<Index>& forward, Index x)
 {
-  while (forward[x] != x)
-  {
-    forward[x] = forward[forward[x]];
-    x = forward[x];
-  }
-  return x;
+  return FindRepresentative(forward, x);
 }
 
 // (value, vertex, id): the order of simulation of simplicity used by stage 1, made total.
