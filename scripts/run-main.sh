@@ -8,5 +8,6 @@ bash "$here/scripts/setup-debian.sh"
 bash "$here/scripts/build.sh"
 build="${TOPOSPLINE_BUILD_DIR:-$here/build}"
 export TOPOSPLINE_PLUGIN="$build/lib/paraview-plugins/TopoSpline/TopoSpline.so"
-# Rendering needs an X server: pvbatch runs under a virtual one.
-exec xvfb-run -a -s "-screen 0 1280x1024x24" pvbatch "$here/scripts/topospline_main.py" "$@"
+# Rendering needs an X server: pvbatch runs under a virtual one (the display search starts at a
+# random number: two "xvfb-run -a" starting together can otherwise pick the same display).
+exec xvfb-run -a -n $((200 + RANDOM % 30000)) -s "-screen 0 1280x1024x24" pvbatch "$here/scripts/topospline_main.py" "$@"

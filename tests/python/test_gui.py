@@ -3,6 +3,7 @@ its own render view (drawn in the style of the paper's figure 6) and saves a scr
 under xvfb-run. (A GUI start-up script that creates layouts and views hangs the 5.11 GUI
 here, so this uses the GUI's own view.)"""
 import os
+import random
 import subprocess
 import tempfile
 
@@ -34,7 +35,7 @@ with tempfile.TemporaryDirectory() as work:
     script = os.path.join(work, "gui.py")
     with open(script, "w") as f:
         f.write(GUI_SCRIPT % {"states": os.path.join(tt.REPO, "states"), "shot": shot})
-    result = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1920x1080x24", "paraview", "--script=" + script, "--exit"],
+    result = subprocess.run(["xvfb-run", "-a", "-n", str(random.randint(200, 30000)), "-s", "-screen 0 1920x1080x24", "paraview", "--script=" + script, "--exit"],
                             cwd=work, env=dict(os.environ, TOPOSPLINE_PLUGIN=tt.plugin_path()),
                             capture_output=True, text=True, timeout=300)
     output = result.stdout + result.stderr

@@ -3,6 +3,7 @@ LoadState(..., data_directory=tests/data)) and its pipeline updates without erro
 Python twin runs in its own process. Rendering needs an X server: each run is under xvfb-run."""
 import glob
 import os
+import random
 import subprocess
 import tempfile
 
@@ -28,7 +29,7 @@ print("SMOOTHED", smoothed)
 def run(args, what):
     environment = dict(os.environ, TOPOSPLINE_PLUGIN=tt.plugin_path(), TOPOSPLINE_DATA=tt.test_data_dir())
     with tempfile.TemporaryDirectory() as elsewhere:
-        result = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24"] + args, cwd=elsewhere,
+        result = subprocess.run(["xvfb-run", "-a", "-n", str(random.randint(200, 30000)), "-s", "-screen 0 1280x1024x24"] + args, cwd=elsewhere,
                                 env=environment, capture_output=True, text=True, timeout=600)
     output = result.stdout + result.stderr
     checks.equal(result.returncode, 0, "%s: exits cleanly (%s)" % (what, output[-600:]))
