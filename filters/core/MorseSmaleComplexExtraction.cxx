@@ -69,24 +69,6 @@ double TurningAngle(double rx, double ry, double dx, double dy)
 }
 } // namespace
 
-std::vector<Index> MorseSmaleComplexExtraction::SeparatricesAround(
-  const MorseSmaleComplex& complex, Index extremum)
-{
-  std::vector<Index> arcs;
-  const bool minimum = complex.CriticalPoints[extremum].MorseIndex == 0;
-  for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
-  {
-    const Separatrix& arc = complex.Separatrices[a];
-    if (minimum ? (arc.Type == Separatrix::Descending && arc.Source == extremum)
-                : (arc.Type == Separatrix::Ascending && arc.Destination == extremum))
-    {
-      arcs.push_back(a);
-    }
-  }
-  SortAroundExtremum(complex, extremum, arcs);
-  return arcs;
-}
-
 void MorseSmaleComplexExtraction::SortAroundExtremum(
   const MorseSmaleComplex& complex, Index extremum, std::vector<Index>& arcs)
 {
@@ -133,6 +115,7 @@ void MorseSmaleComplexExtraction::SortAroundExtremum(
     const double ab = TurningAngle(rx, ry, pb[k][0] - node[0], pb[k][1] - node[1]);
     return aa != ab ? aa < ab : ia < ib;
   };
+  // Sort a copy: `less` finds paths in `arcs`, which must stay sorted by id meanwhile.
   std::vector<Index> sorted = arcs;
   std::sort(sorted.begin(), sorted.end(), less);
   arcs = sorted;

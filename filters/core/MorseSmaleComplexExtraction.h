@@ -87,10 +87,8 @@ public:
   ParallelFor Parallel = SequentialFor;
   ProgressHooks Hooks;
 
-  // The 1-cells of an extremum (descending for a minimum, ascending for a maximum) in
-  // counter-clockwise order around it.
-  static std::vector<Index> SeparatricesAround(const MorseSmaleComplex& complex, Index extremum);
-  // Sorts `arcs`, 1-cells of `extremum`, counter-clockwise around it.
+  // Sorts `arcs`, 1-cells of `extremum` (descending ones for a minimum, ascending ones for a
+  // maximum), counter-clockwise around it.
   static void SortAroundExtremum(const MorseSmaleComplex& complex, Index extremum, std::vector<Index>& arcs);
 
   // Intermediate structures, kept for tests and later stages.
