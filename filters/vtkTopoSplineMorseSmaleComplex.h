@@ -19,6 +19,9 @@
  *                       TwoCellId per point
  *
  * The discrete gradient and the boundary rule are described in core/DiscreteGradient.h.
+ *
+ * Distributed runs: the complex is a global structure. Every process asks for the whole input
+ * and the process that renders piece 0 computes the complex; the others produce an empty one.
  */
 #pragma once
 
@@ -38,6 +41,7 @@ protected:
   ~vtkTopoSplineMorseSmaleComplex() override = default;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
 private:

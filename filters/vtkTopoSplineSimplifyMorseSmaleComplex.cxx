@@ -131,6 +131,12 @@ int vtkTopoSplineSimplifyMorseSmaleComplex::RequestData(
     vtkErrorMacro("Missing input or output.");
     return 0;
   }
+  if (input->GetNumberOfBlocks() == 0)
+  {
+    // An empty complex: another process's share in a distributed run, or an upstream failure
+    // that was already reported. Nothing to do.
+    return 1;
+  }
   if (!std::isfinite(this->PersistenceThreshold) || this->PersistenceThreshold < 0 ||
     this->PersistenceThreshold > 100)
   {

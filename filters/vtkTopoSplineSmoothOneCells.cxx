@@ -125,6 +125,12 @@ int vtkTopoSplineSmoothOneCells::RequestData(
     vtkErrorMacro("Missing input or output.");
     return 0;
   }
+  if (input->GetNumberOfBlocks() == 0)
+  {
+    // An empty complex: another process's share in a distributed run, or an upstream failure
+    // that was already reported. Nothing to do.
+    return 1;
+  }
   if (this->CurveSegments < 2 || this->CurveSegments > topospline::MonotoneBSplineFit::MaximumSegments)
   {
     vtkErrorMacro("Smooth 1-Cells: Curve Segments must be in [2, " << topospline::MonotoneBSplineFit::MaximumSegments
