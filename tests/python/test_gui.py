@@ -3,8 +3,6 @@ its own render view (drawn in the style of the paper's figure 6) and saves a scr
 under xvfb-run. (A GUI start-up script that creates layouts and views hangs the 5.11 GUI
 here, so this uses the GUI's own view.)"""
 import os
-import random
-import subprocess
 import tempfile
 
 import numpy as np
@@ -35,11 +33,10 @@ with tempfile.TemporaryDirectory() as work:
     script = os.path.join(work, "gui.py")
     with open(script, "w") as f:
         f.write(GUI_SCRIPT % {"states": os.path.join(tt.REPO, "states"), "shot": shot})
-    result = subprocess.run(["xvfb-run", "-a", "-n", str(random.randint(200, 30000)), "-s", "-screen 0 1920x1080x24", "paraview", "--script=" + script, "--exit"],
-                            cwd=work, env=dict(os.environ, TOPOSPLINE_PLUGIN=tt.plugin_path()),
-                            capture_output=True, text=True, timeout=300)
-    output = result.stdout + result.stderr
-    checks.equal(result.returncode, 0, "paraview GUI exits cleanly (%s)" % output[-600:])
+    returncode, output = tt.run_with_virtual_display(["paraview", "--script=" + script, "--exit"], work,
+                                                     dict(os.environ, TOPOSPLINE_PLUGIN=tt.plugin_path()),
+                                                     timeout=300, screen="1920x1080x24")
+    checks.equal(returncode, 0, "paraview GUI exits cleanly (%s)" % output[-600:])
     checks.check("GUI-SCRIPT-DONE" in output, "the GUI ran the pipeline script")
     checks.check("ERR|" not in output, "no VTK error in the GUI run (%s)" % output[-600:])
     if checks.check(os.path.exists(shot), "screenshot written"):

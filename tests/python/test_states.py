@@ -3,8 +3,6 @@ LoadState(..., data_directory=tests/data)) and its pipeline updates without erro
 Python twin runs in its own process. Rendering needs an X server: each run is under xvfb-run."""
 import glob
 import os
-import random
-import subprocess
 import tempfile
 
 import topospline_testing as tt
@@ -26,24 +24,12 @@ print("SMOOTHED", smoothed)
 """
 
 
-X_STARTUP_FAILURES = ("bad X server connection", "SupportsOpenGL", "Could not open display", "Xvfb failed")
-
-
 def run(args, what):
     environment = dict(os.environ, TOPOSPLINE_PLUGIN=tt.plugin_path(), TOPOSPLINE_DATA=tt.test_data_dir())
-    for attempt in range(2):
-        with tempfile.TemporaryDirectory() as elsewhere:
-            result = subprocess.run(["xvfb-run", "-a", "-n", str(random.randint(200, 30000)), "-s",
-                                     "-screen 0 1280x1024x24"] + args, cwd=elsewhere, env=environment,
-                                    capture_output=True, text=True, timeout=600)
-        output = result.stdout + result.stderr
-        # A virtual X server that failed to come up (seen once under heavy load) is the test
-        # machine's problem, not the plugin's: one more try, then the usual checks.
-        if result.returncode == 0 or not any(sign in output for sign in X_STARTUP_FAILURES):
-            break
-        print("%s: X server start-up failure, trying again" % what, flush=True)
+    with tempfile.TemporaryDirectory() as elsewhere:
+        returncode, output = tt.run_with_virtual_display(args, elsewhere, environment)
     errors = "\n".join(line for line in output.splitlines() if "ERR|" in line or "rror" in line)[:1500]
-    checks.equal(result.returncode, 0, "%s: exits cleanly (%s)" % (what, errors))
+    checks.equal(returncode, 0, "%s: exits cleanly (%s)" % (what, errors))
     checks.check("ERR|" not in output, "%s: no VTK error (%s)" % (what, errors))
     return output
 

@@ -2,6 +2,8 @@
 with the plain "N passed, N failed" line, and readers of the complex's blocks as numpy arrays."""
 import json
 import os
+import random
+import subprocess
 import sys
 
 import numpy as np
@@ -35,6 +37,25 @@ def find_dataset(filename):
         if os.path.exists(path):
             return path
     return None
+
+
+# Signs that a virtual X server failed to come up (seen once under heavy load): the test
+# machine's problem, not the plugin's.
+X_STARTUP_FAILURES = ("bad X server connection", "SupportsOpenGL", "Could not open display", "Xvfb failed")
+
+
+def run_with_virtual_display(args, cwd, env, timeout=600, screen="1280x1024x24"):
+    """Runs args under xvfb-run (display search from a random number, since two "xvfb-run -a"
+    starting together can pick the same display); one more try if the X server failed to
+    start. Returns (returncode, output)."""
+    for attempt in range(2):
+        result = subprocess.run(["xvfb-run", "-a", "-n", str(random.randint(200, 30000)), "-s", "-screen 0 " + screen]
+                                + args, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
+        output = result.stdout + result.stderr
+        if result.returncode == 0 or not any(sign in output for sign in X_STARTUP_FAILURES):
+            break
+        print("X server start-up failure, trying again", flush=True)
+    return result.returncode, output
 
 
 class Checks:
