@@ -34,20 +34,7 @@ using topospline::Index;
 
 namespace
 {
-// Which two coordinate axes span the plane of the domain, and where the third one sits.
-struct PlanarEmbedding
-{
-  int U = 0, V = 1, W = 2;
-  double WValue = 0;
-  void To3D(const double* uv, double xyz[3]) const
-  {
-    xyz[this->U] = uv[0];
-    xyz[this->V] = uv[1];
-    xyz[this->W] = this->WValue;
-  }
-};
-
-bool DetectEmbedding(vtkDataSet* data, PlanarEmbedding& embedding)
+bool DetectEmbedding(vtkDataSet* data, vtkTopoSplineDomainConversion::DomainPlane& embedding)
 {
   double bounds[6];
   data->GetBounds(bounds);
@@ -65,11 +52,12 @@ bool DetectEmbedding(vtkDataSet* data, PlanarEmbedding& embedding)
   return false;
 }
 
-// The plane of an image is its one-point axis; a mesh's, the axis with no extent. The image
-// rule is the same axes choice ToPlanarScalarField makes (the two axes with several points).
-PlanarEmbedding EmbeddingOf(vtkDataSet* domain)
+} // namespace
+
+// The image rule is the axes choice ToPlanarScalarField makes (the two axes with several points).
+vtkTopoSplineDomainConversion::DomainPlane vtkTopoSplineDomainConversion::PlaneOf(vtkDataSet* domain)
 {
-  PlanarEmbedding embedding;
+  DomainPlane embedding;
   if (auto* image = vtkImageData::SafeDownCast(domain))
   {
     int dims[3];
@@ -95,6 +83,8 @@ PlanarEmbedding EmbeddingOf(vtkDataSet* domain)
   return embedding;
 }
 
+namespace
+{
 struct CopyToDouble
 {
   template <typename ArrayT>
@@ -104,16 +94,6 @@ struct CopyToDouble
     std::copy(values.begin(), values.end(), out.begin());
   }
 };
-
-template <typename ArrayT>
-vtkSmartPointer<ArrayT> MakeArray(const char* name, int components, vtkIdType tuples)
-{
-  auto array = vtkSmartPointer<ArrayT>::New();
-  array->SetName(name);
-  array->SetNumberOfComponents(components);
-  array->SetNumberOfTuples(tuples);
-  return array;
-}
 
 // Adds the arrays (smart pointers or raw) to `data` in the given order.
 void AddArrays(vtkFieldData* data, std::initializer_list<vtkAbstractArray*> arrays)
@@ -268,7 +248,7 @@ bool ToPlanarScalarField(vtkDataSet* input, vtkDataArray* scalars, topospline::P
     return true;
   }
 
-  PlanarEmbedding embedding;
+  vtkTopoSplineDomainConversion::DomainPlane embedding;
   if (!DetectEmbedding(input, embedding))
   {
     error = "the points do not lie in a coordinate plane (x, y or z constant); TopoSpline needs a planar "
@@ -308,21 +288,9 @@ bool ToPlanarScalarField(vtkDataSet* input, vtkDataArray* scalars, topospline::P
   return true;
 }
 
-void PlanarToDomainPoint(vtkDataSet* domain, const double uv[2], double xyz[3])
-{
-  EmbeddingOf(domain).To3D(uv, xyz);
-}
-
-void DomainToPlanarPoint(vtkDataSet* domain, const double xyz[3], double uv[2])
-{
-  const PlanarEmbedding embedding = EmbeddingOf(domain);
-  uv[0] = xyz[embedding.U];
-  uv[1] = xyz[embedding.V];
-}
-
 void PlanarBounds(vtkDataSet* domain, double bounds[4])
 {
-  const PlanarEmbedding embedding = EmbeddingOf(domain);
+  const vtkTopoSplineDomainConversion::DomainPlane embedding = PlaneOf(domain);
   double b[6];
   domain->GetBounds(b);
   bounds[0] = b[2 * embedding.U];
@@ -334,7 +302,7 @@ void PlanarBounds(vtkDataSet* domain, double bounds[4])
 void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* domain, const char* scalarName,
   vtkMultiBlockDataSet* output)
 {
-  const PlanarEmbedding embedding = EmbeddingOf(domain);
+  const vtkTopoSplineDomainConversion::DomainPlane embedding = PlaneOf(domain);
   const auto& cps = complex.CriticalPoints;
 
   // Critical points.
@@ -345,12 +313,12 @@ void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
     points->SetDataTypeToDouble();
     points->SetNumberOfPoints(n);
     vtkNew<vtkCellArray> verts;
-    auto id = MakeArray<vtkIntArray>(names::CriticalPointId, 1, n);
-    auto index = MakeArray<vtkIntArray>(names::CriticalIndex, 1, n);
-    auto value = MakeArray<vtkDoubleArray>(names::CriticalValue, 1, n);
-    auto vertex = MakeArray<vtkIdTypeArray>(names::VertexId, 1, n);
-    auto cell = MakeArray<vtkIdTypeArray>("CriticalCellId", 1, n);
-    auto boundary = MakeArray<vtkCharArray>(names::IsOnBoundary, 1, n);
+    auto id = NewArray<vtkIntArray>(names::CriticalPointId, 1, n);
+    auto index = NewArray<vtkIntArray>(names::CriticalIndex, 1, n);
+    auto value = NewArray<vtkDoubleArray>(names::CriticalValue, 1, n);
+    auto vertex = NewArray<vtkIdTypeArray>(names::VertexId, 1, n);
+    auto cell = NewArray<vtkIdTypeArray>("CriticalCellId", 1, n);
+    auto boundary = NewArray<vtkCharArray>(names::IsOnBoundary, 1, n);
     for (vtkIdType i = 0; i < n; ++i)
     {
       points->SetPoint(i, domain->GetPoint(cps[i].Vertex));
@@ -381,12 +349,12 @@ void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
     points->SetDataTypeToDouble();
     points->SetNumberOfPoints(nPoints);
     vtkNew<vtkCellArray> lines;
-    auto along = MakeArray<vtkDoubleArray>(names::ScalarAlong, 1, nPoints);
-    auto meshCell = MakeArray<vtkIdTypeArray>(names::MeshCellId, 1, nPoints);
-    auto id = MakeArray<vtkIntArray>(names::SeparatrixId, 1, n);
-    auto source = MakeArray<vtkIntArray>(names::SourceId, 1, n);
-    auto destination = MakeArray<vtkIntArray>(names::DestinationId, 1, n);
-    auto type = MakeArray<vtkIntArray>(names::SeparatrixType, 1, n);
+    auto along = NewArray<vtkDoubleArray>(names::ScalarAlong, 1, nPoints);
+    auto meshCell = NewArray<vtkIdTypeArray>(names::MeshCellId, 1, nPoints);
+    auto id = NewArray<vtkIntArray>(names::SeparatrixId, 1, n);
+    auto source = NewArray<vtkIntArray>(names::SourceId, 1, n);
+    auto destination = NewArray<vtkIntArray>(names::DestinationId, 1, n);
+    auto type = NewArray<vtkIntArray>(names::SeparatrixType, 1, n);
     vtkIdType next = 0;
     std::vector<vtkIdType> ids;
     for (vtkIdType a = 0; a < n; ++a)
@@ -428,13 +396,13 @@ void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
     points->SetDataTypeToDouble();
     points->SetNumberOfPoints(n);
     vtkNew<vtkCellArray> verts;
-    auto id = MakeArray<vtkIntArray>(names::TwoCellId, 1, n);
-    auto minimum = MakeArray<vtkIntArray>(names::MinimumId, 1, n);
-    auto maximum = MakeArray<vtkIntArray>(names::MaximumId, 1, n);
-    auto saddles = MakeArray<vtkIntArray>(names::SaddleIds, 2, n);
-    auto arcs = MakeArray<vtkIntArray>(names::BoundarySeparatrices, 4, n);
-    auto pouch = MakeArray<vtkCharArray>(names::IsPouch, 1, n);
-    auto size = MakeArray<vtkIdTypeArray>(names::NumberOfVertices, 1, n);
+    auto id = NewArray<vtkIntArray>(names::TwoCellId, 1, n);
+    auto minimum = NewArray<vtkIntArray>(names::MinimumId, 1, n);
+    auto maximum = NewArray<vtkIntArray>(names::MaximumId, 1, n);
+    auto saddles = NewArray<vtkIntArray>(names::SaddleIds, 2, n);
+    auto arcs = NewArray<vtkIntArray>(names::BoundarySeparatrices, 4, n);
+    auto pouch = NewArray<vtkCharArray>(names::IsPouch, 1, n);
+    auto size = NewArray<vtkIdTypeArray>(names::NumberOfVertices, 1, n);
     auto stable = [&](Index cp) { return cp == topospline::InvalidIndex ? -1 : cps[cp].Id; };
     for (vtkIdType c = 0; c < n; ++c)
     {
@@ -465,9 +433,9 @@ void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
   segmentation->ShallowCopy(domain);
   {
     const vtkIdType n = domain->GetNumberOfPoints();
-    auto ascending = MakeArray<vtkIntArray>(names::AscendingManifoldId, 1, n);
-    auto descending = MakeArray<vtkIntArray>(names::DescendingManifoldId, 1, n);
-    auto cell = MakeArray<vtkIntArray>(names::TwoCellId, 1, n);
+    auto ascending = NewArray<vtkIntArray>(names::AscendingManifoldId, 1, n);
+    auto descending = NewArray<vtkIntArray>(names::DescendingManifoldId, 1, n);
+    auto cell = NewArray<vtkIntArray>(names::TwoCellId, 1, n);
     for (vtkIdType v = 0; v < n; ++v)
     {
       ascending->SetValue(v, cps[complex.AscendingManifold[v]].Id);
@@ -515,7 +483,7 @@ bool FromMultiBlock(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& 
     error = "the input is not a Morse-Smale complex (expected the output of the \"Morse-Smale Complex\" filter)";
     return false;
   }
-  const PlanarEmbedding embedding = EmbeddingOf(segmentation);
+  const vtkTopoSplineDomainConversion::DomainPlane embedding = PlaneOf(segmentation);
 
   auto* pd = critical->GetPointData();
   vtkDataArray* id = RequireArray(pd, names::CriticalPointId, error);

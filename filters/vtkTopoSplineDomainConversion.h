@@ -5,6 +5,8 @@
 
 #include "MorseSmaleComplexExtraction.h" // core
 
+#include <vtkSmartPointer.h>
+
 #include <string>
 
 class vtkDataArray;
@@ -38,13 +40,42 @@ void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
 // message when `input` is not such a complex.
 bool FromMultiBlock(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& complex, std::string& error);
 
-// A point of the field's plane, (u, v) as in PlanarScalarField::Points, in the 3D coordinates
-// of `domain` (the input geometry or the Segmentation block).
-void PlanarToDomainPoint(vtkDataSet* domain, const double uv[2], double xyz[3]);
+// The coordinate plane of a domain: which two axes span it (U, V: the (u, v) of
+// PlanarScalarField::Points) and where the third one (W) sits.
+struct DomainPlane
+{
+  int U = 0, V = 1, W = 2;
+  double WValue = 0;
+  void To3D(const double uv[2], double xyz[3]) const
+  {
+    xyz[this->U] = uv[0];
+    xyz[this->V] = uv[1];
+    xyz[this->W] = this->WValue;
+  }
+  void ToPlanar(const double xyz[3], double uv[2]) const
+  {
+    uv[0] = xyz[this->U];
+    uv[1] = xyz[this->V];
+  }
+};
 
-// The inverse of PlanarToDomainPoint, and the bounds (umin, umax, vmin, vmax) in the plane.
-void DomainToPlanarPoint(vtkDataSet* domain, const double xyz[3], double uv[2]);
+// The plane of `domain` (the input geometry or a complex's Segmentation block): an image's
+// one-point axis, else the axis along which the points have no extent.
+DomainPlane PlaneOf(vtkDataSet* domain);
+
+// The domain's bounds in its plane: umin, umax, vmin, vmax.
 void PlanarBounds(vtkDataSet* domain, double bounds[4]);
+
+// A new named array with `components` components and `tuples` tuples.
+template <typename ArrayT>
+vtkSmartPointer<ArrayT> NewArray(const char* name, int components = 1, vtkIdType tuples = 0)
+{
+  auto array = vtkSmartPointer<ArrayT>::New();
+  array->SetName(name);
+  array->SetNumberOfComponents(components);
+  array->SetNumberOfTuples(tuples);
+  return array;
+}
 
 // The "Segmentation" block of a complex, or nullptr.
 vtkDataSet* SegmentationOf(vtkMultiBlockDataSet* input);

@@ -50,33 +50,25 @@ int vtkTopoSplineSimplifyMorseSmaleComplex::FillInputPortInformation(int, vtkInf
 
 namespace
 {
-template <typename ArrayT>
-vtkSmartPointer<ArrayT> NamedArray(const char* name, int components = 1)
-{
-  auto array = vtkSmartPointer<ArrayT>::New();
-  array->SetName(name);
-  array->SetNumberOfComponents(components);
-  return array;
-}
-
 vtkSmartPointer<vtkPolyData> JunctionPointsBlock(
   const topospline::SimplificationOutput& result, vtkDataSet* domain)
 {
   const auto& cps = result.Complex.CriticalPoints;
+  const auto plane = vtkTopoSplineDomainConversion::PlaneOf(domain);
   auto block = vtkSmartPointer<vtkPolyData>::New();
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   vtkNew<vtkCellArray> verts;
-  auto type = NamedArray<vtkIntArray>(names::SeparatrixType);
-  auto extremum = NamedArray<vtkIntArray>("ExtremumId");
-  auto cell = NamedArray<vtkIntArray>(names::MeshCellId);
-  auto value = NamedArray<vtkDoubleArray>("JunctionValue");
-  auto critical = NamedArray<vtkIntArray>(names::CriticalPointId);
-  auto count = NamedArray<vtkIntArray>("NumberOfSeparatrices");
+  auto type = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::SeparatrixType);
+  auto extremum = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("ExtremumId");
+  auto cell = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::MeshCellId);
+  auto value = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>("JunctionValue");
+  auto critical = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::CriticalPointId);
+  auto count = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("NumberOfSeparatrices");
   for (const auto& junction : result.JunctionPoints)
   {
     double xyz[3];
-    vtkTopoSplineDomainConversion::PlanarToDomainPoint(domain, junction.Position, xyz);
+    plane.To3D(junction.Position, xyz);
     const vtkIdType id = points->InsertNextPoint(xyz);
     verts->InsertNextCell(1, &id);
     type->InsertNextValue(junction.Type);
@@ -98,10 +90,10 @@ vtkSmartPointer<vtkPolyData> JunctionPointsBlock(
 
 void AddCancellations(const topospline::SimplificationOutput& result, double maximumPersistence, vtkFieldData* fd)
 {
-  auto lower = NamedArray<vtkIntArray>("CancelledLowerId");
-  auto upper = NamedArray<vtkIntArray>("CancelledUpperId");
-  auto survivor = NamedArray<vtkIntArray>("SurvivorId");
-  auto persistence = NamedArray<vtkDoubleArray>("CancellationPersistence");
+  auto lower = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("CancelledLowerId");
+  auto upper = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("CancelledUpperId");
+  auto survivor = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("SurvivorId");
+  auto persistence = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>("CancellationPersistence");
   for (const auto& c : result.Cancellations)
   {
     lower->InsertNextValue(c.Lower);
@@ -109,9 +101,9 @@ void AddCancellations(const topospline::SimplificationOutput& result, double max
     survivor->InsertNextValue(c.Survivor);
     persistence->InsertNextValue(c.Persistence);
   }
-  auto absolute = NamedArray<vtkDoubleArray>("AbsolutePersistenceThreshold");
+  auto absolute = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>("AbsolutePersistenceThreshold");
   absolute->InsertNextValue(result.AbsoluteThreshold);
-  auto maximum = NamedArray<vtkDoubleArray>("MaximumPersistence");
+  auto maximum = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>("MaximumPersistence");
   maximum->InsertNextValue(maximumPersistence);
   for (vtkAbstractArray* a : std::initializer_list<vtkAbstractArray*>{ lower, upper, survivor, persistence, absolute, maximum })
   {

@@ -73,7 +73,7 @@ bool ReadJunctions(vtkMultiBlockDataSet* input, const topospline::MorseSmaleComp
     const auto& arc = complex.Separatrices[a];
     arcsOfExtremum[arc.Type == topospline::Separatrix::Descending ? arc.Source : arc.Destination].push_back(a);
   }
-  vtkDataSet* domain = vtkTopoSplineDomainConversion::SegmentationOf(input);
+  const auto plane = vtkTopoSplineDomainConversion::PlaneOf(vtkTopoSplineDomainConversion::SegmentationOf(input));
   for (vtkIdType j = 0; j < block->GetNumberOfPoints(); ++j)
   {
     topospline::JunctionPoint junction;
@@ -90,7 +90,7 @@ bool ReadJunctions(vtkMultiBlockDataSet* input, const topospline::MorseSmaleComp
     junction.Value = value->GetComponent(j, 0);
     double xyz[3];
     block->GetPoint(j, xyz);
-    vtkTopoSplineDomainConversion::DomainToPlanarPoint(domain, xyz, junction.Position);
+    plane.ToPlanar(xyz, junction.Position);
     for (Index a : arcsOfExtremum[junction.Extremum])
     {
       const auto& arc = complex.Separatrices[a];
@@ -105,13 +105,6 @@ bool ReadJunctions(vtkMultiBlockDataSet* input, const topospline::MorseSmaleComp
   return true;
 }
 
-template <typename ArrayT>
-vtkSmartPointer<ArrayT> NamedArray(const char* name)
-{
-  auto array = vtkSmartPointer<ArrayT>::New();
-  array->SetName(name);
-  return array;
-}
 } // namespace
 
 int vtkTopoSplineSmoothOneCells::RequestData(
@@ -165,6 +158,7 @@ int vtkTopoSplineSmoothOneCells::RequestData(
 
   double bounds[4];
   vtkTopoSplineDomainConversion::PlanarBounds(domain, bounds);
+  const auto plane = vtkTopoSplineDomainConversion::PlaneOf(domain);
   topospline::OneCellSmoothing smoothing;
   smoothing.Segments = this->CurveSegments;
   smoothing.Hooks.Progress = [this](double f) { this->UpdateProgress(0.9 * f); };
@@ -203,10 +197,10 @@ int vtkTopoSplineSmoothOneCells::RequestData(
   {
     vtkNew<vtkPoints> points;
     points->SetDataTypeToDouble();
-    auto height = NamedArray<vtkDoubleArray>("Height");
-    auto piece = NamedArray<vtkIntArray>("PieceId");
-    auto segments = NamedArray<vtkIntArray>("PieceSegments");
-    auto type = NamedArray<vtkIntArray>(names::SeparatrixType);
+    auto height = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>("Height");
+    auto piece = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("PieceId");
+    auto segments = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("PieceSegments");
+    auto type = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::SeparatrixType);
     vtkNew<vtkCellArray> cells;
     for (Index p = 0; p < static_cast<Index>(result.Pieces.size()); ++p)
     {
@@ -220,7 +214,7 @@ int vtkTopoSplineSmoothOneCells::RequestData(
         for (int m = 0; m < 4; ++m)
         {
           double xyz[3];
-          vtkTopoSplineDomainConversion::PlanarToDomainPoint(domain, curve + 2 * vtkOrder[m], xyz);
+          plane.To3D(curve + 2 * vtkOrder[m], xyz);
           ids[m] = points->InsertNextPoint(xyz);
           height->InsertNextValue(h[vtkOrder[m]]);
         }
@@ -248,11 +242,11 @@ int vtkTopoSplineSmoothOneCells::RequestData(
     vtkNew<vtkPoints> points;
     points->SetDataTypeToDouble();
     vtkNew<vtkCellArray> lines;
-    auto height = NamedArray<vtkDoubleArray>("Height");
-    auto id = NamedArray<vtkIntArray>(names::SeparatrixId);
-    auto source = NamedArray<vtkIntArray>(names::SourceId);
-    auto destination = NamedArray<vtkIntArray>(names::DestinationId);
-    auto type = NamedArray<vtkIntArray>(names::SeparatrixType);
+    auto height = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>("Height");
+    auto id = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::SeparatrixId);
+    auto source = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::SourceId);
+    auto destination = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::DestinationId);
+    auto type = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::SeparatrixType);
     std::vector<vtkIdType> ids;
     for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
     {
@@ -266,7 +260,7 @@ int vtkTopoSplineSmoothOneCells::RequestData(
           const double t = static_cast<double>(s) / count;
           double uv[2], xyz[3];
           smoothed.Curve.Evaluate(t, uv);
-          vtkTopoSplineDomainConversion::PlanarToDomainPoint(domain, uv, xyz);
+          plane.To3D(uv, xyz);
           ids.push_back(points->InsertNextPoint(xyz));
           height->InsertNextValue(smoothed.Height.Value(t));
         }
@@ -276,7 +270,7 @@ int vtkTopoSplineSmoothOneCells::RequestData(
       {
         // A 1-cell of one point (a saddle on its minimum's vertex, zero persistence).
         double xyz[3];
-        vtkTopoSplineDomainConversion::PlanarToDomainPoint(domain, arc.Points.data(), xyz);
+        plane.To3D(arc.Points.data(), xyz);
         ids.push_back(points->InsertNextPoint(xyz));
         height->InsertNextValue(arc.Values.front());
       }
@@ -306,7 +300,7 @@ int vtkTopoSplineSmoothOneCells::RequestData(
     free += p.UnconstrainedL1Error;
   }
   auto addNumber = [&](const char* name, double value) {
-    auto array = NamedArray<vtkDoubleArray>(name);
+    auto array = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>(name);
     array->InsertNextValue(value);
     output->GetFieldData()->AddArray(array);
   };

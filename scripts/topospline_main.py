@@ -27,6 +27,10 @@ parser.add_argument("--threshold", type=float, default=25.0,
 parser.add_argument("--k", type=int, default=4, help="cubic segments per 1-cell piece (default 4)")
 parser.add_argument("--seed", type=int, default=1, help="seed of the built-in Shepard field")
 args = parser.parse_args([a for a in sys.argv[1:] if a != "--"])
+if not 2 <= args.k <= 1000:
+    sys.exit("--k must be in [2, 1000]")
+if not 0 <= args.threshold <= 100:
+    sys.exit("--threshold must be a percentage in [0, 100]")
 
 plugin = os.environ.get("TOPOSPLINE_PLUGIN")
 if not plugin or not os.path.exists(plugin):
@@ -97,8 +101,6 @@ summary["simplified_complex"]["maximum_persistence"] = simplified_data.GetFieldD
     "MaximumPersistence").GetValue(0)
 
 # --- Stage 3: smooth, strictly monotone 1-cells ---
-if not 2 <= args.k <= 1000:
-    sys.exit("--k must be in [2, 1000]")
 smoothed = Smooth1Cells(Input=simplified, CurveSegments=args.k)
 timed("3 1-cell smoothing (time I)", smoothed)
 summary["stages_available"].append("Smooth 1-Cells")
