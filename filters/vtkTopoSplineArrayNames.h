@@ -55,6 +55,19 @@ constexpr const char* NumberOfVertices = "NumberOfVertices";
 constexpr const char* AscendingManifoldId = "AscendingManifoldId";
 constexpr const char* DescendingManifoldId = "DescendingManifoldId";
 
+// Smoothed 1-cells (the "SmoothedOneCells" block): cell data PieceId, point data Height; field
+// data listing every 1-cell's pieces.
+constexpr const char* PieceId = "PieceId";
+constexpr const char* Height = "Height";
+constexpr const char* SeparatrixPieceOffsets = "SeparatrixPieceOffsets";
+constexpr const char* SeparatrixPieces = "SeparatrixPieces";
+
+// Reconstruction (point data of the input geometry).
+constexpr const char* ReconstructedField = "Reconstructed";
+constexpr const char* ReconstructionDifference = "Difference";
+// F o Phi at the vertices before topological sampling.
+constexpr const char* ExactReconstruction = "ReconstructedExact";
+
 // Field data of the complex: which input array it was computed from.
 constexpr const char* ScalarFieldName = "TopoSplineScalarField";
 }

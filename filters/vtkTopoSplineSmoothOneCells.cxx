@@ -197,8 +197,8 @@ int vtkTopoSplineSmoothOneCells::RequestData(
   {
     vtkNew<vtkPoints> points;
     points->SetDataTypeToDouble();
-    auto height = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>("Height");
-    auto piece = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("PieceId");
+    auto height = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>(names::Height);
+    auto piece = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::PieceId);
     auto segments = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("PieceSegments");
     auto type = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::SeparatrixType);
     vtkNew<vtkCellArray> cells;
@@ -227,10 +227,25 @@ int vtkTopoSplineSmoothOneCells::RequestData(
     bezier->SetPoints(points);
     bezier->SetCells(VTK_BEZIER_CURVE, cells);
     bezier->GetPointData()->AddArray(height);
-    bezier->GetPointData()->SetActiveScalars("Height");
+    bezier->GetPointData()->SetActiveScalars(names::Height);
     bezier->GetCellData()->AddArray(piece);
     bezier->GetCellData()->AddArray(segments);
     bezier->GetCellData()->AddArray(type);
+    // Which pieces make up every 1-cell, in order from its source: stage 4 assembles the
+    // sides of the 2-cells from them. 1-cell a is SeparatrixPieces[offsets[a] .. offsets[a+1]).
+    auto offsets = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::SeparatrixPieceOffsets);
+    auto list = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::SeparatrixPieces);
+    offsets->InsertNextValue(0);
+    for (const auto& pieces : result.PiecesOfSeparatrix)
+    {
+      for (Index p : pieces)
+      {
+        list->InsertNextValue(p);
+      }
+      offsets->InsertNextValue(static_cast<int>(list->GetNumberOfTuples()));
+    }
+    bezier->GetFieldData()->AddArray(offsets);
+    bezier->GetFieldData()->AddArray(list);
   }
   output->SetBlock(names::SmoothedOneCellsIndex, bezier);
   output->GetMetaData(static_cast<unsigned int>(names::SmoothedOneCellsIndex))
@@ -242,7 +257,7 @@ int vtkTopoSplineSmoothOneCells::RequestData(
     vtkNew<vtkPoints> points;
     points->SetDataTypeToDouble();
     vtkNew<vtkCellArray> lines;
-    auto height = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>("Height");
+    auto height = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>(names::Height);
     auto id = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::SeparatrixId);
     auto source = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::SourceId);
     auto destination = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::DestinationId);
@@ -283,7 +298,7 @@ int vtkTopoSplineSmoothOneCells::RequestData(
     sampled->SetPoints(points);
     sampled->SetLines(lines);
     sampled->GetPointData()->AddArray(height);
-    sampled->GetPointData()->SetActiveScalars("Height");
+    sampled->GetPointData()->SetActiveScalars(names::Height);
     for (vtkAbstractArray* a : std::initializer_list<vtkAbstractArray*>{ id, source, destination, type })
     {
       sampled->GetCellData()->AddArray(a);

@@ -1,5 +1,5 @@
-"""Paper figure 6 (the Shepard field, 25 %, k = 4 and k = 7), as far as TopoSpline goes:
-input, complex, simplified complex, smoothed 1-cells for both k, side by side.
+"""Paper figure 6 (the Shepard field, 25 %, k = 4 and k = 7): the reconstruction with its
+smoothed 1-cells for both k, side by side.
 Run with pvpython/pvbatch; TOPOSPLINE_PLUGIN names the plugin (else it must be loaded)."""
 import os
 import sys
@@ -19,8 +19,9 @@ simplified = SimplifyMorseSmaleComplex(registrationName="Simplified 25%", Input=
 layout = CreateLayout("Figure 6")
 for k, where in ((4, 0), (7, 1)):
     smooth = Smooth1Cells(registrationName="Smoothed k=%d" % k, Input=simplified, CurveSegments=k)
+    reconstruction = Reconstruct2Cells(registrationName="Reconstruction k=%d" % k, Input=smooth, VerifyTopology=0)
     view = CreateView("RenderView")
     AssignViewToLayout(view=view, layout=layout, hint=where)
-    style.field_with_isolines(field, "Shepard", view)
+    style.field_with_isolines(reconstruction, "Reconstructed", view)
     style.complex_lines(smooth, view)
     style.view_from_above(view)

@@ -15,8 +15,11 @@ field = TrigonometricField(registrationName="Trigo", Amplitude=10.0, Resolution=
 complex_ = MorseSmaleComplex(registrationName="Complex", Input=field)
 complex_.ScalarField = ["POINTS", "Trigonometric"]
 smooth = Smooth1Cells(registrationName="Smoothed k=7", Input=complex_, CurveSegments=7)
-view = CreateView("RenderView")
-AssignViewToLayout(view=view, layout=CreateLayout("Figure 8"), hint=0)
-style.field_with_isolines(field, "Trigonometric", view)
-style.complex_lines(smooth, view)
-style.view_from_above(view)
+reconstruction = Reconstruct2Cells(registrationName="Reconstruction", Input=smooth, VerifyTopology=0)
+layout = CreateLayout("Figure 8")
+for where, (source, array) in enumerate(((field, "Trigonometric"), (reconstruction, "Reconstructed"))):
+    view = CreateView("RenderView")
+    AssignViewToLayout(view=view, layout=layout, hint=where)
+    style.field_with_isolines(source, array, view)
+    style.complex_lines(smooth, view)
+    style.view_from_above(view)

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 
@@ -476,8 +477,9 @@ bool MonotoneSibsonSurface::Build(
   }
   if (mismatch > allowedMismatch)
   {
-    error = "the boundary segments do not join with common values and derivatives (mismatch " +
-      std::to_string(mismatch) + ")";
+    char text[64];
+    std::snprintf(text, sizeof(text), "%.3g of %.3g allowed", mismatch, allowedMismatch);
+    error = std::string("the boundary segments do not join with common values and derivatives (mismatch ") + text + ")";
     this->N = 0;
     return false;
   }
@@ -497,9 +499,27 @@ bool MonotoneSibsonSurface::Build(
     }
   }
 
-  // Interior values: discrete Laplace equation (5-point stencil) with the boundary values.
+  // Interior values: discrete Laplace equation (5-point stencil) with the boundary values, or
+  // the Coons patch of the four sides blended by cubic Hermite functions.
   const int m = n - 1;
-  if (m > 0)
+  if (m > 0 && options.Interior == MonotoneSurfaceOptions::CoonsInterior)
+  {
+    auto h1 = [](double t) { return t * t * (3 - 2 * t); };
+    const double z00 = this->Z[this->Node(0, 0)], z10 = this->Z[this->Node(n, 0)];
+    const double z01 = this->Z[this->Node(0, n)], z11 = this->Z[this->Node(n, n)];
+    for (int j = 1; j < n; ++j)
+    {
+      const double b = h1(static_cast<double>(j) / n), a = 1 - b;
+      for (int i = 1; i < n; ++i)
+      {
+        const double d = h1(static_cast<double>(i) / n), c = 1 - d;
+        this->Z[this->Node(i, j)] = a * this->Z[this->Node(i, 0)] + b * this->Z[this->Node(i, n)] +
+          c * this->Z[this->Node(0, j)] + d * this->Z[this->Node(n, j)] -
+          (c * a * z00 + d * a * z10 + c * b * z01 + d * b * z11);
+      }
+    }
+  }
+  else if (m > 0)
   {
     std::vector<Eigen::Triplet<double>> entries;
     entries.reserve(5 * m * m);
@@ -597,12 +617,12 @@ bool MonotoneSibsonSurface::Build(
       else if (kind[k] == CrossIsQ)
       {
         const double t = this->P[k];
-        qMin[k] = t < sigma ? sigma - 2 * t : -t;
+        qMin[k] = t < sigma ? sigma - 2 * t : (options.FlatAcrossBoundary ? 0.0 : -t);
       }
       else if (kind[k] == CrossIsP)
       {
         const double t = this->Q[k];
-        pMin[k] = t < sigma ? sigma - 2 * t : -t;
+        pMin[k] = t < sigma ? sigma - 2 * t : (options.FlatAcrossBoundary ? 0.0 : -t);
       }
     }
   };
@@ -682,13 +702,13 @@ bool MonotoneSibsonSurface::Build(
       else if (kind[k] == CrossIsQ)
       {
         const int inward = j == 0 ? 1 : -1;
-        const double d = 0.5 * (-3 * z(i, j) + 4 * z(i, j + inward) - z(i, j + 2 * inward));
+        const double d = options.FlatAcrossBoundary ? 0.0 : 0.5 * (-3 * z(i, j) + 4 * z(i, j + inward) - z(i, j + 2 * inward));
         qEst[k] = std::max(inward * d, qMin[k]);
       }
       else if (kind[k] == CrossIsP)
       {
         const int inward = i == 0 ? 1 : -1;
-        const double d = 0.5 * (-3 * z(i, j) + 4 * z(i + inward, j) - z(i + 2 * inward, j));
+        const double d = options.FlatAcrossBoundary ? 0.0 : 0.5 * (-3 * z(i, j) + 4 * z(i + inward, j) - z(i + 2 * inward, j));
         pEst[k] = std::max(inward * d, pMin[k]);
       }
     }

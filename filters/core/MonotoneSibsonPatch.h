@@ -160,6 +160,20 @@ struct MonotoneSurfaceOptions
   // the per-diagonal one (makes every diagonal fixable); if the latter does not settle, all
   // free derivatives take the minimal choice, which always works when anything does.
   int CellLimiterSweeps = 8;
+  // Cross-boundary derivatives: 0 (a flat valley floor or ridge top along the 1-cells, as a
+  // smooth field has there; raised only where the tangential derivative vanishes) instead of
+  // the one-sided difference into the interior values, which makes a crease whose sampling
+  // shows spurious critical points along the 1-cells.
+  bool FlatAcrossBoundary = false;
+  // Interior node values before the monotonicity corrections: the paper's discrete Laplace
+  // solve, or the Coons patch of the four sides with cubic Hermite blending (flat across the
+  // sides wherever the corners have zero derivatives).
+  enum InteriorValues
+  {
+    LaplaceInterior = 0,
+    CoonsInterior = 1
+  };
+  InteriorValues Interior = LaplaceInterior;
   int DiagonalLimiterRounds = 8;
 };
 

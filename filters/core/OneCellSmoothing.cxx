@@ -68,13 +68,37 @@ bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<Smoothin
   piece.Curve = curve.Spline.ToCubicBezier();
   // A least-squares curve fitted to a 1-cell that runs along the boundary and then turns
   // inwards can overshoot the boundary slightly. A Bezier curve lies in the convex hull of its
-  // control points: clamping them into the domain's box keeps it inside (the ends, data
-  // points, never move).
-  piece.Clamped = false;
-  for (double& coordinate : piece.Curve.ControlPoints)
+  // control points: clamping them keeps it inside (the ends, data points, never move). Only a
+  // piece that lies entirely on one side of the domain's box may touch that side: a boundary
+  // stretch belongs to one piece at most (1-cells on the same vertices share their pieces),
+  // and any other curve touching it would make the 2-cells of stage 4 pinch. Other pieces are
+  // kept a quarter of their sample spacing inside.
+  const std::size_t samples = piece.Points.size() / 2;
+  double length = 0;
+  for (std::size_t i = 1; i < samples; ++i)
   {
-    const size_t axis = (&coordinate - piece.Curve.ControlPoints.data()) % 2;
-    const double clamped = std::clamp(coordinate, bounds[2 * axis], bounds[2 * axis + 1]);
+    length += std::hypot(piece.Points[2 * i] - piece.Points[2 * i - 2], piece.Points[2 * i + 1] - piece.Points[2 * i - 1]);
+  }
+  const double margin = samples > 1 ? 0.25 * length / (samples - 1) : 0.0;
+  double box[4];
+  for (int side = 0; side < 4; ++side)
+  {
+    const int axis = side / 2;
+    bool alongSide = samples > 1;
+    for (std::size_t i = 0; i < samples && alongSide; ++i)
+    {
+      alongSide = piece.Points[2 * i + axis] == bounds[side];
+    }
+    box[side] = bounds[side] + (alongSide ? 0.0 : (side % 2 == 0 ? margin : -margin));
+  }
+  piece.Clamped = false;
+  const std::size_t count = piece.Curve.ControlPoints.size();
+  for (std::size_t i = 2; i + 2 < count; ++i)
+  {
+    double& coordinate = piece.Curve.ControlPoints[i];
+    const std::size_t axis = i % 2;
+    const double lo = box[2 * axis], hi = box[2 * axis + 1];
+    const double clamped = lo <= hi ? std::clamp(coordinate, lo, hi) : 0.5 * (lo + hi);
     piece.Clamped = piece.Clamped || clamped != coordinate;
     coordinate = clamped;
   }
@@ -433,8 +457,10 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
       // Up to MaximumSegments, or to the piece's number of samples for long pieces: with about
       // one segment per sample the least-squares curve follows the jagged 1-cell, which does
       // not cross the others.
+      // k doubles, so that the counts of the pieces around a 2-cell keep small common multiples:
+      // stage 4 subdivides the four sides of every cell to one common count.
       const int cap = std::max(this->MaximumSegments, static_cast<int>(piece.Values.size()) - 1);
-      const int next = std::min(cap, piece.Segments + std::max(2, piece.Segments / 2));
+      const int next = std::min(cap, 2 * piece.Segments);
       if (next > piece.Segments && next <= MonotoneBSplineFit::MaximumSegments)
       {
         if (!this->FitPiece(piece, nodes, next, domainBounds, error))

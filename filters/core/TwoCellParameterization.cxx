@@ -7,26 +7,36 @@
 #include <CGAL/Delaunay_mesher_no_edge_refinement_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_2_algorithms.h>
+#include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseLU>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <numeric>
 #include <sstream>
+#include <tuple>
 
 namespace topospline
 {
 namespace
 {
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-// The vertex info is the output index; it is reset before every use because the mesher
-// creates Steiner vertices with an uninitialized info.
+// The vertex info marks boundary vertices (InvalidIndex: Steiner point), then holds the output
+// index of Steiner points; it is reset before every use because the mesher creates Steiner
+// vertices with an uninitialized info.
 using VertexBase = CGAL::Delaunay_mesh_vertex_base_2<Kernel, CGAL::Triangulation_vertex_base_with_info_2<Index, Kernel>>;
-using FaceBase = CGAL::Delaunay_mesh_face_base_2<Kernel>;
+// The face info holds, per corner at a boundary vertex, the sample (the visit of that vertex
+// by the boundary walk) whose side of the slits the face lies on: that is how the mesh is cut
+// open along slits without touching the triangulation. InvalidIndex at Steiner points.
+using FaceInfo = std::array<Index, 3>;
+using FaceBase = CGAL::Delaunay_mesh_face_base_2<Kernel,
+  CGAL::Constrained_triangulation_face_base_2<Kernel, CGAL::Triangulation_face_base_with_info_2<FaceInfo, Kernel>>>;
 using DataStructure = CGAL::Triangulation_data_structure_2<VertexBase, FaceBase>;
 using Triangulation = CGAL::Constrained_Delaunay_triangulation_2<Kernel, DataStructure>;
 using Criteria = CGAL::Delaunay_mesh_size_criteria_2<Triangulation>;
@@ -80,13 +90,15 @@ double PerimeterCoordinate(double u, double v, int mask)
   return 3 + (1 - v);
 }
 
-// tan(a/2) for the angle a between vectors (ax, ay) and (bx, by), in the form that stays
-// accurate for small angles: sin a / (1 + cos a).
+// tan(a/2) for the angle a between vectors (ax, ay) and (bx, by): sin a / (1 + cos a) for acute
+// angles, (1 - cos a) / sin a for obtuse ones, so that neither cancels (a point split onto an
+// edge next to a thin channel sees that edge's neighbours at almost 180 degrees).
 double HalfAngleTangent(double ax, double ay, double bx, double by)
 {
   const double cross = std::abs(ax * by - ay * bx);
   const double dot = ax * bx + ay * by;
-  return cross / (std::hypot(ax, ay) * std::hypot(bx, by) + dot);
+  const double lengths = std::hypot(ax, ay) * std::hypot(bx, by);
+  return dot >= 0 ? cross / (lengths + dot) : (lengths - dot) / cross;
 }
 
 // What CGAL::refine_Delaunay_mesh_2_without_edge_refinement(cdt, criteria) does, except that
@@ -112,13 +124,239 @@ void ResetVertexIndices(Triangulation& cdt, const std::vector<VertexHandle>& bou
   }
 }
 
-// Midpoints of the interior edges whose end points are boundary samples on a common side of
-// the square. Mean value coordinates map such an edge onto that side, and the part of the
+// The boundary walk with equal coordinates identified.
+struct BoundaryGraph
+{
+  std::vector<Index> PointOf;      // sample -> distinct point
+  std::size_t PointCount = 0;
+  std::vector<Index> Loop;         // one sample per outer loop point, in walk order
+  // Distinct undirected edges as point pairs: the Loop.size() loop edges, then the slit edges.
+  std::vector<std::pair<Index, Index>> Edges;
+};
+
+// Splits the walk into the outer loop and slits. A slit is retraced: ..., x, y, x, ... steps
+// out along edge xy and straight back. Cancelling such back-and-forth steps until none is left
+// (cyclically, since slits may wrap around the start of the sequence) leaves the outer loop,
+// which must visit distinct points. The cancelled edges must be traversed exactly once each
+// way and form trees hanging from the loop (as many edges as non-loop points: contracting the
+// loop to one vertex leaves a connected graph, so it is a tree). Geometry is checked later.
+bool AnalyzeBoundary(const double* xy, std::size_t n, BoundaryGraph& graph, std::string& error)
+{
+  // Exact comparison: a slit retraces bit-identical samples.
+  std::vector<Index> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  auto less = [xy](Index a, Index b) {
+    return std::make_tuple(xy[2 * a], xy[2 * a + 1], a) < std::make_tuple(xy[2 * b], xy[2 * b + 1], b);
+  };
+  std::sort(order.begin(), order.end(), less);
+  graph.PointOf.assign(n, 0);
+  graph.PointCount = 0;
+  for (std::size_t k = 0; k < n; ++k)
+  {
+    const Index i = order[k];
+    if (k == 0 || xy[2 * i] != xy[2 * order[k - 1]] || xy[2 * i + 1] != xy[2 * order[k - 1] + 1])
+    {
+      ++graph.PointCount;
+    }
+    graph.PointOf[i] = static_cast<Index>(graph.PointCount - 1);
+  }
+  const std::vector<Index>& point = graph.PointOf;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    if (point[i] == point[(i + 1) % n])
+    {
+      std::ostringstream message;
+      message << "TwoCellParameterization: samples " << i << " and " << (i + 1) % n
+              << " are the same point (zero-length boundary edge)";
+      error = message.str();
+      return false;
+    }
+  }
+
+  // Cancel x y x -> x along the sequence, then across its wrap-around.
+  std::vector<Index> stack;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    if (stack.size() >= 2 && point[stack[stack.size() - 2]] == point[i])
+    {
+      stack.pop_back();
+    }
+    else
+    {
+      stack.push_back(static_cast<Index>(i));
+    }
+  }
+  std::size_t head = 0;
+  while (stack.size() - head >= 3)
+  {
+    if (point[stack[stack.size() - 2]] == point[stack[head]])
+    {
+      stack.resize(stack.size() - 2); // ... x y | x ...
+    }
+    else if (point[stack.back()] == point[stack[head + 1]])
+    {
+      head += 2; // ... x | y x ...
+    }
+    else
+    {
+      break;
+    }
+  }
+  graph.Loop.assign(stack.begin() + head, stack.end());
+  const std::size_t loopSize = graph.Loop.size();
+  if (loopSize < 3)
+  {
+    error = "TwoCellParameterization: the boundary encloses no area (it only runs out and back along slits)";
+    return false;
+  }
+  std::vector<char> onLoop(graph.PointCount, 0);
+  for (const Index s : graph.Loop)
+  {
+    if (onLoop[point[s]])
+    {
+      std::ostringstream message;
+      message << "TwoCellParameterization: the boundary touches itself at sample " << s
+              << " (a repeated point that is not on a slit retraced straight back)";
+      error = message.str();
+      return false;
+    }
+    onLoop[point[s]] = 1;
+  }
+
+  // Every walk step, as (smaller point, larger point, forward): count the traversals per edge.
+  std::vector<std::tuple<Index, Index, bool>> steps(n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const Index a = point[i], b = point[(i + 1) % n];
+    steps[i] = std::make_tuple(std::min(a, b), std::max(a, b), a < b);
+  }
+  std::sort(steps.begin(), steps.end());
+  graph.Edges.clear();
+  for (std::size_t k = 0; k < loopSize; ++k)
+  {
+    graph.Edges.emplace_back(point[graph.Loop[k]], point[graph.Loop[(k + 1) % loopSize]]);
+  }
+  std::size_t singles = 0;
+  bool valid = true;
+  for (std::size_t k = 0; k < n && valid;)
+  {
+    std::size_t end = k;
+    int forward = 0;
+    while (end < n && std::get<0>(steps[end]) == std::get<0>(steps[k]) && std::get<1>(steps[end]) == std::get<1>(steps[k]))
+    {
+      forward += std::get<2>(steps[end]) ? 1 : 0;
+      ++end;
+    }
+    if (end - k == 1)
+    {
+      ++singles;
+    }
+    else if (end - k == 2 && forward == 1)
+    {
+      graph.Edges.emplace_back(std::get<0>(steps[k]), std::get<1>(steps[k]));
+    }
+    else
+    {
+      valid = false;
+    }
+    k = end;
+  }
+  const std::size_t slitEdges = graph.Edges.size() - loopSize;
+  if (!valid || singles != loopSize || slitEdges != graph.PointCount - loopSize)
+  {
+    error = "TwoCellParameterization: the boundary repeats points but is not an outer loop with slits "
+            "(trees retraced straight back, each touching the loop at one point)";
+    return false;
+  }
+  return true;
+}
+
+// Cuts the mesh open along the slits: gives every corner of a domain face at a boundary vertex
+// the sample (visit of that vertex) of the wedge it lies in. With the cell on the left of a
+// counter-clockwise walk, visit i of vertex v owns the faces swept counter-clockwise around v
+// from edge (v, next sample) to edge (v, previous sample) (for a clockwise walk from previous to
+// next). Boundary and slit edges are exactly the constrained edges, so the sweep stops at the
+// first constrained edge, which must be the expected one. At a slit tip next = previous and the
+// sweep goes all around. False if the wedges do not match the walk (slits visited in an order
+// that does not follow their geometry around a vertex).
+bool AssignBoundaryCorners(Triangulation& cdt, const std::vector<VertexHandle>& boundary, int orientation)
+{
+  for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f)
+  {
+    f->info().fill(InvalidIndex);
+  }
+  const std::size_t n = boundary.size();
+  std::vector<std::pair<FaceHandle, int>> firstCorner(n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const VertexHandle v = boundary[i];
+    const VertexHandle next = boundary[(i + 1) % n], previous = boundary[(i + n - 1) % n];
+    const VertexHandle from = orientation > 0 ? next : previous, to = orientation > 0 ? previous : next;
+    FaceHandle f;
+    int k;
+    if (!cdt.is_edge(v, from, f, k))
+    {
+      return false;
+    }
+    int j = f->index(v);
+    if (f->vertex(Triangulation::ccw(j)) != from)
+    {
+      f = f->neighbor(k);
+      j = f->index(v);
+    }
+    firstCorner[i] = { f, j };
+    for (;;)
+    {
+      if (cdt.is_infinite(f) || !f->is_in_domain() || f->info()[j] != InvalidIndex)
+      {
+        return false;
+      }
+      f->info()[j] = static_cast<Index>(i);
+      if (f->is_constrained(Triangulation::ccw(j)))
+      {
+        if (f->vertex(Triangulation::cw(j)) != to)
+        {
+          return false;
+        }
+        break;
+      }
+      f = f->neighbor(Triangulation::ccw(j));
+      j = f->index(v);
+    }
+  }
+  // The face starting visit i's wedge has the edge to the neighbouring visit: it must end that
+  // visit's wedge, so that the border of the cut mesh is the walk itself...
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const std::size_t neighbor = orientation > 0 ? (i + 1) % n : (i + n - 1) % n;
+    if (firstCorner[i].first->info()[Triangulation::ccw(firstCorner[i].second)] != static_cast<Index>(neighbor))
+    {
+      return false;
+    }
+  }
+  // ... and every boundary corner of the domain belongs to a visit.
+  for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      if (f->is_in_domain() && f->vertex(k)->info() != InvalidIndex && f->info()[k] == InvalidIndex)
+      {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+// The interior edges of the cut mesh whose end points are boundary samples on a common side
+// of the square. Mean value coordinates map such an edge onto that side, and the part of the
 // cell it cuts off (only boundary vertices of that side, plus interior vertices that become
 // convex combinations of them) collapses: Floater's one-to-one theorem excludes exactly them.
-std::vector<Point> DividingEdgeMidpoints(const Triangulation& cdt, const std::vector<int>& sideMasks)
+// The samples are the visits of the face corners (AssignBoundaryCorners), so on a slit the
+// side of the square of the edge's own side of the slit counts.
+std::vector<std::pair<VertexHandle, VertexHandle>> DividingEdges(const Triangulation& cdt, const std::vector<int>& sideMasks)
 {
-  std::vector<Point> midpoints;
+  std::vector<std::pair<VertexHandle, VertexHandle>> edges;
   for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f)
   {
     if (!f->is_in_domain())
@@ -132,26 +370,38 @@ std::vector<Point> DividingEdgeMidpoints(const Triangulation& cdt, const std::ve
       {
         continue;
       }
-      // Each interior edge is seen from both faces: keep one.
-      if (&*neighbor < &*f)
+      // Each interior edge is seen from both faces, with its end points swapped: keep one
+      // (by sample index rather than face address, so that the fixes do not depend on the
+      // allocator).
+      const Index ia = f->info()[Triangulation::cw(i)];
+      const Index ib = f->info()[Triangulation::ccw(i)];
+      if (ia != InvalidIndex && ib != InvalidIndex && ia < ib && (sideMasks[ia] & sideMasks[ib]))
       {
-        continue;
-      }
-      const VertexHandle a = f->vertex(Triangulation::cw(i));
-      const VertexHandle b = f->vertex(Triangulation::ccw(i));
-      const Index ia = a->info();
-      const Index ib = b->info();
-      if (ia == InvalidIndex || ib == InvalidIndex)
-      {
-        continue;
-      }
-      if (sideMasks[ia] & sideMasks[ib])
-      {
-        midpoints.push_back(CGAL::midpoint(a->point(), b->point()));
+        edges.emplace_back(f->vertex(Triangulation::cw(i)), f->vertex(Triangulation::ccw(i)));
       }
     }
   }
-  return midpoints;
+  return edges;
+}
+
+// Splits the edges at their midpoints; returns the number of points inserted. The point is
+// inserted *on* the edge: the rounded midpoint may be an ulp off it, and on a tiny edge (a
+// thin channel) a point merely near it need not conflict with both of its triangles, so the
+// edge could survive. An edge already flipped away by an earlier insertion is skipped.
+int SplitEdges(Triangulation& cdt, const std::vector<std::pair<VertexHandle, VertexHandle>>& edges)
+{
+  int inserted = 0;
+  for (const auto& edge : edges)
+  {
+    FaceHandle f;
+    int i;
+    if (cdt.is_edge(edge.first, edge.second, f, i))
+    {
+      cdt.insert(CGAL::midpoint(edge.first->point(), edge.second->point()), Triangulation::EDGE, f, i);
+      ++inserted;
+    }
+  }
+  return inserted;
 }
 } // namespace
 
@@ -159,9 +409,8 @@ bool TwoCellParameterization::Parameterize(
   const std::vector<double>& boundaryPoints, const std::vector<double>& boundaryParameters, std::string& error)
 {
   this->Mesh = TwoCellMesh();
-  this->BucketStart.clear();
-  this->BucketTriangles.clear();
-  this->GridSize[0] = this->GridSize[1] = 0;
+  this->PointGrid = BucketGrid();
+  this->ParameterGrid = BucketGrid();
 
   // --- Validate the boundary ---------------------------------------------------------------
   if (boundaryPoints.size() % 2 != 0 || boundaryPoints.size() != boundaryParameters.size())
@@ -242,38 +491,44 @@ bool TwoCellParameterization::Parameterize(
   }
   const int parameterOrientation = winding > 0 ? 1 : -1;
 
-  std::vector<Point> polygon(n);
-  double bounds[4] = { xy[0], xy[0], xy[1], xy[1] };
-  double perimeter = 0;
+  // --- Outer loop and slits -----------------------------------------------------------------
+  BoundaryGraph graph;
+  if (!AnalyzeBoundary(xy, n, graph, error))
+  {
+    return false;
+  }
+  const std::size_t loopSize = graph.Loop.size();
+  const bool hasSlits = loopSize < n;
+  std::vector<Point> loop(loopSize);
+  for (std::size_t k = 0; k < loopSize; ++k)
+  {
+    loop[k] = Point(xy[2 * graph.Loop[k]], xy[2 * graph.Loop[k] + 1]);
+  }
+  // Exact predicates: touching or crossing edges and collinear (zero-area) loops are all "not
+  // simple". (Repeated points were refused above unless they are on slits.)
+  if (!CGAL::is_simple_2(loop.begin(), loop.end(), Kernel()))
+  {
+    error = hasSlits ? "TwoCellParameterization: the outer loop of the boundary (without its slits) is not simple "
+                       "(self-touching, self-crossing or zero area)"
+                     : "TwoCellParameterization: the boundary polygon is not simple (self-touching, self-crossing "
+                       "or zero area)";
+    return false;
+  }
+  const int polygonOrientation = CGAL::orientation_2(loop.begin(), loop.end(), Kernel()) == CGAL::LEFT_TURN ? 1 : -1;
+  double signedArea = 0;
+  for (std::size_t k = 0; k < loopSize; ++k)
+  {
+    const Point& p = loop[k];
+    const Point& q = loop[(k + 1) % loopSize];
+    signedArea += p.x() * q.y() - q.x() * p.y();
+  }
+  const double area = std::abs(signedArea) / 2;
+  double perimeter = 0; // of the whole walk: slit edges count twice, as they have two sides
   for (std::size_t i = 0; i < n; ++i)
   {
-    polygon[i] = Point(xy[2 * i], xy[2 * i + 1]);
-    bounds[0] = std::min(bounds[0], xy[2 * i]);
-    bounds[1] = std::max(bounds[1], xy[2 * i]);
-    bounds[2] = std::min(bounds[2], xy[2 * i + 1]);
-    bounds[3] = std::max(bounds[3], xy[2 * i + 1]);
     const std::size_t j = (i + 1) % n;
     perimeter += std::hypot(xy[2 * j] - xy[2 * i], xy[2 * j + 1] - xy[2 * i + 1]);
   }
-  // Exact predicates: repeated points, touching or crossing edges and collinear (zero-area)
-  // polygons are all "not simple". A pouch cell whose boundary runs twice along the same
-  // 1-cell (a slit) lands here too: its slit vertices would need two (u, v) each, which a
-  // single triangulation vertex cannot carry; the caller has to open the slit first.
-  if (!CGAL::is_simple_2(polygon.begin(), polygon.end(), Kernel()))
-  {
-    error = "TwoCellParameterization: the boundary polygon is not simple (repeated points, self-touching or "
-            "self-crossing, e.g. a pouch cell's slit, or zero area)";
-    return false;
-  }
-  double signedArea = 0;
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    const std::size_t j = (i + 1) % n;
-    signedArea += xy[2 * i] * xy[2 * j + 1] - xy[2 * j] * xy[2 * i + 1];
-  }
-  signedArea /= 2;
-  const int polygonOrientation = CGAL::orientation_2(polygon.begin(), polygon.end(), Kernel()) == CGAL::LEFT_TURN ? 1 : -1;
-  const double area = std::abs(signedArea);
 
   double edgeLength = this->TargetEdgeLength > 0 ? this->TargetEdgeLength : perimeter / static_cast<double>(n);
   // An equilateral triangle of side s covers sqrt(3)/4 s^2, and there are about twice as many
@@ -289,66 +544,108 @@ bool TwoCellParameterization::Parameterize(
   try
   {
     // --- Constrained Delaunay triangulation and refinement ---------------------------------
+    // One vertex per distinct point; the loop and slit edges are the constraints (slit edges
+    // are interior constraints, with the domain on both sides).
     Triangulation cdt;
-    std::vector<VertexHandle> boundary(n);
+    std::vector<VertexHandle> pointVertex(graph.PointCount);
+    std::vector<VertexHandle> boundary(n); // per sample; the visits of a slit point share one
     VertexHandle hint;
     for (std::size_t i = 0; i < n; ++i)
     {
-      boundary[i] = cdt.insert(polygon[i], hint == VertexHandle() ? FaceHandle() : hint->face());
-      hint = boundary[i];
+      VertexHandle& v = pointVertex[graph.PointOf[i]];
+      if (v == VertexHandle())
+      {
+        v = cdt.insert(Point(xy[2 * i], xy[2 * i + 1]), hint == VertexHandle() ? FaceHandle() : hint->face());
+        hint = v;
+      }
+      boundary[i] = v;
     }
-    for (std::size_t i = 0; i < n; ++i)
+    for (const auto& edge : graph.Edges)
     {
-      cdt.insert_constraint(boundary[i], boundary[(i + 1) % n]);
+      cdt.insert_constraint(pointVertex[edge.first], pointVertex[edge.second]);
     }
-    if (cdt.number_of_vertices() != n)
+    if (cdt.number_of_vertices() != graph.PointCount)
     {
       error = "TwoCellParameterization: boundary samples merged in the triangulation";
       this->Mesh = TwoCellMesh();
       return false;
     }
+    // A constraint through another sample is split there: a slit touching the loop or another
+    // slit, or (without slits) a sample on an edge, which is_simple_2 already refused.
+    for (const auto& edge : graph.Edges)
+    {
+      if (!cdt.is_edge(pointVertex[edge.first], pointVertex[edge.second]))
+      {
+        error = "TwoCellParameterization: a slit touches the outer loop or another slit";
+        this->Mesh = TwoCellMesh();
+        return false;
+      }
+    }
+    if (hasSlits)
+    {
+      // The domain is what the loop encloses (faces not reachable from the infinite face
+      // without crossing a constraint): a slit edge must have it on both sides.
+      Mesher::mark_convex_hull(cdt);
+      for (std::size_t e = loopSize; e < graph.Edges.size(); ++e)
+      {
+        FaceHandle f;
+        int k;
+        cdt.is_edge(pointVertex[graph.Edges[e].first], pointVertex[graph.Edges[e].second], f, k);
+        if (!f->is_in_domain() || !f->neighbor(k)->is_in_domain())
+        {
+          error = "TwoCellParameterization: a slit lies outside the outer loop of the boundary";
+          this->Mesh = TwoCellMesh();
+          return false;
+        }
+      }
+    }
     // Delaunay refinement is only guaranteed to end for a smallest angle up to ~20.7 degrees
-    // (b = 0.125); a larger bound could refine forever.
+    // (b = 0.125); a larger bound could refine forever. Points that would encroach upon a
+    // constraint (boundary or slit) are not inserted, so constraints are never split.
     const double shapeBound = this->ShapeBound > 0 ? std::min(this->ShapeBound, 0.125) : 0.0;
     const Criteria criteria(shapeBound, edgeLength);
     Refine(cdt, criteria);
 
-    // --- Remove dividing edges ---------------------------------------------------------------
+    // --- Cut open along the slits, remove dividing edges ------------------------------------
     // Inserting a point on an edge removes that edge, and every edge a Delaunay insertion
     // creates ends at the new point: neither the fix nor the re-refinement can create another
-    // dividing edge, so the rounds end.
+    // dividing edge, so one round suffices (the others are a guard).
     int round = 0;
     for (;; ++round)
     {
       ResetVertexIndices(cdt, boundary);
-      const std::vector<Point> midpoints = DividingEdgeMidpoints(cdt, sideMasks);
-      if (midpoints.empty())
+      if (!AssignBoundaryCorners(cdt, boundary, polygonOrientation))
+      {
+        error = "TwoCellParameterization: the mesh cannot be cut open along the slits so that its border is the "
+                "boundary walk (slits visited in an order that does not match their geometry)";
+        this->Mesh = TwoCellMesh();
+        return false;
+      }
+      const std::vector<std::pair<VertexHandle, VertexHandle>> dividing = DividingEdges(cdt, sideMasks);
+      if (dividing.empty())
       {
         break;
       }
       if (round >= this->MaximumFixRounds)
       {
         std::ostringstream message;
-        message << "TwoCellParameterization: " << midpoints.size() << " dividing edges remain after "
+        message << "TwoCellParameterization: " << dividing.size() << " dividing edges remain after "
                 << this->MaximumFixRounds << " rounds of fixes";
         error = message.str();
         this->Mesh = TwoCellMesh();
         return false;
       }
-      for (const Point& p : midpoints)
-      {
-        cdt.insert(p);
-      }
-      mesh.DividingEdgeFixes += static_cast<int>(midpoints.size());
+      mesh.DividingEdgeFixes += SplitEdges(cdt, dividing);
       // Re-marks the domain (new faces are not marked) and restores the size and shape.
       Refine(cdt, criteria);
     }
 
     // --- Output: boundary vertices first, in input order ---------------------------------------
+    // Boundary corners take the sample of their wedge (so each visit of a slit point is its own
+    // vertex), Steiner points are numbered as they are met.
     mesh.BoundaryCount = static_cast<Index>(n);
     mesh.Points.assign(xy, xy + 2 * n);
     mesh.Parameters.assign(uv, uv + 2 * n);
-    std::vector<char> boundaryUsed(n, 0);
     for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f)
     {
       if (!f->is_in_domain())
@@ -357,30 +654,28 @@ bool TwoCellParameterization::Parameterize(
       }
       for (int k = 0; k < 3; ++k)
       {
-        const VertexHandle v = f->vertex(k);
-        if (v->info() == InvalidIndex)
+        Index corner = f->info()[k];
+        if (corner == InvalidIndex)
         {
-          v->info() = mesh.NumberOfPoints();
-          mesh.Points.push_back(v->point().x());
-          mesh.Points.push_back(v->point().y());
+          const VertexHandle v = f->vertex(k);
+          if (v->info() == InvalidIndex)
+          {
+            v->info() = mesh.NumberOfPoints();
+            mesh.Points.push_back(v->point().x());
+            mesh.Points.push_back(v->point().y());
+          }
+          corner = v->info();
         }
-        else if (v->info() < static_cast<Index>(n))
-        {
-          boundaryUsed[v->info()] = 1;
-        }
-        mesh.Triangles.push_back(v->info());
-      }
-    }
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      if (!boundaryUsed[i] || !cdt.is_edge(boundary[i], boundary[(i + 1) % n]))
-      {
-        error = "TwoCellParameterization: the triangulation does not keep the boundary samples and edges";
-        this->Mesh = TwoCellMesh();
-        return false;
+        mesh.Triangles.push_back(corner);
       }
     }
     mesh.Parameters.resize(mesh.Points.size(), 0);
+  }
+  catch (const Triangulation::Intersection_of_constraints_exception&)
+  {
+    error = "TwoCellParameterization: the boundary crosses itself (a slit crosses the outer loop or another slit)";
+    this->Mesh = TwoCellMesh();
+    return false;
   }
   catch (const std::exception& e)
   {
@@ -514,42 +809,44 @@ bool TwoCellParameterization::Parameterize(
     return false;
   }
 
-  this->BuildLocator();
+  BuildGrid(mesh.Points, mesh.Triangles, this->PointGrid);
+  BuildGrid(mesh.Parameters, mesh.Triangles, this->ParameterGrid);
   return true;
 }
 
-void TwoCellParameterization::BuildLocator()
+void TwoCellParameterization::BuildGrid(
+  const std::vector<double>& coordinates, const std::vector<Index>& triangleList, BucketGrid& grid)
 {
-  const TwoCellMesh& mesh = this->Mesh;
-  const Index triangles = mesh.NumberOfTriangles();
-  double bounds[4] = { mesh.Points[0], mesh.Points[0], mesh.Points[1], mesh.Points[1] };
-  for (Index i = 0; i < mesh.NumberOfPoints(); ++i)
+  const Index points = static_cast<Index>(coordinates.size() / 2);
+  const Index triangles = static_cast<Index>(triangleList.size() / 3);
+  double bounds[4] = { coordinates[0], coordinates[0], coordinates[1], coordinates[1] };
+  for (Index i = 0; i < points; ++i)
   {
-    bounds[0] = std::min(bounds[0], mesh.Points[2 * i]);
-    bounds[1] = std::max(bounds[1], mesh.Points[2 * i]);
-    bounds[2] = std::min(bounds[2], mesh.Points[2 * i + 1]);
-    bounds[3] = std::max(bounds[3], mesh.Points[2 * i + 1]);
+    bounds[0] = std::min(bounds[0], coordinates[2 * i]);
+    bounds[1] = std::max(bounds[1], coordinates[2 * i]);
+    bounds[2] = std::min(bounds[2], coordinates[2 * i + 1]);
+    bounds[3] = std::max(bounds[3], coordinates[2 * i + 1]);
   }
   const double width = std::max(bounds[1] - bounds[0], 1e-300);
   const double height = std::max(bounds[3] - bounds[2], 1e-300);
-  this->LocateTolerance = 1e-9 * std::max(width, height);
+  grid.Tolerance = 1e-9 * std::max(width, height);
   // About one triangle per grid cell, cells roughly square, at most 1024 a side (thin cells
   // get a thin grid).
   const double cellSize = std::sqrt(width * height / std::max<Index>(triangles, 1));
   for (int d = 0; d < 2; ++d)
   {
     const double extent = d == 0 ? width : height;
-    this->GridSize[d] = static_cast<int>(std::min(1024.0, std::max(1.0, std::ceil(extent / cellSize))));
-    this->GridOrigin[d] = bounds[2 * d] - this->LocateTolerance;
-    this->GridCellSize[d] = (extent + 2 * this->LocateTolerance) / this->GridSize[d];
+    grid.Size[d] = static_cast<int>(std::min(1024.0, std::max(1.0, std::ceil(extent / cellSize))));
+    grid.Origin[d] = bounds[2 * d] - grid.Tolerance;
+    grid.CellSize[d] = (extent + 2 * grid.Tolerance) / grid.Size[d];
   }
-  auto cellOf = [this](double value, int d) {
-    const double c = std::floor((value - this->GridOrigin[d]) / this->GridCellSize[d]);
-    return static_cast<int>(std::min<double>(std::max(c, 0.0), this->GridSize[d] - 1));
+  auto cellOf = [&grid](double value, int d) {
+    const double c = std::floor((value - grid.Origin[d]) / grid.CellSize[d]);
+    return static_cast<int>(std::min<double>(std::max(c, 0.0), grid.Size[d] - 1));
   };
-  const std::size_t cells = static_cast<std::size_t>(this->GridSize[0]) * this->GridSize[1];
+  const std::size_t cells = static_cast<std::size_t>(grid.Size[0]) * grid.Size[1];
   std::vector<int> ranges(4 * static_cast<std::size_t>(triangles));
-  this->BucketStart.assign(cells + 1, 0);
+  grid.Start.assign(cells + 1, 0);
   for (int pass = 0; pass < 2; ++pass)
   {
     std::vector<Index> fill;
@@ -557,41 +854,41 @@ void TwoCellParameterization::BuildLocator()
     {
       for (std::size_t c = 0; c < cells; ++c)
       {
-        this->BucketStart[c + 1] += this->BucketStart[c];
+        grid.Start[c + 1] += grid.Start[c];
       }
-      this->BucketTriangles.resize(this->BucketStart[cells]);
-      fill.assign(this->BucketStart.begin(), this->BucketStart.end() - 1);
+      grid.Triangles.resize(grid.Start[cells]);
+      fill.assign(grid.Start.begin(), grid.Start.end() - 1);
     }
     for (Index t = 0; t < triangles; ++t)
     {
       int* range = &ranges[4 * t];
       if (pass == 0)
       {
-        const Index* tri = &mesh.Triangles[3 * t];
+        const Index* tri = &triangleList[3 * t];
         for (int d = 0; d < 2; ++d)
         {
-          double lo = mesh.Points[2 * tri[0] + d], hi = lo;
+          double lo = coordinates[2 * tri[0] + d], hi = lo;
           for (int k = 1; k < 3; ++k)
           {
-            lo = std::min(lo, mesh.Points[2 * tri[k] + d]);
-            hi = std::max(hi, mesh.Points[2 * tri[k] + d]);
+            lo = std::min(lo, coordinates[2 * tri[k] + d]);
+            hi = std::max(hi, coordinates[2 * tri[k] + d]);
           }
-          range[2 * d] = cellOf(lo - this->LocateTolerance, d);
-          range[2 * d + 1] = cellOf(hi + this->LocateTolerance, d);
+          range[2 * d] = cellOf(lo - grid.Tolerance, d);
+          range[2 * d + 1] = cellOf(hi + grid.Tolerance, d);
         }
       }
       for (int cy = range[2]; cy <= range[3]; ++cy)
       {
         for (int cx = range[0]; cx <= range[1]; ++cx)
         {
-          const std::size_t c = static_cast<std::size_t>(cy) * this->GridSize[0] + cx;
+          const std::size_t c = static_cast<std::size_t>(cy) * grid.Size[0] + cx;
           if (pass == 0)
           {
-            ++this->BucketStart[c + 1];
+            ++grid.Start[c + 1];
           }
           else
           {
-            this->BucketTriangles[fill[c]++] = t;
+            grid.Triangles[fill[c]++] = t;
           }
         }
       }
@@ -599,10 +896,27 @@ void TwoCellParameterization::BuildLocator()
   }
 }
 
-bool TwoCellParameterization::Locate(double x, double y, Index& triangle, double barycentric[3]) const
+namespace
+{
+double DistanceToSegment(double x, double y, const double* a, const double* b)
+{
+  const double dx = b[0] - a[0], dy = b[1] - a[1];
+  const double t = std::max(0.0, std::min(1.0, ((x - a[0]) * dx + (y - a[1]) * dy) / (dx * dx + dy * dy)));
+  return std::hypot(x - a[0] - t * dx, y - a[1] - t * dy);
+}
+
+// For a point outside the triangle.
+double DistanceToTriangle(double x, double y, const double* a, const double* b, const double* c)
+{
+  return std::min(DistanceToSegment(x, y, a, b), std::min(DistanceToSegment(x, y, b, c), DistanceToSegment(x, y, c, a)));
+}
+} // namespace
+
+bool TwoCellParameterization::LocateInGrid(const BucketGrid& grid, const std::vector<double>& coordinates,
+  const std::vector<Index>& triangleList, int orientation, double x, double y, Index& triangle, double barycentric[3])
 {
   triangle = InvalidIndex;
-  if (this->GridSize[0] == 0 || !std::isfinite(x) || !std::isfinite(y))
+  if (grid.Size[0] == 0 || !std::isfinite(x) || !std::isfinite(y))
   {
     return false;
   }
@@ -610,41 +924,59 @@ bool TwoCellParameterization::Locate(double x, double y, Index& triangle, double
   int cell[2];
   for (int d = 0; d < 2; ++d)
   {
-    const double c = std::floor((position[d] - this->GridOrigin[d]) / this->GridCellSize[d]);
-    if (c < 0 || c >= this->GridSize[d])
+    const double c = std::floor((position[d] - grid.Origin[d]) / grid.CellSize[d]);
+    if (c < 0 || c >= grid.Size[d])
     {
       return false;
     }
     cell[d] = static_cast<int>(c);
   }
-  const std::size_t c = static_cast<std::size_t>(cell[1]) * this->GridSize[0] + cell[0];
-  const TwoCellMesh& mesh = this->Mesh;
+  const std::size_t c = static_cast<std::size_t>(cell[1]) * grid.Size[0] + cell[0];
   // The triangle in which (x, y) is deepest (largest smallest barycentric coordinate, scaled
   // to a distance) wins, so that points on shared edges get a definite answer.
   double best = -std::numeric_limits<double>::infinity();
-  for (Index k = this->BucketStart[c]; k < this->BucketStart[c + 1]; ++k)
+  for (Index k = grid.Start[c]; k < grid.Start[c + 1]; ++k)
   {
-    const Index t = this->BucketTriangles[k];
-    const Index* tri = &mesh.Triangles[3 * t];
-    const double* a = &mesh.Points[2 * tri[0]];
-    const double* b = &mesh.Points[2 * tri[1]];
-    const double* q = &mesh.Points[2 * tri[2]];
+    const Index t = grid.Triangles[k];
+    const Index* tri = &triangleList[3 * t];
+    const double* a = &coordinates[2 * tri[0]];
+    const double* b = &coordinates[2 * tri[1]];
+    const double* q = &coordinates[2 * tri[2]];
     const double twiceArea = (b[0] - a[0]) * (q[1] - a[1]) - (b[1] - a[1]) * (q[0] - a[0]);
-    if (!(twiceArea > 0))
+    if (!(orientation * twiceArea > 0))
     {
       continue;
     }
+    // Twice the signed areas of the sub-triangles (x, y) + edge, each from its own cross
+    // product: at a vertex two are exactly 0, which 1 - l0 - l1 would not give on a sliver.
     double lambda[3];
-    lambda[0] = ((b[0] - x) * (q[1] - y) - (b[1] - y) * (q[0] - x)) / twiceArea;
-    lambda[1] = ((q[0] - x) * (a[1] - y) - (q[1] - y) * (a[0] - x)) / twiceArea;
-    lambda[2] = 1 - lambda[0] - lambda[1];
-    // Barycentric coordinate times the opposite edge length = distance to that edge.
+    lambda[0] = (b[0] - x) * (q[1] - y) - (b[1] - y) * (q[0] - x);
+    lambda[1] = (q[0] - x) * (a[1] - y) - (q[1] - y) * (a[0] - x);
+    lambda[2] = (a[0] - x) * (b[1] - y) - (a[1] - y) * (b[0] - x);
+    const double sum = lambda[0] + lambda[1] + lambda[2];
+    if (!(orientation * sum > 0))
+    {
+      continue;
+    }
+    // Sub-area over the opposite edge length = signed distance to that edge's line.
     const double edges[3] = { std::hypot(q[0] - b[0], q[1] - b[1]), std::hypot(a[0] - q[0], a[1] - q[1]),
       std::hypot(b[0] - a[0], b[1] - a[1]) };
     double depth = std::numeric_limits<double>::infinity();
     for (int k2 = 0; k2 < 3; ++k2)
     {
-      depth = std::min(depth, lambda[k2] * twiceArea / edges[k2]);
+      depth = std::min(depth, orientation * lambda[k2] / edges[k2]);
+      lambda[k2] /= sum;
+    }
+    if (depth < 0)
+    {
+      // Outside. The distances to the edge *lines* only bound the distance to the triangle
+      // from below: a point far beyond the sharp tip of a sliver is nearly on both long edge
+      // lines. Candidates that can still win are scored by the true distance.
+      if (depth < -grid.Tolerance || depth <= best)
+      {
+        continue;
+      }
+      depth = -DistanceToTriangle(x, y, a, b, q);
     }
     if (depth > best)
     {
@@ -653,7 +985,7 @@ bool TwoCellParameterization::Locate(double x, double y, Index& triangle, double
       std::copy(lambda, lambda + 3, barycentric);
     }
   }
-  if (triangle == InvalidIndex || best < -this->LocateTolerance)
+  if (triangle == InvalidIndex || best < -grid.Tolerance)
   {
     triangle = InvalidIndex;
     return false;
@@ -673,6 +1005,24 @@ bool TwoCellParameterization::Locate(double x, double y, Index& triangle, double
   return true;
 }
 
+bool TwoCellParameterization::Locate(double x, double y, Index& triangle, double barycentric[3]) const
+{
+  return LocateInGrid(this->PointGrid, this->Mesh.Points, this->Mesh.Triangles, 1, x, y, triangle, barycentric);
+}
+
+namespace
+{
+// Barycentric interpolation of per-vertex pairs over one triangle.
+void Interpolate(const std::vector<double>& values, const Index* tri, const double barycentric[3], double out[2])
+{
+  for (int d = 0; d < 2; ++d)
+  {
+    out[d] = barycentric[0] * values[2 * tri[0] + d] + barycentric[1] * values[2 * tri[1] + d] +
+      barycentric[2] * values[2 * tri[2] + d];
+  }
+}
+} // namespace
+
 bool TwoCellParameterization::Evaluate(double x, double y, double uv[2]) const
 {
   Index triangle;
@@ -681,12 +1031,21 @@ bool TwoCellParameterization::Evaluate(double x, double y, double uv[2]) const
   {
     return false;
   }
-  const Index* tri = &this->Mesh.Triangles[3 * triangle];
-  for (int d = 0; d < 2; ++d)
+  Interpolate(this->Mesh.Parameters, &this->Mesh.Triangles[3 * triangle], barycentric, uv);
+  return true;
+}
+
+bool TwoCellParameterization::InverseEvaluate(double u, double v, double xy[2]) const
+{
+  Index triangle;
+  double barycentric[3];
+  // Triangles are clockwise in (u, v) when Phi is a mirror map.
+  if (!LocateInGrid(this->ParameterGrid, this->Mesh.Parameters, this->Mesh.Triangles, this->Mesh.Orientation, u, v,
+        triangle, barycentric))
   {
-    uv[d] = barycentric[0] * this->Mesh.Parameters[2 * tri[0] + d] +
-      barycentric[1] * this->Mesh.Parameters[2 * tri[1] + d] + barycentric[2] * this->Mesh.Parameters[2 * tri[2] + d];
+    return false;
   }
+  Interpolate(this->Mesh.Points, &this->Mesh.Triangles[3 * triangle], barycentric, xy);
   return true;
 }
 } // namespace topospline

@@ -3,7 +3,13 @@
 // (constrained Delaunay + Delaunay refinement that never splits the boundary, so the boundary
 // vertices are exactly the samples), and every interior vertex gets (u, v) from Floater's mean
 // value coordinates with the boundary fixed on the border of the square. A point location
-// grid then evaluates Phi(x, y) anywhere in the cell, which is what F o Phi needs.
+// grid then evaluates Phi(x, y) anywhere in the cell, which is what F o Phi needs, and a second
+// grid over the square evaluates Phi^-1(u, v).
+//
+// Pouch cells: the boundary walk may run out along a slit (a tree of boundary edges hanging
+// from the outer loop into the cell) and straight back. The mesh is then cut open along the
+// slits, so each visit of a slit sample is its own mesh vertex with its own (u, v), and the
+// cut mesh is a disk whose border is exactly the walk.
 //
 // CGAL stays in the .cxx: its meshing headers cost ~20 s per translation unit.
 #pragma once
@@ -19,7 +25,9 @@ namespace topospline
 struct TwoCellMesh
 {
   // Vertex positions (x, y), interleaved. The first BoundaryCount vertices are the input
-  // samples, in input order; the rest are interior Steiner points.
+  // samples, in input order; the rest are interior Steiner points. A slit sample visited k
+  // times is k vertices with equal (x, y) (the mesh is cut open along the slit); the triangles
+  // on each side of the slit use the copy of that side.
   std::vector<double> Points;
   // (u, v) per vertex, interleaved: the given values on the boundary (bit for bit), mean value
   // coordinates inside.
@@ -62,9 +70,15 @@ public:
   // boundaryPoints: (x, y) of the n samples of the closed boundary, in order (either
   // orientation; a repeated first sample at the end is dropped). boundaryParameters: their
   // (u, v), on the border of the unit square, going monotonically once around it in the same
-  // order. Returns false with a message on invalid or degenerate input (n < 4, non-finite
-  // values, repeated points, self-touching or zero-area polygons such as a pouch cell's slit,
-  // (u, v) off the border or not monotone) or if the map could not be made one-to-one.
+  // order. The walk may contain slits: it goes out along a path into the cell and comes back
+  // along the same samples reversed (bit-identical coordinates), e.g. ..., s, p1, p2, M, p2, p1,
+  // s, ... (s on the outer loop, M the tip; trees of such paths and wrapping around the start of
+  // the sequence are allowed; each visit has its own (u, v)). After identifying equal
+  // coordinates the boundary must be a simple closed outer loop plus trees inside it that touch
+  // the loop at one vertex each and nothing else. Returns false with a message on invalid or
+  // degenerate input (n < 4, non-finite values, a zero-length edge, a self-crossing or
+  // self-touching boundary that is not of this form, zero area, (u, v) off the border or not
+  // monotone) or if the map could not be made one-to-one.
   bool Parameterize(const std::vector<double>& boundaryPoints, const std::vector<double>& boundaryParameters,
     std::string& error);
 
@@ -73,21 +87,35 @@ public:
 
   // Finds the triangle containing (x, y) and its barycentric coordinates. Points on the
   // boundary, or outside by rounding only (relative 1e-9), are found; others return false.
+  // A point on a slit lies in triangles of both sides: either is reported.
   bool Locate(double x, double y, Index& triangle, double barycentric[3]) const;
   // Phi(x, y): the piecewise linear parameterization at (x, y). False outside the cell.
   bool Evaluate(double x, double y, double uv[2]) const;
+  // Phi^-1(u, v): the triangle containing (u, v) in parameter space, its corners' (x, y)
+  // interpolated. (u, v) on the border of the square or outside by rounding only (1e-9) are
+  // found; false outside the square (or before a successful Parameterize).
+  bool InverseEvaluate(double u, double v, double xy[2]) const;
 
 private:
-  void BuildLocator();
+  // Uniform grid over the bounding box of some vertex coordinates; cell c holds the triangles
+  // Triangles[Start[c] .. Start[c+1]) whose bounding boxes (grown by Tolerance) overlap it.
+  struct BucketGrid
+  {
+    double Origin[2] = { 0, 0 };
+    double CellSize[2] = { 1, 1 };
+    int Size[2] = { 0, 0 };
+    double Tolerance = 0;
+    std::vector<Index> Start;
+    std::vector<Index> Triangles;
+  };
+  static void BuildGrid(const std::vector<double>& coordinates, const std::vector<Index>& triangles, BucketGrid& grid);
+  // The triangle of `grid` in which (x, y) lies deepest; orientation is the sign of the
+  // triangles' areas in `coordinates`.
+  static bool LocateInGrid(const BucketGrid& grid, const std::vector<double>& coordinates,
+    const std::vector<Index>& triangles, int orientation, double x, double y, Index& triangle, double barycentric[3]);
 
   TwoCellMesh Mesh;
-  // Uniform grid over the bounding box; cell c holds triangles BucketTriangles[BucketStart[c]
-  // .. BucketStart[c+1]) whose bounding boxes overlap it.
-  double GridOrigin[2] = { 0, 0 };
-  double GridCellSize[2] = { 1, 1 };
-  int GridSize[2] = { 0, 0 };
-  double LocateTolerance = 0;
-  std::vector<Index> BucketStart;
-  std::vector<Index> BucketTriangles;
+  BucketGrid PointGrid;     // over (x, y): Locate, Evaluate
+  BucketGrid ParameterGrid; // over (u, v): InverseEvaluate
 };
 } // namespace topospline

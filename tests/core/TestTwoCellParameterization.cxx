@@ -1,7 +1,8 @@
 // Unit tests of the 2-cell parameterization (stage 4, paper section 5.1): triangulation of the
 // cell with the boundary samples as the only boundary vertices, mean value coordinates onto
-// the unit square, the one-to-one check with its dividing-edge fix, point location, and
-// graceful failure on degenerate input.
+// the unit square, the one-to-one check with its dividing-edge fix, point location and its
+// inverse, pouch cells (boundaries with slits, cut open), and graceful failure on degenerate
+// input.
 #include "DeterministicRandom.h"
 #include "TestHarness.h"
 #include "TwoCellParameterization.h"
@@ -300,15 +301,42 @@ int CheckParameterization(const TwoCellParameterization& tcp, const Cell& cell, 
   }
   expect(interiorInside, "interior (u, v) strictly inside (0,1)^2");
 
+  double bounds[4] = { 1e300, -1e300, 1e300, -1e300 };
+  for (Index i = 0; i < n; ++i)
+  {
+    bounds[0] = std::min(bounds[0], cell.Points[2 * i]);
+    bounds[1] = std::max(bounds[1], cell.Points[2 * i]);
+    bounds[2] = std::min(bounds[2], cell.Points[2 * i + 1]);
+    bounds[3] = std::max(bounds[3], cell.Points[2 * i + 1]);
+  }
+  const double size = std::max(bounds[1] - bounds[0], bounds[3] - bounds[2]);
+
   // Point location: vertices and centroids map to their (u, v); random points inside the
-  // polygon are found and land in the square; points well outside are rejected.
-  bool roundTrip = true;
+  // polygon are found and land in the square; points well outside are rejected. A slit
+  // sample is several vertices (one per visit): any of their (u, v) is right.
+  std::map<std::pair<double, double>, std::vector<Index>> copies;
   for (Index i = 0; i < mesh.NumberOfPoints(); ++i)
   {
-    double uv[2];
-    roundTrip = roundTrip && tcp.Evaluate(mesh.Points[2 * i], mesh.Points[2 * i + 1], uv) &&
-      std::abs(uv[0] - mesh.Parameters[2 * i]) < 1e-9 && std::abs(uv[1] - mesh.Parameters[2 * i + 1]) < 1e-9;
+    copies[{ mesh.Points[2 * i], mesh.Points[2 * i + 1] }].push_back(i);
   }
+  bool roundTrip = true, inverseAtVertices = true;
+  for (Index i = 0; i < mesh.NumberOfPoints(); ++i)
+  {
+    double uv[2], xy[2];
+    bool matched = false;
+    if (tcp.Evaluate(mesh.Points[2 * i], mesh.Points[2 * i + 1], uv))
+    {
+      for (const Index j : copies[{ mesh.Points[2 * i], mesh.Points[2 * i + 1] }])
+      {
+        matched = matched ||
+          (std::abs(uv[0] - mesh.Parameters[2 * j]) < 1e-9 && std::abs(uv[1] - mesh.Parameters[2 * j + 1]) < 1e-9);
+      }
+    }
+    roundTrip = roundTrip && matched;
+    inverseAtVertices = inverseAtVertices && tcp.InverseEvaluate(mesh.Parameters[2 * i], mesh.Parameters[2 * i + 1], xy) &&
+      std::hypot(xy[0] - mesh.Points[2 * i], xy[1] - mesh.Points[2 * i + 1]) <= 1e-9 * size;
+  }
+  expect(inverseAtVertices, "InverseEvaluate maps every vertex's (u, v) to its (x, y)");
   for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
   {
     const Index* tri = &mesh.Triangles[3 * t];
@@ -327,16 +355,8 @@ int CheckParameterization(const TwoCellParameterization& tcp, const Cell& cell, 
   }
   expect(roundTrip, "point location round-trips at vertices and centroids");
 
-  double bounds[4] = { 1e300, -1e300, 1e300, -1e300 };
-  for (Index i = 0; i < n; ++i)
-  {
-    bounds[0] = std::min(bounds[0], cell.Points[2 * i]);
-    bounds[1] = std::max(bounds[1], cell.Points[2 * i]);
-    bounds[2] = std::min(bounds[2], cell.Points[2 * i + 1]);
-    bounds[3] = std::max(bounds[3], cell.Points[2 * i + 1]);
-  }
-  const double size = std::max(bounds[1] - bounds[0], bounds[3] - bounds[2]);
   bool insideFound = true, outsideRejected = true;
+  double inverseError = 0, inverseBackward = 0;
   for (int s = 0; s < 300; ++s)
   {
     const double x = random.Uniform(bounds[0] - 0.1 * size, bounds[1] + 0.1 * size);
@@ -351,6 +371,24 @@ int CheckParameterization(const TwoCellParameterization& tcp, const Cell& cell, 
     if (InsidePolygon(cell.Points, x, y))
     {
       insideFound = insideFound && found && uv[0] >= 0 && uv[0] <= 1 && uv[1] >= 0 && uv[1] <= 1;
+      // Phi^-1(Phi(x, y)) = (x, y).
+      double xy[2], back[2];
+      if (found && tcp.InverseEvaluate(uv[0], uv[1], xy) && tcp.Evaluate(xy[0], xy[1], back))
+      {
+        const double forward = std::hypot(xy[0] - x, xy[1] - y) / size;
+        inverseError = std::max(inverseError, forward);
+        // Where Phi squeezes triangles to (u, v) areas near 1e-17 (thin channels along a side),
+        // a rounding of (u, v) moves Phi^-1 by ~1e-7: then the result must still be exact
+        // backwards, Phi(xy) = (u, v).
+        if (forward > 1e-9)
+        {
+          inverseBackward = std::max(inverseBackward, std::hypot(back[0] - uv[0], back[1] - uv[1]));
+        }
+      }
+      else
+      {
+        inverseError = inverseBackward = 1e300;
+      }
     }
     else
     {
@@ -359,6 +397,31 @@ int CheckParameterization(const TwoCellParameterization& tcp, const Cell& cell, 
   }
   expect(insideFound, "random inside points located, (u, v) in the square");
   expect(outsideRejected, "random outside points rejected");
+  expect(inverseError <= 1e-9 || inverseBackward <= 1e-14,
+    "InverseEvaluate(Evaluate(x, y)) = (x, y) at random inside points (1e-9, or exact backwards)");
+  // The corners of the square: the corner samples; outside the square: nothing.
+  bool corners = true;
+  for (int k = 0; k < 4; ++k)
+  {
+    const double corner[2] = { static_cast<double>(k == 1 || k == 2), static_cast<double>(k >= 2) };
+    double xy[2];
+    bool matched = false;
+    if (tcp.InverseEvaluate(corner[0], corner[1], xy))
+    {
+      for (Index i = 0; i < n; ++i)
+      {
+        matched = matched ||
+          (mesh.Parameters[2 * i] == corner[0] && mesh.Parameters[2 * i + 1] == corner[1] &&
+            std::hypot(xy[0] - mesh.Points[2 * i], xy[1] - mesh.Points[2 * i + 1]) <= 1e-12 * size);
+      }
+    }
+    corners = corners && matched;
+  }
+  double xy[2];
+  expect(corners, "InverseEvaluate maps the corners of the square to the corner samples");
+  expect(!tcp.InverseEvaluate(-0.01, 0.5, xy) && !tcp.InverseEvaluate(0.5, 1.01, xy) &&
+      !tcp.InverseEvaluate(std::nan(""), 0.5, xy),
+    "InverseEvaluate rejects (u, v) outside the square");
   return failures;
 }
 
@@ -730,9 +793,14 @@ TEST_CASE(DegenerateInputs)
     line.push_back(0);
   }
   CHECK(Fails(line, square.Parameters, "collinear (zero area)"));
-  // A pouch cell's boundary that runs up a slit and back down the same samples.
-  const std::vector<double> slit = { 0, 0, 1, 0, 2, 0, 2, 1, 2, 2, 1, 2, 1, 1.5, 1, 1, 1, 1.5, 1, 2, 0, 2, 0, 1 };
-  CHECK(Fails(slit, square.Parameters, "slit (self-touching)"));
+  // A pouch cell's boundary that runs down a slit and back up the same samples is accepted
+  // (PouchCells); the same walk with the way back off by one ulp is self-touching.
+  std::vector<double> slit = { 0, 0, 1, 0, 2, 0, 2, 1, 2, 2, 1, 2, 1, 1.5, 1, 1, 1, 1.5, 1, 2, 0, 2, 0, 1 };
+  TwoCellParameterization pouch;
+  std::string pouchError;
+  CHECK(pouch.Parameterize(slit, square.Parameters, pouchError));
+  slit[16] = std::nextafter(1.0, 2.0);
+  CHECK(Fails(slit, square.Parameters, "slit not retraced exactly (self-touching)"));
   // Touching at a single point without repeating a sample: still not simple.
   const std::vector<double> touching = { 0, 0, 1, 0, 2, 0, 2, 1, 2, 2, 1.5, 2, 1.5, 0, 0.5, 2, 0, 2, 0, 1.5, 0, 1, 0, 0.5 };
   CHECK(Fails(touching, square.Parameters, "self-touching at a point"));
@@ -768,6 +836,639 @@ TEST_CASE(DegenerateInputs)
   CHECK(!tcp.Evaluate(0.5, 0.5, uv));
 }
 
+namespace
+{
+// ---- Pouch cells: boundary walks with slits ---------------------------------------------------
+
+// A boundary walk built piece by piece; Corner() makes the last added sample the next corner
+// of the square ((0,0), (1,0), (1,1), (0,1) in walk order, or mirrored).
+struct Walk
+{
+  std::vector<double> Points;
+  std::vector<int> Corners;
+  void Add(const std::pair<double, double>& p)
+  {
+    this->Points.push_back(p.first);
+    this->Points.push_back(p.second);
+  }
+  void Corner() { this->Corners.push_back(static_cast<int>(this->Points.size() / 2) - 1); }
+  Cell Build(bool mirrored = false) const
+  {
+    Cell cell;
+    cell.Points = this->Points;
+    cell.Parameters = SquareParameters(static_cast<int>(this->Points.size() / 2), this->Corners.data(), mirrored);
+    return cell;
+  }
+};
+
+std::pair<double, double> CirclePoint(int k, int count, double radius = 1)
+{
+  const double a = 2 * Pi * k / count;
+  return { radius * std::cos(a), radius * std::sin(a) };
+}
+
+std::pair<double, double> Scaled(const std::pair<double, double>& p, double r)
+{
+  return { r * p.first, r * p.second };
+}
+
+// The brief's pouch: the unit circle (40 samples), a radial slit of 6 samples (base s = c_10 on
+// the circle, 4 inner samples, tip M near the centre). Walk m = c_0, .., s, out to M, back to
+// s, .., c_39; (u, v): m = (0,0), s = (1,0), out along the right side to M = (1,1), back along
+// the top to s = (0,1), down the left side to m. 50 samples, s twice, the inner samples twice.
+Cell InnerPouch(bool mirrored = false)
+{
+  const std::pair<double, double> s = CirclePoint(10, 40);
+  const std::vector<double> radii = { 0.8, 0.6, 0.4, 0.2, 0.05 };
+  Walk walk;
+  for (int k = 0; k <= 10; ++k)
+  {
+    walk.Add(CirclePoint(k, 40));
+    if (k == 0 || k == 10)
+    {
+      walk.Corner();
+    }
+  }
+  for (const double r : radii)
+  {
+    walk.Add(Scaled(s, r)); // the same expression on the way back: bit-identical
+  }
+  walk.Corner();
+  for (int j = 3; j >= 0; --j)
+  {
+    walk.Add(Scaled(s, radii[j]));
+  }
+  walk.Add(s);
+  walk.Corner();
+  for (int k = 11; k < 40; ++k)
+  {
+    walk.Add(CirclePoint(k, 40));
+  }
+  return walk.Build(mirrored);
+}
+
+// The slit wraps around the start of the sequence: m (the tip, near the centre), q_1..q_4 out
+// to s = c_0 on the circle, once around the circle (corner M = c_20) back to s, then q_4..q_1
+// (closing to m). (u, v): m = (0,0), s = (1,0), M = (1,1), s = (0,1).
+Cell WrapPouch()
+{
+  const std::pair<double, double> s = CirclePoint(0, 40);
+  const std::vector<double> radii = { 0.05, 0.2, 0.4, 0.6, 0.8 };
+  Walk walk;
+  for (const double r : radii)
+  {
+    walk.Add(Scaled(s, r));
+    if (r == radii[0])
+    {
+      walk.Corner();
+    }
+  }
+  for (int k = 0; k < 40; ++k)
+  {
+    walk.Add(CirclePoint(k, 40));
+    if (k == 0 || k == 20)
+    {
+      walk.Corner();
+    }
+  }
+  walk.Add(s);
+  walk.Corner();
+  for (int j = 4; j >= 1; --j)
+  {
+    walk.Add(Scaled(s, radii[j]));
+  }
+  return walk.Build();
+}
+
+// Three slits on a 48-sample circle: a single edge (c_6 -> M -> c_6), a tree with a fork
+// hanging from c_24, and a radial slit from c_36. With wrongOrder the walk takes the fork's
+// branches in the order that does not follow their geometry.
+Cell MultiSlitPouch(bool wrongOrder = false)
+{
+  const int count = 48;
+  const std::pair<double, double> b1 = { -0.8, 0 }, b2 = { -0.6, 0 }, b3 = { -0.45, 0.15 }, t1 = { -0.3, 0.3 },
+                                  b4 = { -0.45, -0.15 }, t2 = { -0.3, -0.3 };
+  Walk walk;
+  for (int k = 0; k < count; ++k)
+  {
+    const std::pair<double, double> c = CirclePoint(k, count);
+    walk.Add(c);
+    if (k == 6)
+    {
+      walk.Add(Scaled(c, 0.5));
+      walk.Add(c);
+    }
+    else if (k == 24)
+    {
+      // The cell is on the left: going right along the slit, the upper branch comes first.
+      const std::pair<double, double> first[2] = { wrongOrder ? b4 : b3, wrongOrder ? t2 : t1 };
+      const std::pair<double, double> second[2] = { wrongOrder ? b3 : b4, wrongOrder ? t1 : t2 };
+      for (const auto& p : { b1, b2, first[0], first[1], first[0], b2, second[0], second[1], second[0], b2, b1, c })
+      {
+        walk.Add(p);
+      }
+    }
+    else if (k == 36)
+    {
+      for (const double r : { 0.75, 0.5, 0.3, 0.5, 0.75, 1.0 })
+      {
+        walk.Add(r == 1.0 ? c : Scaled(c, r));
+      }
+    }
+  }
+  const int n = static_cast<int>(walk.Points.size() / 2);
+  walk.Corners = { 0, n / 4, n / 2, (3 * n) / 4 };
+  return walk.Build();
+}
+
+// Two radial slits from the same base c_12 = (0, 1) of a 48-sample circle (the base is
+// visited three times). Arriving from c_11 on the right with the cell on the left, the walk
+// must take the right slit first.
+Cell TwoSlitsOneBase(bool wrongOrder = false)
+{
+  Walk walk;
+  const std::pair<double, double> right[2] = { { 0.1, 0.75 }, { 0.3, 0.2 } }, left[2] = { { -0.1, 0.75 }, { -0.3, 0.2 } };
+  for (int k = 0; k < 48; ++k)
+  {
+    const std::pair<double, double> c = CirclePoint(k, 48);
+    walk.Add(c);
+    if (k == 12)
+    {
+      for (const auto* slit : { wrongOrder ? left : right, wrongOrder ? right : left })
+      {
+        for (const auto& p : { slit[0], slit[1], slit[0], c })
+        {
+          walk.Add(p);
+        }
+      }
+    }
+  }
+  walk.Corners = { 0, 14, 28, 42 };
+  return walk.Build();
+}
+
+Cell Rotated(const Cell& cell, int offset)
+{
+  Cell out;
+  const int n = static_cast<int>(cell.Points.size() / 2);
+  for (int i = 0; i < n; ++i)
+  {
+    const int j = (i + offset) % n;
+    out.Points.insert(out.Points.end(), { cell.Points[2 * j], cell.Points[2 * j + 1] });
+    out.Parameters.insert(out.Parameters.end(), { cell.Parameters[2 * j], cell.Parameters[2 * j + 1] });
+  }
+  return out;
+}
+
+double CellSize(const Cell& cell)
+{
+  double bounds[4] = { 1e300, -1e300, 1e300, -1e300 };
+  for (std::size_t i = 0; i < cell.Points.size() / 2; ++i)
+  {
+    bounds[0] = std::min(bounds[0], cell.Points[2 * i]);
+    bounds[1] = std::max(bounds[1], cell.Points[2 * i]);
+    bounds[2] = std::min(bounds[2], cell.Points[2 * i + 1]);
+    bounds[3] = std::max(bounds[3], cell.Points[2 * i + 1]);
+  }
+  return std::max(bounds[1] - bounds[0], bounds[3] - bounds[2]);
+}
+
+// max |Phi^-1(Phi(x, y)) - (x, y)| / cell size over random points inside the cell (1e300 if
+// one is not found).
+double InverseRoundTripError(const TwoCellParameterization& tcp, const Cell& cell, Random& random, int samples)
+{
+  const double size = CellSize(cell);
+  double lo[2] = { 1e300, 1e300 }, hi[2] = { -1e300, -1e300 };
+  for (std::size_t i = 0; i < cell.Points.size() / 2; ++i)
+  {
+    for (int d = 0; d < 2; ++d)
+    {
+      lo[d] = std::min(lo[d], cell.Points[2 * i + d]);
+      hi[d] = std::max(hi[d], cell.Points[2 * i + d]);
+    }
+  }
+  double worst = 0;
+  for (int found = 0; found < samples;)
+  {
+    const double x = random.Uniform(lo[0], hi[0]), y = random.Uniform(lo[1], hi[1]);
+    if (!InsidePolygon(cell.Points, x, y) || DistanceToPolygon(cell.Points, x, y) < 1e-6 * size)
+    {
+      continue;
+    }
+    ++found;
+    double uv[2], xy[2];
+    if (!tcp.Evaluate(x, y, uv) || !tcp.InverseEvaluate(uv[0], uv[1], xy))
+    {
+      return 1e300;
+    }
+    worst = std::max(worst, std::hypot(xy[0] - x, xy[1] - y) / size);
+  }
+  return worst;
+}
+
+// On a slit: points of a slit edge are located and Phi gives the (u, v) of one of its two
+// sides (at its end points, which may be forks with more visits, CheckParameterization's
+// vertex round trip applies instead), and Phi^-1 of either side's (u, v) gives the point back.
+// Returns the number of slit edges checked, -1 on a failure.
+int CheckSlits(const TwoCellParameterization& tcp, const Cell& cell)
+{
+  const int n = static_cast<int>(cell.Points.size() / 2);
+  const double size = CellSize(cell);
+  const double* p = cell.Points.data();
+  const double* q = cell.Parameters.data();
+  std::map<std::pair<std::pair<double, double>, std::pair<double, double>>, int> steps; // (from, to) -> step
+  for (int i = 0; i < n; ++i)
+  {
+    const int j = (i + 1) % n;
+    steps[{ { p[2 * i], p[2 * i + 1] }, { p[2 * j], p[2 * j + 1] } }] = i;
+  }
+  int checked = 0;
+  for (int i = 0; i < n; ++i)
+  {
+    const int j = (i + 1) % n;
+    const auto back = steps.find({ { p[2 * j], p[2 * j + 1] }, { p[2 * i], p[2 * i + 1] } });
+    if (back == steps.end() || back->second < i)
+    {
+      continue; // not a slit edge, or seen from its other side already
+    }
+    const int k = back->second, l = (k + 1) % n; // the way back: k -> l, with p_k = p_j, p_l = p_i
+    for (const double t : { 0.0, 0.25, 0.5, 1.0 })
+    {
+      const double x = (1 - t) * p[2 * i] + t * p[2 * j], y = (1 - t) * p[2 * i + 1] + t * p[2 * j + 1];
+      double sides[2][2];
+      for (int d = 0; d < 2; ++d)
+      {
+        sides[0][d] = (1 - t) * q[2 * i + d] + t * q[2 * j + d];
+        sides[1][d] = (1 - t) * q[2 * l + d] + t * q[2 * k + d];
+      }
+      double uv[2], xy[2];
+      if (!tcp.Evaluate(x, y, uv))
+      {
+        return -1;
+      }
+      bool oneSide = false;
+      for (int side = 0; side < 2; ++side)
+      {
+        oneSide = oneSide || (std::abs(uv[0] - sides[side][0]) < 1e-9 && std::abs(uv[1] - sides[side][1]) < 1e-9);
+        if (!tcp.InverseEvaluate(sides[side][0], sides[side][1], xy) || std::hypot(xy[0] - x, xy[1] - y) > 1e-9 * size)
+        {
+          return -1;
+        }
+      }
+      if (!oneSide && t != 0 && t != 1)
+      {
+        return -1;
+      }
+    }
+    ++checked;
+  }
+  return checked;
+}
+
+// Parameterize a pouch cell and check everything; prints a line with name and sizes.
+bool RunPouch(const Cell& cell, int expectedOrientation, int expectedSlitEdges, Random& random, const char* name,
+  bool verbose = true)
+{
+  TwoCellParameterization tcp;
+  std::string error;
+  if (!tcp.Parameterize(cell.Points, cell.Parameters, error))
+  {
+    std::printf("  %s: Parameterize failed: %s\n", name, error.c_str());
+    return false;
+  }
+  const TwoCellMesh& mesh = tcp.GetMesh();
+  const int failures = CheckParameterization(tcp, cell, expectedOrientation, random);
+  const int slitEdges = CheckSlits(tcp, cell);
+  const double inverse = InverseRoundTripError(tcp, cell, random, 300);
+  if (verbose || failures || slitEdges != expectedSlitEdges || inverse > 1e-9)
+  {
+    std::printf("  %s: %d samples, %d vertices, %d triangles, %d fixes, min uv area %.2e, %d slit edges ok, "
+                "max |Phi^-1 Phi - id| %.1e, %d failed checks\n",
+      name, static_cast<int>(mesh.BoundaryCount), static_cast<int>(mesh.NumberOfPoints()),
+      static_cast<int>(mesh.NumberOfTriangles()), mesh.DividingEdgeFixes, mesh.MinimumParameterArea, slitEdges, inverse,
+      failures);
+  }
+  return failures == 0 && slitEdges == expectedSlitEdges && inverse <= 1e-9 && mesh.MinimumParameterArea > 0;
+}
+} // namespace
+
+TEST_CASE(PouchCells)
+{
+  Random random(11);
+  const Cell inner = InnerPouch();
+  CHECK(RunPouch(inner, 1, 5, random, "inner slit"));
+  CHECK(RunPouch(WrapPouch(), 1, 5, random, "slit wrapping around the start"));
+  // The same walk started at every sample (the slit cut anywhere by the start), clockwise,
+  // and with (u, v) running clockwise (a mirror map).
+  int rotations = 0;
+  const int n = static_cast<int>(inner.Points.size() / 2);
+  for (int offset = 1; offset < n; ++offset)
+  {
+    rotations += RunPouch(Rotated(inner, offset), 1, 5, random, "rotated inner slit", false) ? 1 : 0;
+  }
+  std::printf("  inner slit started at each of the other %d samples: %d valid\n", n - 1, rotations);
+  CHECK_EQ(rotations, n - 1);
+  Cell clockwise = inner;
+  clockwise.Points = Reversed(inner.Points);
+  clockwise.Parameters = Reversed(inner.Parameters);
+  CHECK(RunPouch(clockwise, 1, 5, random, "clockwise walk"));
+  CHECK(RunPouch(InnerPouch(true), -1, 5, random, "mirrored (u, v)"));
+  // A single-edge slit, a forked tree and a radial slit in one cell; two slits from one base.
+  CHECK(RunPouch(MultiSlitPouch(), 1, 1 + 6 + 3, random, "three slits, one forked"));
+  CHECK(RunPouch(TwoSlitsOneBase(), 1, 4, random, "two slits from one base"));
+  // Refinement off: the cut mesh has boundary vertices only (chords between the slit's banks
+  // and the circle), and the boundary copies alone must still make it a disk.
+  TwoCellParameterization coarse;
+  coarse.TargetEdgeLength = 100;
+  coarse.ShapeBound = 0;
+  std::string error;
+  CHECK(coarse.Parameterize(inner.Points, inner.Parameters, error));
+  std::printf("  inner slit without refinement: %d vertices, %d dividing-edge fixes\n",
+    static_cast<int>(coarse.GetMesh().NumberOfPoints()), coarse.GetMesh().DividingEdgeFixes);
+  CHECK(CheckParameterization(coarse, inner, 1, random) == 0);
+  CHECK(CheckSlits(coarse, inner) == 5);
+
+  // The (x, y) of the two visits of a slit sample are equal, their (u, v) differ; the tip is
+  // one vertex.
+  TwoCellParameterization tcp;
+  CHECK(tcp.Parameterize(inner.Points, inner.Parameters, error));
+  const TwoCellMesh& mesh = tcp.GetMesh();
+  CHECK(mesh.Points[2 * 11] == mesh.Points[2 * 19] && mesh.Points[2 * 11 + 1] == mesh.Points[2 * 19 + 1]);
+  CHECK(mesh.Parameters[2 * 11] == 1 && mesh.Parameters[2 * 19 + 1] == 1);
+
+  // Timing: the 50-sample pouch, 100 runs.
+  const auto start = std::chrono::steady_clock::now();
+  int ok = 0;
+  for (int run = 0; run < 100; ++run)
+  {
+    ok += tcp.Parameterize(inner.Points, inner.Parameters, error) ? 1 : 0;
+  }
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::printf("  50-sample pouch cell: %.3f ms per cell (mesh + cut + MVC + both locators), %d vertices\n", ms / 100,
+    static_cast<int>(tcp.GetMesh().NumberOfPoints()));
+  CHECK_EQ(ok, 100);
+}
+
+TEST_CASE(RandomPouches)
+{
+  // Perturbed circles (star-shaped about their centre) with 1..3 radial slits of 1..6 samples
+  // from distinct random bases, corners anywhere, mirrored or not, the walk started anywhere.
+  // Every cell must be valid or reported, never a wrong success.
+  Random random(14);
+  int valid = 0, reported = 0, wrong = 0;
+  for (int trial = 0; trial < 100; ++trial)
+  {
+    const int count = 12 + random.Integer(100);
+    const std::vector<double> circle = PerturbedCirclePoints(count, random);
+    const int slits = 1 + random.Integer(3);
+    std::map<int, std::vector<std::pair<double, double>>> slitAt; // base sample -> slit samples
+    for (int k = 0; k < slits; ++k)
+    {
+      const int base = random.Integer(count);
+      const int samples = 1 + random.Integer(6);
+      const double length = random.Uniform(0.1, 0.85);
+      std::vector<std::pair<double, double>>& slit = slitAt[base];
+      slit.clear();
+      for (int j = 1; j <= samples; ++j)
+      {
+        const double t = length * j / samples; // towards the centre (3, -2)
+        slit.push_back({ circle[2 * base] + t * (3 - circle[2 * base]), circle[2 * base + 1] + t * (-2 - circle[2 * base + 1]) });
+      }
+    }
+    Walk walk;
+    for (int i = 0; i < count; ++i)
+    {
+      const std::pair<double, double> c = { circle[2 * i], circle[2 * i + 1] };
+      walk.Add(c);
+      const auto slit = slitAt.find(i);
+      if (slit != slitAt.end())
+      {
+        const std::vector<std::pair<double, double>>& q = slit->second;
+        for (std::size_t j = 0; j < q.size(); ++j)
+        {
+          walk.Add(q[j]);
+        }
+        for (std::size_t j = q.size() - 1; j-- > 0;)
+        {
+          walk.Add(q[j]);
+        }
+        walk.Add(c);
+      }
+    }
+    const int n = static_cast<int>(walk.Points.size() / 2);
+    const int offset = random.Integer(n);
+    walk.Corners.clear();
+    for (int k = 0; k < 4; ++k)
+    {
+      walk.Corners.push_back(std::max(offset + (k * n) / 4 + random.Integer(std::max(1, n / 8)),
+        k == 0 ? 0 : walk.Corners.back() + 1));
+    }
+    walk.Corners[3] = std::min(walk.Corners[3], walk.Corners[0] + n - 1);
+    const bool mirrored = random.Uniform() < 0.5;
+    const Cell cell = Rotated(walk.Build(mirrored), random.Integer(n)); // slits may wrap around the start
+    TwoCellParameterization tcp;
+    std::string error;
+    if (!tcp.Parameterize(cell.Points, cell.Parameters, error))
+    {
+      ++reported;
+      continue;
+    }
+    const bool ok = CheckParameterization(tcp, cell, mirrored ? -1 : 1, random) == 0 && CheckSlits(tcp, cell) >= 0;
+    valid += ok ? 1 : 0;
+    wrong += ok ? 0 : 1;
+  }
+  std::printf("  random pouches: %d valid, %d reported as not one-to-one, %d wrong\n", valid, reported, wrong);
+  CHECK_EQ(wrong, 0);
+  CHECK(valid >= 80);
+}
+
+TEST_CASE(InverseEvaluation)
+{
+  Random random(12);
+  for (const bool mirrored : { false, true })
+  {
+    const Cell cell = MakeCell(PerturbedCirclePoints(40, random), mirrored);
+    TwoCellParameterization tcp;
+    std::string error;
+    CHECK(tcp.Parameterize(cell.Points, cell.Parameters, error));
+    CHECK_EQ(tcp.GetMesh().Orientation, mirrored ? -1 : 1);
+    const double roundTrip = InverseRoundTripError(tcp, cell, random, 2000);
+    std::printf("  perturbed circle%s: max |Phi^-1 Phi - id| / size = %.1e\n", mirrored ? " (mirrored)" : "", roundTrip);
+    CHECK(roundTrip <= 1e-9);
+    // The other way round: random (u, v) in the square, and on its border (the image is on the
+    // boundary polygon), also off by rounding.
+    const double size = CellSize(cell);
+    double worst = 0, border = 0;
+    for (int s = 0; s < 2000; ++s)
+    {
+      const double uv[2] = { random.Uniform(), random.Uniform() };
+      double xy[2], back[2];
+      CHECK(tcp.InverseEvaluate(uv[0], uv[1], xy) && tcp.Evaluate(xy[0], xy[1], back));
+      worst = std::max(worst, std::hypot(back[0] - uv[0], back[1] - uv[1]));
+      const double t = random.Uniform(), off = random.Uniform(-1e-12, 1e-12);
+      const double onBorder[4][2] = { { t, off }, { 1 + off, t }, { t, 1 + off }, { off, t } };
+      for (const auto& b : onBorder)
+      {
+        CHECK(tcp.InverseEvaluate(b[0], b[1], xy));
+        border = std::max(border, DistanceToPolygon(cell.Points, xy[0], xy[1]) / size);
+      }
+    }
+    std::printf("  max |Phi Phi^-1 - id| = %.1e, border of the square to boundary: %.1e\n", worst, border);
+    CHECK(worst <= 1e-12);
+    CHECK(border <= 1e-9);
+    double xy[2];
+    CHECK(!tcp.InverseEvaluate(1 + 1e-6, 0.5, xy));
+    CHECK(!tcp.InverseEvaluate(0.5, -1e-6, xy));
+  }
+  // Before any (or after a failed) Parameterize nothing is found.
+  TwoCellParameterization empty;
+  double xy[2];
+  CHECK(!empty.InverseEvaluate(0.5, 0.5, xy));
+}
+
+TEST_CASE(SlitRefusals)
+{
+  // A walk around the 40-sample circle with an excursion from s = c_10 = (0, 1) through the
+  // given samples and straight back; (u, v) at quarter positions.
+  auto withSlit = [](const std::vector<std::pair<double, double>>& slit, bool retrace = true) {
+    Walk walk;
+    for (int k = 0; k < 40; ++k)
+    {
+      walk.Add(CirclePoint(k, 40));
+      if (k == 10)
+      {
+        for (const auto& p : slit)
+        {
+          walk.Add(p);
+        }
+        for (int j = static_cast<int>(slit.size()) - 2; j >= 0 && retrace; --j)
+        {
+          walk.Add(slit[j]);
+        }
+        walk.Add(CirclePoint(10, 40));
+      }
+    }
+    return MakeCell(walk.Points);
+  };
+  const Cell crossing = withSlit({ { 0, 0.5 }, { 0, -0.5 }, { 0, -1.5 } });
+  CHECK(Fails(crossing.Points, crossing.Parameters, "slit crossing the outer loop"));
+  const Cell outside = withSlit({ { 0, 1.3 }, { 0, 1.6 } });
+  CHECK(Fails(outside.Points, outside.Parameters, "slit outside the outer loop"));
+  const std::pair<double, double> c30 = CirclePoint(30, 40);
+  const Cell touchingVertex = withSlit({ { 0, 0.5 }, { c30.first, c30.second } });
+  CHECK(Fails(touchingVertex.Points, touchingVertex.Parameters, "slit tip on an outer loop sample"));
+  // A slit from the top of a 2 x 2 square down to a point exactly on its bottom edge.
+  Walk square;
+  for (const auto& p : std::vector<std::pair<double, double>>{ { 0, 0 }, { 1, 0 }, { 2, 0 }, { 2, 1 }, { 2, 2 }, { 1, 2 },
+         { 1.5, 1 }, { 1.5, 0 }, { 1.5, 1 }, { 1, 2 }, { 0, 2 }, { 0, 1 } })
+  {
+    square.Add(p);
+  }
+  const Cell touchingEdge = MakeCell(square.Points);
+  CHECK(Fails(touchingEdge.Points, touchingEdge.Parameters, "slit tip on an outer loop edge"));
+  // An excursion that goes around a small triangle and back along its stem: a hole, not a
+  // slit.
+  const Cell lollipop = withSlit({ { 0, 0.5 }, { 0.2, 0.3 }, { -0.2, 0.3 }, { 0, 0.5 } }, false);
+  CHECK(Fails(lollipop.Points, lollipop.Parameters, "excursion around a loop instead of retracing"));
+  const Cell wrongOrder = MultiSlitPouch(true);
+  CHECK(Fails(wrongOrder.Points, wrongOrder.Parameters, "fork branches in the wrong order"));
+  const Cell wrongBaseOrder = TwoSlitsOneBase(true);
+  CHECK(Fails(wrongBaseOrder.Points, wrongBaseOrder.Parameters, "two slits from one base in the wrong order"));
+  // Nothing but a slit: no area.
+  const Cell needle = MakeCell({ 0, 0, 1, 0, 2, 0, 3, 0, 2, 0, 1, 0 });
+  CHECK(Fails(needle.Points, needle.Parameters, "only a slit (no area)"));
+}
+
+TEST_CASE(ThinPouches)
+{
+  // Slits nearly touching the outer loop: a radial slit whose tip comes within `gap` of the
+  // circle's far side, and a slit running along the circle at distance `gap` (a thin channel
+  // between the slit and the arc c_1..c_9). Each must end quickly, either valid (all checks) or
+  // reported. With corners at quarter positions both banks of the channel lie on the right
+  // side of the square, the known limitation (the exact map squeezes the channel below double
+  // resolution): reported. With the corners at the slit's base, tip and base again the banks
+  // map to two adjacent sides and the cell must be valid.
+  Random random(13);
+  const char* names[3] = { "slit tip near the far side", "slit along the circle", "slit along the circle, corners on it" };
+  int valid[3] = { 0, 0, 0 };
+  for (const double gap : { 1e-2, 1e-4, 1e-7, 1e-10 })
+  {
+    for (int shape = 0; shape < 3; ++shape)
+    {
+      Walk walk;
+      for (int k = 0; k < 40; ++k)
+      {
+        walk.Add(CirclePoint(k, 40));
+        if (shape == 0 && k == 10)
+        {
+          std::vector<std::pair<double, double>> slit;
+          for (int j = 1; j <= 8; ++j)
+          {
+            slit.push_back({ 0.0, 1 - j * (2 - gap) / 8 });
+          }
+          for (const auto& p : slit)
+          {
+            walk.Add(p);
+          }
+          for (int j = 6; j >= 0; --j)
+          {
+            walk.Add(slit[j]);
+          }
+          walk.Add(CirclePoint(10, 40));
+        }
+        if (shape >= 1 && k == 0)
+        {
+          for (int j = 1; j <= 10; ++j)
+          {
+            walk.Add(CirclePoint(j, 40, 1 - gap));
+          }
+          for (int j = 9; j >= 1; --j)
+          {
+            walk.Add(CirclePoint(j, 40, 1 - gap));
+          }
+          walk.Add(CirclePoint(0, 40));
+        }
+      }
+      if (shape == 2)
+      {
+        walk.Corners = { 0, 10, 20, 40 }; // c_0, tip, c_0 again, c_20
+      }
+      const Cell cell = shape == 2 ? walk.Build() : MakeCell(walk.Points);
+      const auto start = std::chrono::steady_clock::now();
+      TwoCellParameterization tcp;
+      std::string error;
+      const bool ok = tcp.Parameterize(cell.Points, cell.Parameters, error);
+      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      std::printf("  %s, gap %.0e: %s, %d vertices, %.2f ms\n", names[shape], gap, ok ? "ok" : error.c_str(),
+        static_cast<int>(tcp.GetMesh().NumberOfPoints()), ms);
+      CHECK(ok || !error.empty());
+      valid[shape] += ok ? 1 : 0;
+      if (ok && gap >= 1e-4)
+      {
+        CHECK(CheckParameterization(tcp, cell, 1, random) == 0);
+      }
+      else if (ok)
+      {
+        // A gap g is spanned by slivers across which Phi varies like 1/g: rounding a query
+        // point by 1e-16 moves Phi by 1e-16 / g, beyond the 1e-9 of the location checks (and
+        // g = 1e-10 is below the locator's tolerance). Check the mesh itself.
+        const TwoCellMesh& mesh = tcp.GetMesh();
+        double area = 0;
+        for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
+        {
+          const Index* tri = &mesh.Triangles[3 * t];
+          area += TwiceSignedArea(&mesh.Points[2 * tri[0]], &mesh.Points[2 * tri[1]], &mesh.Points[2 * tri[2]]) / 2;
+        }
+        CHECK(mesh.MinimumParameterArea > 0);
+        CHECK(std::abs(area - PolygonArea(cell.Points)) <= 1e-9 * area);
+      }
+      CHECK(ms < 2000);
+    }
+  }
+  CHECK_EQ(valid[0], 4);
+  CHECK_EQ(valid[2], 4);
+}
+
 TEST_CASE(Timing)
 {
   // The paper's typical cell: c = 5 samples on each of 8 Bezier segments (2 per side).
@@ -792,7 +1493,7 @@ TEST_CASE(Timing)
     }
   }
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  std::printf("  40-sample cell: %.3f ms per cell (mesh + MVC + locator), %.0f vertices on average\n", ms / 100,
+  std::printf("  40-sample cell: %.3f ms per cell (mesh + MVC + both locators), %.0f vertices on average\n", ms / 100,
     vertices / std::max(ok, 1));
   CHECK_EQ(ok, 100);
   // Locating the ~vertex count of queries per cell (F o Phi at the input vertices).

@@ -1,0 +1,44 @@
+// Samplings of the reconstruction with exactly the simplified complex's critical points.
+//
+// F o Phi has no critical point inside a 2-cell, but a piecewise-linear sampling of it can
+// have small spurious pairs where the field is nearly flat or where a 1-cell (a C0 crease)
+// crosses the grid obliquely: along a ridge that rises slowly, a vertex beside the crease can
+// have all its neighbours lower. This pass removes them from the sampled values with the
+// flooding of Tierny and Pascucci ("Generalized topological simplification of scalar fields on
+// surfaces", IEEE TVCG 2012): a sweep upwards from the wanted minima fills every other pit to
+// the level at which the sweep reaches it, a sweep downwards from the wanted maxima cuts every
+// other peak, alternately until nothing changes. Values move only inside spurious pits and
+// peaks, by less than their depth. The stage-1 boundary rule (boundary cells pair only with
+// boundary cells) makes the extrema of the field along the boundary curve critical too, so
+// the same sweeps first run along the boundary curve, from the wanted boundary minima and
+// boundary saddles. Ties are ordered as stage 1 orders them: by value, then vertex id.
+#pragma once
+
+#include "CoreTypes.h"
+#include "TriangleMeshTopology.h"
+
+#include <vector>
+
+namespace topospline
+{
+struct TopologicalSamplingReport
+{
+  int Rounds = 0;
+  bool Converged = false;
+  Index ChangedVertices = 0;
+  double MaximumChange = 0;
+};
+
+struct SamplingConstraints
+{
+  std::vector<Index> Minima;         // vertices of the wanted minima
+  std::vector<Index> Maxima;         // vertices of the wanted maxima
+  std::vector<Index> BoundaryMinima; // wanted minima along the boundary curve (boundary vertices)
+  std::vector<Index> BoundaryMaxima; // wanted maxima along the boundary curve (higher vertex of a
+                                     // critical boundary edge: a boundary saddle)
+};
+
+// Modifies `values` (one per mesh vertex) in place.
+TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds = 50);
+} // namespace topospline

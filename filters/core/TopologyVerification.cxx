@@ -1,0 +1,82 @@
+#include "TopologyVerification.h"
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+namespace topospline
+{
+std::vector<CriticalPointLocation> CriticalPointLocations(
+  const MorseSmaleComplex& complex, const std::vector<double>& points)
+{
+  std::vector<CriticalPointLocation> result;
+  result.reserve(complex.CriticalPoints.size());
+  for (const CriticalPoint& cp : complex.CriticalPoints)
+  {
+    CriticalPointLocation location;
+    location.MorseIndex = cp.MorseIndex;
+    location.Position[0] = points[2 * static_cast<std::size_t>(cp.Vertex)];
+    location.Position[1] = points[2 * static_cast<std::size_t>(cp.Vertex) + 1];
+    location.Value = cp.Value;
+    result.push_back(location);
+  }
+  return result;
+}
+
+TopologyComparison CompareCriticalPoints(const std::vector<CriticalPointLocation>& expected,
+  const std::vector<CriticalPointLocation>& found, double tolerance)
+{
+  TopologyComparison comparison;
+  for (const auto& cp : expected)
+  {
+    ++comparison.Expected[std::clamp(cp.MorseIndex, 0, 2)];
+  }
+  for (const auto& cp : found)
+  {
+    ++comparison.Found[std::clamp(cp.MorseIndex, 0, 2)];
+  }
+  // Candidate pairs within the tolerance, closest first.
+  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
+  for (std::size_t e = 0; e < expected.size(); ++e)
+  {
+    for (std::size_t f = 0; f < found.size(); ++f)
+    {
+      if (expected[e].MorseIndex != found[f].MorseIndex)
+      {
+        continue;
+      }
+      const double d = std::hypot(expected[e].Position[0] - found[f].Position[0],
+        expected[e].Position[1] - found[f].Position[1]);
+      if (d <= tolerance)
+      {
+        pairs.emplace_back(d, e, f);
+      }
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<char> usedExpected(expected.size(), 0), usedFound(found.size(), 0);
+  for (const auto& [d, e, f] : pairs)
+  {
+    if (!usedExpected[e] && !usedFound[f])
+    {
+      usedExpected[e] = usedFound[f] = 1;
+      comparison.MaximumDistance = std::max(comparison.MaximumDistance, d);
+    }
+  }
+  for (std::size_t e = 0; e < expected.size(); ++e)
+  {
+    if (!usedExpected[e])
+    {
+      comparison.Missing.push_back(expected[e]);
+    }
+  }
+  for (std::size_t f = 0; f < found.size(); ++f)
+  {
+    if (!usedFound[f])
+    {
+      comparison.Spurious.push_back(found[f]);
+    }
+  }
+  return comparison;
+}
+} // namespace topospline

@@ -1,0 +1,39 @@
+// The reconstruction's promise, checked: the Morse-Smale complex of the reconstructed field
+// (extracted again with stage 1 on a sampling of it) must have exactly the critical points of
+// the simplified complex, each near its node, and no others.
+#pragma once
+
+#include "CoreTypes.h"
+#include "MorseSmaleComplexExtraction.h"
+
+#include <array>
+#include <vector>
+
+namespace topospline
+{
+struct CriticalPointLocation
+{
+  int MorseIndex = 0;
+  double Position[2] = { 0, 0 };
+  double Value = 0;
+};
+
+// The critical points of `complex`, placed at their vertices of `points` (x, y per vertex).
+std::vector<CriticalPointLocation> CriticalPointLocations(
+  const MorseSmaleComplex& complex, const std::vector<double>& points);
+
+struct TopologyComparison
+{
+  std::array<Index, 3> Expected{ { 0, 0, 0 } }; // minima, saddles, maxima
+  std::array<Index, 3> Found{ { 0, 0, 0 } };
+  std::vector<CriticalPointLocation> Spurious; // found, not matched to an expected one
+  std::vector<CriticalPointLocation> Missing;  // expected, not matched
+  double MaximumDistance = 0;                  // over matched pairs
+  bool Identical() const { return this->Spurious.empty() && this->Missing.empty(); }
+};
+
+// Matches found to expected critical points of the same index within `tolerance` (closest
+// pairs first, each point used once).
+TopologyComparison CompareCriticalPoints(const std::vector<CriticalPointLocation>& expected,
+  const std::vector<CriticalPointLocation>& found, double tolerance);
+} // namespace topospline

@@ -1,0 +1,698 @@
+#include "TwoCellReconstruction.h"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace topospline
+{
+namespace
+{
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point start)
+{
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Samples one side, forward from its lower corner: c points per Bezier segment plus the end
+// point, with the side parameter tau = (segment + t) / segments of each.
+void SampleSide(const SideSegments& side, int c, std::vector<double>& xy, std::vector<double>& tau)
+{
+  const int total = static_cast<int>(side.Curve.size());
+  double point[2];
+  for (int j = 0; j < total; ++j)
+  {
+    const double* curve = side.Curve[j].data();
+    for (int i = 0; i < c; ++i)
+    {
+      const double t = static_cast<double>(i) / c;
+      // t = 0 is the control point itself, bit for bit: neighbouring cells and the two sides
+      // of a slit then share their samples exactly.
+      if (i == 0)
+      {
+        point[0] = curve[0];
+        point[1] = curve[1];
+      }
+      else
+      {
+        CubicBezierSpline::EvaluateSegment(curve, 2, t, point);
+      }
+      xy.insert(xy.end(), point, point + 2);
+      tau.push_back((j + t) / total);
+    }
+  }
+  const double* end = side.Curve.back().data() + 6;
+  xy.insert(xy.end(), end, end + 2);
+  tau.push_back(1.0);
+}
+
+// The closed walk around a cell: bottom and right forwards, top and left backwards (each
+// side without its last point, the next side's first), with the (u, v) of every sample, and
+// the height segments of the four sides.
+void BuildBoundaryWalk(std::array<SideSegments, 4>&& segments, int c, std::vector<double>& walk,
+  std::vector<double>& parameters, MonotoneSurfaceBoundary& boundary)
+{
+  std::array<std::vector<double>, 4> xy, tau;
+  for (int s = 0; s < 4; ++s)
+  {
+    SampleSide(segments[s], c, xy[s], tau[s]);
+  }
+  walk.clear();
+  parameters.clear();
+  auto append = [&](int s, bool forward, double u0, double v0, double du, double dv) {
+    const std::size_t count = tau[s].size();
+    for (std::size_t k = 0; k + 1 < count; ++k)
+    {
+      const std::size_t i = forward ? k : count - 1 - k;
+      walk.push_back(xy[s][2 * i]);
+      walk.push_back(xy[s][2 * i + 1]);
+      parameters.push_back(u0 + du * tau[s][i]);
+      parameters.push_back(v0 + dv * tau[s][i]);
+    }
+  };
+  append(TwoCellSides::Bottom, true, 0, 0, 1, 0); // (tau, 0)
+  append(TwoCellSides::Right, true, 1, 0, 0, 1);  // (1, tau)
+  append(TwoCellSides::Top, false, 0, 1, 1, 0);   // (tau, 1), from tau = 1 down
+  append(TwoCellSides::Left, false, 0, 0, 0, 1);  // (0, tau), from tau = 1 down
+  boundary.Bottom = std::move(segments[TwoCellSides::Bottom].Height);
+  boundary.Right = std::move(segments[TwoCellSides::Right].Height);
+  boundary.Top = std::move(segments[TwoCellSides::Top].Height);
+  boundary.Left = std::move(segments[TwoCellSides::Left].Height);
+}
+
+// Even-odd point-in-polygon test.
+bool InsidePolygon(const std::vector<double>& polygon, const std::array<double, 2>& p)
+{
+  bool inside = false;
+  const std::size_t n = polygon.size() / 2;
+  for (std::size_t i = 0, j = n - 1; i < n; j = i++)
+  {
+    const double xi = polygon[2 * i], yi = polygon[2 * i + 1], xj = polygon[2 * j], yj = polygon[2 * j + 1];
+    if ((yi > p[1]) != (yj > p[1]) && p[0] < (xj - xi) * (p[1] - yi) / (yj - yi) + xi)
+    {
+      inside = !inside;
+    }
+  }
+  return inside;
+}
+
+// First and last point of a 1-cell's smoothed curve.
+std::array<double, 2> StartOf(const OneCellSmoothingResult& smoothed, Index arc)
+{
+  const SmoothedPiece& piece = smoothed.Pieces[smoothed.PiecesOfSeparatrix[arc].front()];
+  return { { piece.Curve.ControlPoints[0], piece.Curve.ControlPoints[1] } };
+}
+std::array<double, 2> EndOf(const OneCellSmoothingResult& smoothed, Index arc)
+{
+  const SmoothedPiece& piece = smoothed.Pieces[smoothed.PiecesOfSeparatrix[arc].back()];
+  const std::size_t n = piece.Curve.ControlPoints.size();
+  return { { piece.Curve.ControlPoints[n - 2], piece.Curve.ControlPoints[n - 1] } };
+}
+
+// Bernstein matrix of the cubic triangle at its 10 lattice points, inverted: control points
+// of the cubic interpolating given values at the lattice points.
+const Eigen::Matrix<double, 10, 10>& LatticeToControl()
+{
+  static const Eigen::Matrix<double, 10, 10> inverse = []() {
+    Eigen::Matrix<double, 10, 10> m;
+    const double factorial[4] = { 1, 1, 2, 6 };
+    for (int i = 0; i <= 3; ++i)
+    {
+      for (int j = 0; i + j <= 3; ++j)
+      {
+        const int row = BezierOrdinateIndex(i, j);
+        const double a = i / 3.0, b = j / 3.0, c = (3 - i - j) / 3.0;
+        for (int p = 0; p <= 3; ++p)
+        {
+          for (int q = 0; p + q <= 3; ++q)
+          {
+            const int r = 3 - p - q;
+            m(row, BezierOrdinateIndex(p, q)) =
+              6.0 / (factorial[p] * factorial[q] * factorial[r]) * std::pow(a, p) * std::pow(b, q) * std::pow(c, r);
+          }
+        }
+      }
+    }
+    return Eigen::Matrix<double, 10, 10>(m.inverse());
+  }();
+  return inverse;
+}
+
+// Closest point of segment ab to p: returns the squared distance and the fraction along ab.
+double SegmentDistance2(const double* a, const double* b, double x, double y, double& fraction)
+{
+  const double dx = b[0] - a[0], dy = b[1] - a[1];
+  const double length2 = dx * dx + dy * dy;
+  fraction = length2 > 0 ? std::clamp(((x - a[0]) * dx + (y - a[1]) * dy) / length2, 0.0, 1.0) : 0.0;
+  const double ex = a[0] + fraction * dx - x, ey = a[1] + fraction * dy - y;
+  return ex * ex + ey * ey;
+}
+} // namespace
+
+bool AssembleTwoCellSides(const TwoCell& cell, const OneCellSmoothingResult& smoothed, TwoCellSides& sides,
+  std::string& error, bool mergeAtMinimum, bool mergeAtMaximum)
+{
+  sides = TwoCellSides();
+  const Index arcs = static_cast<Index>(smoothed.PiecesOfSeparatrix.size());
+  for (Index a : cell.Arcs)
+  {
+    if (a < 0 || a >= arcs)
+    {
+      error = "a boundary 1-cell is not in the smoothed complex";
+      return false;
+    }
+  }
+  const Index d0 = cell.Arcs[0], a0 = cell.Arcs[1], d1 = cell.Arcs[2], a1 = cell.Arcs[3];
+  auto& bottom = sides.Pieces[TwoCellSides::Bottom];
+  auto& right = sides.Pieces[TwoCellSides::Right];
+  auto& top = sides.Pieces[TwoCellSides::Top];
+  auto& left = sides.Pieces[TwoCellSides::Left];
+  bottom = smoothed.PiecesOfSeparatrix[d0];
+  right = smoothed.PiecesOfSeparatrix[a0];
+  left = smoothed.PiecesOfSeparatrix[d1];
+  top = smoothed.PiecesOfSeparatrix[a1];
+
+  // Two different 1-cells that share their first pieces merge before the minimum: the cell's
+  // boundary leaves them where they split, and that junction takes the minimum's corner.
+  // The same 1-cell on both sides (a pouch) is a slit and stays whole.
+  if (d0 != d1)
+  {
+    std::size_t shared = 0;
+    while (shared < bottom.size() && shared < left.size() && bottom[shared] == left[shared])
+    {
+      ++shared;
+    }
+    if (shared > 0 && !mergeAtMinimum)
+    {
+      sides.Slit = true;
+    }
+    else if (shared > 0)
+    {
+      bottom.erase(bottom.begin(), bottom.begin() + shared);
+      left.erase(left.begin(), left.begin() + shared);
+      sides.MinimumShifted = true;
+    }
+  }
+  else
+  {
+    sides.Slit = true;
+  }
+  if (a0 != a1)
+  {
+    std::size_t shared = 0;
+    while (shared < right.size() && shared < top.size() &&
+      right[right.size() - 1 - shared] == top[top.size() - 1 - shared])
+    {
+      ++shared;
+    }
+    if (shared > 0 && !mergeAtMaximum)
+    {
+      sides.Slit = true;
+    }
+    else if (shared > 0)
+    {
+      right.resize(right.size() - shared);
+      top.resize(top.size() - shared);
+      sides.MaximumShifted = true;
+    }
+  }
+  else if (sides.Slit)
+  {
+    error = "both pairs of sides are the same 1-cell";
+    return false;
+  }
+  else
+  {
+    sides.Slit = true;
+  }
+  // A side of zero length (a 1-cell of one point: a saddle on its extremum's vertex) is no
+  // side: the cell has 3 corners.
+  for (auto& side : sides.Pieces)
+  {
+    bool degenerate = !side.empty();
+    for (Index p : side)
+    {
+      if (p < 0 || p >= static_cast<Index>(smoothed.Pieces.size()))
+      {
+        degenerate = false;
+        break;
+      }
+      const auto& points = smoothed.Pieces[p].Curve.ControlPoints;
+      for (std::size_t i = 2; i < points.size() && degenerate; ++i)
+      {
+        degenerate = points[i] == points[i % 2];
+      }
+    }
+    if (degenerate)
+    {
+      side.clear();
+    }
+  }
+  // An empty side takes half of its partner in the pair Bottom + Right or Left + Top.
+  const int partner[4] = { TwoCellSides::Right, TwoCellSides::Bottom, TwoCellSides::Left, TwoCellSides::Top };
+  for (int s = 0; s < 4; ++s)
+  {
+    if (sides.Pieces[s].empty())
+    {
+      if (sides.Pieces[partner[s]].empty())
+      {
+        error = "both sides of a pair are empty (the cell has fewer than 3 corners)";
+        return false;
+      }
+      sides.SplitSides[s == TwoCellSides::Bottom || s == TwoCellSides::Right ? 0 : 1] = partner[s];
+    }
+  }
+  for (int s = 0; s < 4; ++s)
+  {
+    for (Index p : sides.Pieces[s])
+    {
+      if (p < 0 || p >= static_cast<Index>(smoothed.Pieces.size()) || smoothed.Pieces[p].Curve.Segments < 1 ||
+        smoothed.Pieces[p].Height.Segments != smoothed.Pieces[p].Curve.Segments)
+      {
+        error = "a boundary piece has no Bezier curve";
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed)
+{
+  std::array<SideSegments, 4> result;
+  for (int s = 0; s < 4; ++s)
+  {
+    for (Index p : sides.Pieces[s])
+    {
+      const SmoothedPiece& piece = smoothed.Pieces[p];
+      for (int j = 0; j < piece.Curve.Segments; ++j)
+      {
+        std::array<double, 8> curve;
+        std::copy(piece.Curve.Segment(j), piece.Curve.Segment(j) + 8, curve.begin());
+        result[s].Curve.push_back(curve);
+        const double* h = piece.Height.Segment(j);
+        result[s].Height.push_back({ { h[0], h[1], h[2], h[3] } });
+      }
+    }
+  }
+  // The lower half of a Right or Top side goes to its empty partner (Bottom or Left); the
+  // upper half of a Bottom or Left side goes to its empty partner (Right or Top).
+  // Split at the segment boundary nearest the middle: the samples stay those of the
+  // neighbouring cell that shares this 1-cell, so both cells keep one common boundary. Only a
+  // side of one segment is cut inside it (at t = 1/2); there the two cells' boundaries differ
+  // by a sliver between two samples.
+  for (int split : sides.SplitSides)
+  {
+    if (split < 0)
+    {
+      continue;
+    }
+    SideSegments whole = std::move(result[split]);
+    if (whole.Curve.size() == 1)
+    {
+      SideSegments halved;
+      std::array<double, 8> left, right;
+      CubicBezierSpline::Subdivide(whole.Curve[0].data(), 2, 0.5, left.data(), right.data());
+      halved.Curve = { left, right };
+      CubicHeightSegment lower, upper;
+      SplitCubicSegment(whole.Height[0], 0.5, lower, upper);
+      halved.Height = { lower, upper };
+      whole = std::move(halved);
+    }
+    const std::size_t half = whole.Curve.size() / 2;
+    SideSegments lower, upper;
+    lower.Curve.assign(whole.Curve.begin(), whole.Curve.begin() + half);
+    lower.Height.assign(whole.Height.begin(), whole.Height.begin() + half);
+    upper.Curve.assign(whole.Curve.begin() + half, whole.Curve.end());
+    upper.Height.assign(whole.Height.begin() + half, whole.Height.end());
+    const bool bottomPair = split == TwoCellSides::Bottom || split == TwoCellSides::Right;
+    result[bottomPair ? TwoCellSides::Bottom : TwoCellSides::Left] = std::move(lower);
+    result[bottomPair ? TwoCellSides::Right : TwoCellSides::Top] = std::move(upper);
+  }
+  return result;
+}
+
+bool TwoCellReconstruction::Reconstruct(
+  const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed, std::string& error)
+{
+  this->Cells.clear();
+  this->Summary = TwoCellReconstructionReport();
+  if (this->BoundarySamples < 1 || this->BoundarySamples > 1000)
+  {
+    error = "the number of boundary samples must be in [1, 1000], not " + std::to_string(this->BoundarySamples);
+    return false;
+  }
+  if (smoothed.PiecesOfSeparatrix.size() != complex.Separatrices.size())
+  {
+    error = "the smoothed 1-cells do not belong to this complex";
+    return false;
+  }
+  const Index n = static_cast<Index>(complex.TwoCells.size());
+  this->Cells.resize(n);
+  for (auto& cell : this->Cells)
+  {
+    cell = std::make_unique<ReconstructedTwoCell>();
+  }
+  std::vector<MonotoneSurfaceBoundary> boundaries(n);
+
+  // Pass 1 (the paper's "time II"): sides, boundary samples, triangulation, parameterization.
+  auto start = Clock::now();
+  this->Parallel(0, n, [&](Index begin, Index end) {
+    for (Index c = begin; c < end && !this->Hooks.Aborted(); ++c)
+    {
+      ReconstructedTwoCell& cell = *this->Cells[c];
+      std::string message;
+      const TwoCell& twoCell = complex.TwoCells[c];
+      std::vector<double> walk, parameters;
+      bool mergeAtMinimum = true, mergeAtMaximum = true;
+      bool assembled = false;
+      for (int attempt = 0; attempt < 3; ++attempt)
+      {
+        if (!AssembleTwoCellSides(twoCell, smoothed, cell.Sides, message, mergeAtMinimum, mergeAtMaximum))
+        {
+          break;
+        }
+        BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed), this->BoundarySamples, walk, parameters,
+          boundaries[c]);
+        // A stem that ends inside the walk is the cell's own: keep it as a slit instead.
+        bool retry = false;
+        if (mergeAtMinimum && cell.Sides.MinimumShifted &&
+          InsidePolygon(walk, StartOf(smoothed, twoCell.Arcs[0])))
+        {
+          mergeAtMinimum = false;
+          retry = true;
+        }
+        if (mergeAtMaximum && cell.Sides.MaximumShifted && InsidePolygon(walk, EndOf(smoothed, twoCell.Arcs[1])))
+        {
+          mergeAtMaximum = false;
+          retry = true;
+        }
+        if (!retry)
+        {
+          assembled = true;
+          break;
+        }
+      }
+      if (!assembled)
+      {
+        cell.Error = message.empty() ? "its sides could not be assembled" : message;
+        continue;
+      }
+      // Cells of (almost) no area, e.g. a zero-persistence pair on the domain boundary whose
+      // 1-cells run on top of each other, hold no vertex: they are skipped, and counted.
+      double area = 0;
+      for (std::size_t i = 0, count = walk.size() / 2; i < count; ++i)
+      {
+        const std::size_t j = (i + 1) % count;
+        area += walk[2 * i] * walk[2 * j + 1] - walk[2 * j] * walk[2 * i + 1];
+      }
+      if (std::abs(0.5 * area) <= this->NegligibleArea)
+      {
+        cell.Negligible = true;
+        cell.Error = "it has no area";
+        continue;
+      }
+      cell.Bounds[0] = cell.Bounds[2] = std::numeric_limits<double>::infinity();
+      cell.Bounds[1] = cell.Bounds[3] = -std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < walk.size(); i += 2)
+      {
+        cell.Bounds[0] = std::min(cell.Bounds[0], walk[i]);
+        cell.Bounds[1] = std::max(cell.Bounds[1], walk[i]);
+        cell.Bounds[2] = std::min(cell.Bounds[2], walk[i + 1]);
+        cell.Bounds[3] = std::max(cell.Bounds[3], walk[i + 1]);
+      }
+      // The paper's interior triangle size is the mean boundary sample spacing; dense samples
+      // on short 1-cells (large k) would make it far finer than the input grid, which only
+      // costs time: it is kept at least MinimumMeshEdgeLength.
+      double perimeter = 0;
+      const std::size_t samples = walk.size() / 2;
+      for (std::size_t i = 0; i < samples; ++i)
+      {
+        const std::size_t j = (i + 1) % samples;
+        perimeter += std::hypot(walk[2 * j] - walk[2 * i], walk[2 * j + 1] - walk[2 * i + 1]);
+      }
+      const double spacing = this->MeshEdgeLength > 0 ? this->MeshEdgeLength : perimeter / std::max<std::size_t>(samples, 1);
+      cell.Parameterization.TargetEdgeLength = std::max(spacing, this->MinimumMeshEdgeLength);
+      if (!cell.Parameterization.Parameterize(walk, parameters, message))
+      {
+        cell.Error = "parameterization: " + message;
+        continue;
+      }
+      cell.Valid = true;
+    }
+  });
+  if (this->Hooks.Aborted())
+  {
+    error = "aborted";
+    return false;
+  }
+  this->Summary.ParameterizationSeconds = Seconds(start);
+  this->Hooks.Report(0.7);
+
+  // Pass 2 (the paper's "time III"): subdivision to a common count and the Sibson surface.
+  start = Clock::now();
+  this->Parallel(0, n, [&](Index begin, Index end) {
+    for (Index c = begin; c < end; ++c)
+    {
+      ReconstructedTwoCell& cell = *this->Cells[c];
+      if (!cell.Valid)
+      {
+        continue;
+      }
+      MonotoneSurfaceBoundary& boundary = boundaries[c];
+      const int count = CommonSegmentCount(boundary.Bottom, boundary.Left, boundary.Top, boundary.Right);
+      if (count < 1 || count > this->MaximumGridSize)
+      {
+        cell.Valid = false;
+        cell.Error = "its sides need " + std::to_string(count) + " segments each after subdivision (more than " +
+          std::to_string(this->MaximumGridSize) + ")";
+        continue;
+      }
+      MonotoneSurfaceBoundary subdivided;
+      SubdivideSide(boundary.Bottom, count, subdivided.Bottom);
+      SubdivideSide(boundary.Left, count, subdivided.Left);
+      SubdivideSide(boundary.Top, count, subdivided.Top);
+      SubdivideSide(boundary.Right, count, subdivided.Right);
+      std::string message;
+      MonotoneSurfaceOptions options;
+      // Subdivision and the B-spline conversion round the segment joins by ~1e-12 relative to
+      // the values, which can exceed 1e-9 of a small cell's own range.
+      options.ConsistencyTolerance = 1e-7;
+      options.FlatAcrossBoundary = this->FlatAcrossOneCells;
+      options.Interior = this->CoonsInterior ? MonotoneSurfaceOptions::CoonsInterior : MonotoneSurfaceOptions::LaplaceInterior;
+      cell.SurfaceConditionsHold = cell.Surface.Build(subdivided, message, options);
+      if (cell.Surface.GetGridSize() != count)
+      {
+        // Malformed boundary data (not merely infeasible conditions): no surface at all.
+        cell.Valid = false;
+        cell.Error = "surface: " + message;
+        continue;
+      }
+      cell.GridSize = count;
+    }
+  });
+  this->Summary.SurfaceSeconds = Seconds(start);
+
+  auto& s = this->Summary;
+  s.Cells = n;
+  for (const auto& cell : this->Cells)
+  {
+    if (!cell->Valid)
+    {
+      ++(cell->Negligible ? s.NegligibleCells : s.FailedCells);
+      continue;
+    }
+    s.SlitCells += cell->Sides.Slit ? 1 : 0;
+    s.ShiftedCorners += (cell->Sides.MinimumShifted ? 1 : 0) + (cell->Sides.MaximumShifted ? 1 : 0);
+    const MonotoneSurfaceReport& r = cell->Surface.Report();
+    s.ViolatingPatches += r.ViolatingCells;
+    s.LinearizedDiagonals += r.LinearizedDiagonals;
+    s.AdjustedDiagonals += r.AdjustedDiagonals;
+    s.MeshTriangles += cell->Parameterization.GetMesh().NumberOfTriangles();
+    s.BezierTriangles += 4 * cell->GridSize * cell->GridSize;
+    s.MaximumGridSize = std::max(s.MaximumGridSize, cell->GridSize);
+  }
+  this->BuildCellLocator();
+  this->Hooks.Report(1.0);
+  return true;
+}
+
+void TwoCellReconstruction::BuildCellLocator()
+{
+  double box[4] = { std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+    std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity() };
+  Index valid = 0;
+  for (const auto& cell : this->Cells)
+  {
+    if (cell->Valid)
+    {
+      ++valid;
+      box[0] = std::min(box[0], cell->Bounds[0]);
+      box[1] = std::max(box[1], cell->Bounds[1]);
+      box[2] = std::min(box[2], cell->Bounds[2]);
+      box[3] = std::max(box[3], cell->Bounds[3]);
+    }
+  }
+  this->BucketStart.assign(1, 0);
+  this->BucketCells.clear();
+  this->Buckets[0] = this->Buckets[1] = 0;
+  if (valid == 0)
+  {
+    return;
+  }
+  const double diagonal = std::hypot(box[1] - box[0], box[3] - box[2]);
+  this->Snap = this->SnapDistance > 0 ? this->SnapDistance : 1e-3 * diagonal;
+  box[0] -= this->Snap;
+  box[1] += this->Snap;
+  box[2] -= this->Snap;
+  box[3] += this->Snap;
+  const int side = std::max(1, static_cast<int>(std::ceil(2 * std::sqrt(static_cast<double>(valid)))));
+  this->Buckets[0] = this->Buckets[1] = side;
+  this->Origin[0] = box[0];
+  this->Origin[1] = box[2];
+  this->BucketSize[0] = std::max((box[1] - box[0]) / side, 1e-300);
+  this->BucketSize[1] = std::max((box[3] - box[2]) / side, 1e-300);
+  std::vector<std::vector<Index>> lists(static_cast<std::size_t>(side) * side);
+  for (Index c = 0; c < this->NumberOfCells(); ++c)
+  {
+    const auto& cell = *this->Cells[c];
+    if (!cell.Valid)
+    {
+      continue;
+    }
+    const int i0 = std::clamp(static_cast<int>((cell.Bounds[0] - this->Snap - box[0]) / this->BucketSize[0]), 0, side - 1);
+    const int i1 = std::clamp(static_cast<int>((cell.Bounds[1] + this->Snap - box[0]) / this->BucketSize[0]), 0, side - 1);
+    const int j0 = std::clamp(static_cast<int>((cell.Bounds[2] - this->Snap - box[2]) / this->BucketSize[1]), 0, side - 1);
+    const int j1 = std::clamp(static_cast<int>((cell.Bounds[3] + this->Snap - box[2]) / this->BucketSize[1]), 0, side - 1);
+    for (int j = j0; j <= j1; ++j)
+    {
+      for (int i = i0; i <= i1; ++i)
+      {
+        lists[static_cast<std::size_t>(j) * side + i].push_back(c);
+      }
+    }
+  }
+  for (const auto& list : lists)
+  {
+    this->BucketCells.insert(this->BucketCells.end(), list.begin(), list.end());
+    this->BucketStart.push_back(static_cast<Index>(this->BucketCells.size()));
+  }
+}
+
+bool TwoCellReconstruction::EvaluateInCell(Index c, double x, double y, double& value) const
+{
+  const ReconstructedTwoCell& cell = *this->Cells[c];
+  const double tolerance = 1e-9 * std::max(cell.Bounds[1] - cell.Bounds[0], cell.Bounds[3] - cell.Bounds[2]);
+  if (!cell.Valid || x < cell.Bounds[0] - tolerance || x > cell.Bounds[1] + tolerance ||
+    y < cell.Bounds[2] - tolerance || y > cell.Bounds[3] + tolerance)
+  {
+    return false;
+  }
+  double uv[2];
+  if (!cell.Parameterization.Evaluate(x, y, uv))
+  {
+    return false;
+  }
+  value = cell.Surface.Evaluate(uv[0], uv[1]);
+  return true;
+}
+
+TwoCellReconstruction::Evaluation TwoCellReconstruction::Evaluate(double x, double y, Index hint) const
+{
+  Evaluation result;
+  if (hint >= 0 && hint < this->NumberOfCells() && this->EvaluateInCell(hint, x, y, result.Value))
+  {
+    result.Cell = hint;
+    result.Inside = true;
+    return result;
+  }
+  if (this->Buckets[0] == 0)
+  {
+    return result;
+  }
+  const int i = static_cast<int>(std::floor((x - this->Origin[0]) / this->BucketSize[0]));
+  const int j = static_cast<int>(std::floor((y - this->Origin[1]) / this->BucketSize[1]));
+  if (i < 0 || j < 0 || i >= this->Buckets[0] || j >= this->Buckets[1])
+  {
+    return result;
+  }
+  const std::size_t bucket = static_cast<std::size_t>(j) * this->Buckets[0] + i;
+  const Index* begin = this->BucketCells.data() + this->BucketStart[bucket];
+  const Index* end = this->BucketCells.data() + this->BucketStart[bucket + 1];
+  for (const Index* c = begin; c != end; ++c)
+  {
+    if (*c != hint && this->EvaluateInCell(*c, x, y, result.Value))
+    {
+      result.Cell = *c;
+      result.Inside = true;
+      return result;
+    }
+  }
+  // Outside every cell: the smoothed boundary of the domain or a rounding gap. The nearest
+  // boundary point within the snap distance gives the value.
+  double best = this->Snap * this->Snap;
+  for (const Index* c = begin; c != end; ++c)
+  {
+    const ReconstructedTwoCell& cell = *this->Cells[*c];
+    const TwoCellMesh& mesh = cell.Parameterization.GetMesh();
+    const Index count = mesh.BoundaryCount;
+    for (Index k = 0; k < count; ++k)
+    {
+      const Index l = (k + 1) % count;
+      double fraction;
+      const double d2 = SegmentDistance2(&mesh.Points[2 * k], &mesh.Points[2 * l], x, y, fraction);
+      if (d2 <= best)
+      {
+        best = d2;
+        const double u = (1 - fraction) * mesh.Parameters[2 * k] + fraction * mesh.Parameters[2 * l];
+        const double v = (1 - fraction) * mesh.Parameters[2 * k + 1] + fraction * mesh.Parameters[2 * l + 1];
+        result.Value = cell.Surface.Evaluate(u, v);
+        result.Cell = *c;
+        result.Inside = false;
+      }
+    }
+  }
+  return result;
+}
+
+std::vector<PlanarBezierTriangle> TwoCellReconstruction::PlanarBezierTriangles(Index c) const
+{
+  std::vector<PlanarBezierTriangle> result;
+  const ReconstructedTwoCell& cell = *this->Cells[c];
+  if (!cell.Valid)
+  {
+    return result;
+  }
+  const auto& toControl = LatticeToControl();
+  const std::vector<SurfaceBezierTriangle> patches = cell.Surface.GetBezierTriangles();
+  result.resize(patches.size());
+  Eigen::Matrix<double, 10, 2> lattice;
+  for (std::size_t t = 0; t < patches.size(); ++t)
+  {
+    // The (u, v) of a polynomial triangle's control points are its lattice points.
+    for (int m = 0; m < 10; ++m)
+    {
+      double xy[2] = { 0, 0 };
+      if (!cell.Parameterization.InverseEvaluate(patches[t].Points[m][0], patches[t].Points[m][1], xy))
+      {
+        // Only rounding can put a lattice point outside the square's mesh; clamp it in.
+        const double u = std::clamp(patches[t].Points[m][0], 0.0, 1.0);
+        const double v = std::clamp(patches[t].Points[m][1], 0.0, 1.0);
+        cell.Parameterization.InverseEvaluate(u, v, xy);
+      }
+      lattice(m, 0) = xy[0];
+      lattice(m, 1) = xy[1];
+    }
+    const Eigen::Matrix<double, 10, 2> control = toControl * lattice;
+    for (int m = 0; m < 10; ++m)
+    {
+      result[t].Points[m] = { { control(m, 0), control(m, 1), patches[t].Points[m][2] } };
+    }
+  }
+  return result;
+}
+} // namespace topospline

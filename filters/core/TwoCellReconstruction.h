@@ -1,0 +1,184 @@
+// Stage 4 of the paper (section 5): the final field inside every 2-cell of the smoothed
+// complex. Per cell: its four sides are assembled from the smoothed 1-cell pieces, the cell is
+// parameterized onto the unit square (TwoCellParameterization: CGAL triangulation + mean value
+// coordinates), and a monotone C1 Sibson surface F with no interior critical point is built on
+// the square (MonotoneSibsonSurface). The reconstruction is F o Phi. Cells are independent and
+// are built in parallel; every cell writes only its own slot, so the result does not depend on
+// the number of threads.
+//
+// Corners of the square (the paper's section 5.1): minimum (0,0), maximum (1,1), the saddles of
+// Arcs[0..1] at (1,0) and of Arcs[2..3] at (0,1):
+//   Bottom (0,0)->(1,0): the descending 1-cell of saddle 0, Right (1,0)->(1,1): its ascending one,
+//   Left (0,0)->(0,1): the descending 1-cell of saddle 1, Top (0,1)->(1,1): its ascending one.
+// Where the two descending 1-cells merge before the minimum (they share their first pieces),
+// the minimum is not on the cell's boundary: the junction where they split takes corner (0,0),
+// as in the paper; likewise for the maximum. A pouch cell (one saddle twice) whose two sides are
+// the same 1-cell keeps that 1-cell as a slit: the boundary runs out along it and back.
+#pragma once
+
+#include "CoreTypes.h"
+#include "MonotoneSibsonPatch.h"
+#include "MorseSmaleComplexExtraction.h"
+#include "OneCellSmoothing.h"
+#include "TwoCellParameterization.h"
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace topospline
+{
+// The pieces (positions in OneCellSmoothingResult::Pieces) along each side of one cell, every
+// side oriented from its lower corner to its upper one (every piece runs from low to high).
+struct TwoCellSides
+{
+  enum Side : int
+  {
+    Bottom = 0,
+    Right = 1,
+    Top = 2,
+    Left = 3
+  };
+  std::array<std::vector<Index>, 4> Pieces;
+  bool MinimumShifted = false; // corner (0,0) is a junction, not the minimum
+  bool MaximumShifted = false; // corner (1,1) is a junction, not the maximum
+  bool Slit = false;           // a pouch whose boundary runs out along a 1-cell and back
+  // A saddle on the other saddle's 1-cell (the two 1-cells merge right at it) or on the
+  // extremum's vertex (a 1-cell of one point) leaves a side empty: the cell has 3 corners (2
+  // if it happens in both pairs). Bottom + Right and Left + Top are each a path from the lower
+  // corner to the upper one, and an empty side takes half of its partner: SplitSides[0] is the
+  // split side of the pair Bottom + Right, SplitSides[1] of Left + Top; -1: none.
+  std::array<int, 2> SplitSides{ { -1, -1 } };
+};
+
+// Assembles the sides of `cell` (see the top of this file). Where the two descending 1-cells
+// share their first pieces (a "stem" from the minimum to the junction where they split), the
+// stem is either outside the cell, which then starts at the junction (mergeAtMinimum, the
+// paper's rule), or inside it, with the minimum at the stem's tip: the cell then wraps around
+// the stem, which stays on its boundary as a slit (mergeAtMinimum = false). Likewise at the
+// maximum. Returns false with a message when the cell cannot be mapped to a square (both
+// sides of a pair empty, unknown pieces).
+bool AssembleTwoCellSides(const TwoCell& cell, const OneCellSmoothingResult& smoothed, TwoCellSides& sides,
+  std::string& error, bool mergeAtMinimum = true, bool mergeAtMaximum = true);
+
+// The Bezier segments along one side, in order: planar control points (x0 y0 ... x3 y3) and
+// height control values.
+struct SideSegments
+{
+  std::vector<std::array<double, 8>> Curve;
+  BezierSide Height;
+};
+
+// The segments of the four sides (Bottom, Right, Top, Left), with an empty side made up from
+// half of its partner (TwoCellSides::SplitSides), cut at the segment boundary nearest the middle.
+std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed);
+
+// One reconstructed 2-cell.
+struct ReconstructedTwoCell
+{
+  bool Valid = false;  // parameterized and surface built (possibly with violations, see Surface)
+  std::string Error;   // why not, when !Valid
+  bool Negligible = false; // skipped: its boundary encloses no more than NegligibleArea
+  TwoCellSides Sides;
+  int GridSize = 0;    // N: cubic segments per side of the square after subdivision
+  double Bounds[4] = { 0, 0, 0, 0 }; // xmin, xmax, ymin, ymax of the boundary samples
+  TwoCellParameterization Parameterization;
+  MonotoneSibsonSurface Surface;
+  bool SurfaceConditionsHold = false; // MonotoneSibsonSurface::Build succeeded: no violating cell
+};
+
+struct TwoCellReconstructionReport
+{
+  Index Cells = 0;
+  Index FailedCells = 0;       // not reconstructed (see ReconstructedTwoCell::Error)
+  Index NegligibleCells = 0;   // skipped for having no area
+  Index SlitCells = 0;         // pouch cells parameterized with a slit
+  Index ShiftedCorners = 0;    // corners taken by junction points
+  Index ViolatingPatches = 0;  // Sibson grid cells failing the monotonicity conditions (0 is the goal)
+  Index LinearizedDiagonals = 0; // the paper's fallback for non-increasing Laplace values
+  Index AdjustedDiagonals = 0;   // diagonals whose values were moved to meet the conditions
+  Index MeshTriangles = 0;     // triangles of all cell meshes
+  Index BezierTriangles = 0;   // 4 N^2 per cell
+  int MaximumGridSize = 0;
+  double ParameterizationSeconds = 0; // wall time: triangulation + mean value coordinates
+  double SurfaceSeconds = 0;          // wall time: Sibson surfaces
+};
+
+// A cubic Bezier triangle of the reconstruction in the plane: control points (x, y, height),
+// ordinates in the order of BezierOrdinateIndex.
+struct PlanarBezierTriangle
+{
+  std::array<std::array<double, 3>, 10> Points;
+};
+
+class TwoCellReconstruction
+{
+public:
+  // c in the paper: samples per boundary Bezier segment.
+  int BoundarySamples = 5;
+  // Cells whose sides need more segments than this after subdivision (the least common
+  // multiple of the four sides' counts) are not reconstructed.
+  int MaximumGridSize = 512;
+  // A point outside every cell by at most this distance (the smoothed boundary differs from
+  // the jagged one) takes the value of the nearest boundary point. <= 0: 1e-3 of the domain.
+  double SnapDistance = 0;
+  // Target edge length of the cell triangulations; <= 0: the mean boundary sample spacing
+  // (the paper's choice). Phi is piecewise linear on these triangles, so F o Phi has a kink
+  // across every triangle edge: triangles much larger than the input's grid spacing show in a
+  // sampling of the result.
+  double MeshEdgeLength = 0;
+  // Lower bound of that target (the filter passes the input's grid spacing).
+  double MinimumMeshEdgeLength = 0;
+  // Cells whose boundary encloses at most this area are skipped (the filter passes the square
+  // of the mean grid edge: such a cell holds at most a vertex or two, which take the value of
+  // the nearest cell boundary).
+  double NegligibleArea = 0;
+  // Zero cross-boundary derivatives of every surface (MonotoneSurfaceOptions::FlatAcrossBoundary).
+  bool FlatAcrossOneCells = true;
+  // Interior values from the Coons patch instead of the Laplace solve (MonotoneSurfaceOptions).
+  bool CoonsInterior = false;
+  ParallelFor Parallel = SequentialFor;
+  ProgressHooks Hooks;
+
+  // Reconstructs every 2-cell of `complex` (the simplified complex that `smoothed` was made
+  // from). Cells that fail are reported (Report().FailedCells); the call fails only on
+  // malformed input or abort.
+  bool Reconstruct(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed, std::string& error);
+
+  Index NumberOfCells() const { return static_cast<Index>(this->Cells.size()); }
+  const ReconstructedTwoCell& Cell(Index c) const { return *this->Cells[c]; }
+  const TwoCellReconstructionReport& Report() const { return this->Summary; }
+
+  struct Evaluation
+  {
+    double Value = 0;
+    Index Cell = InvalidIndex; // InvalidIndex: no reconstructed cell near the point
+    bool Inside = false;       // false: snapped to the nearest boundary point of Cell
+  };
+  // F o Phi at (x, y). `hint`: a cell likely to contain the point (e.g. the input vertex's
+  // 2-cell), tried first; InvalidIndex if unknown.
+  Evaluation Evaluate(double x, double y, Index hint = InvalidIndex) const;
+
+  // The 4 N^2 Bezier triangles of cell c placed in the plane: heights are F's ordinates
+  // (exact); the (x, y) of the control points are those of the cubic that interpolates
+  // Phi^-1 at the 10 lattice points of each sub-triangle (Phi^-1 is piecewise linear, so the
+  // placement, not the height, is approximated). Empty for an invalid cell.
+  std::vector<PlanarBezierTriangle> PlanarBezierTriangles(Index c) const;
+
+private:
+  void ReconstructCell(Index c, const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed);
+  void BuildCellLocator();
+  bool EvaluateInCell(Index c, double x, double y, double& value) const;
+
+  std::vector<std::unique_ptr<ReconstructedTwoCell>> Cells;
+  TwoCellReconstructionReport Summary;
+  // Uniform grid over the domain; bucket b lists the valid cells whose box (grown by the snap
+  // distance) overlaps it.
+  double Origin[2] = { 0, 0 };
+  double BucketSize[2] = { 1, 1 };
+  int Buckets[2] = { 0, 0 };
+  double Snap = 0;
+  std::vector<Index> BucketStart, BucketCells;
+};
+} // namespace topospline

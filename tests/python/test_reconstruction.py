@@ -1,0 +1,120 @@
+"""Stage 4 through ParaView on the synthetic fields and every catalog data set at 2, 5 and
+25 % with k = 4 and 7 (files above 300k vertices only with TOPOSPLINE_LARGE_TESTS=1).
+Asserted: no Sibson cell violates the monotonicity conditions; critical values are
+interpolated; the Bezier patches (VTK_BEZIER_TRIANGLE) and the finer resampling (4x, 2x
+above 100k vertices) are output; the outputs' samplings (after topological sampling) have
+exactly the simplified complex's number of minima, saddles and maxima, at the input
+resolution and finer. Printed for the record: failed 2-cells, the counts before topological
+sampling, how far it moved values, the topology verdict (which also requires every critical
+point within one grid spacing of its node), and the L-infinity and RMS errors."""
+import os
+
+import numpy as np
+from paraview.simple import *
+from paraview import servermanager as sm
+from vtkmodules.util.numpy_support import vtk_to_numpy
+
+import topospline_testing as tt
+
+LoadPlugin(tt.plugin_path(), remote=False, ns=globals())
+checks = tt.Checks()
+
+inputs = [("shepard", ShepardField()), ("trig", TrigonometricField())]
+LARGE = os.environ.get("TOPOSPLINE_LARGE_TESTS") == "1"
+for entry in tt.catalog():
+    path = tt.find_dataset(entry["file"])
+    if path and entry["vertices"] > 300000 and not LARGE:
+        checks.skip("%s: %d vertices, run with TOPOSPLINE_LARGE_TESTS=1 (CI time budget)" % (entry["file"],
+                                                                                          entry["vertices"]))
+    elif path:
+        inputs.append((entry["file"], XMLImageDataReader(FileName=[path])))
+    else:
+        checks.skip("%s absent (large data sets live in ../shared/data)" % entry["file"])
+
+
+def number(fd, name, index=0):
+    array = fd.GetArray(name)
+    return array.GetValue(index) if array is not None else None
+
+
+def field_range_of(fd):
+    return number(fd, "ValueRange", 1) - number(fd, "ValueRange", 0)
+
+
+def check_reconstruction(label, reconstruct, c, resolution):
+    reconstruct.UpdatePipeline()
+    out = sm.Fetch(reconstruct)
+    fd = out.GetFieldData()
+    checks.equal(number(fd, "ViolatingPatches"), 0, "%s: no Sibson cell violates the monotonicity conditions" % label)
+    expected = [int(number(fd, "ExpectedCriticalPoints", i)) for i in range(3)]
+    checks.equal(sum(expected), len(c["cp_VertexId"]), "%s: the topology check counted every node" % label)
+    found = [int(number(fd, "InputCriticalPoints", i)) for i in range(3)]
+    fine = [int(number(fd, "ResampledCriticalPoints", i)) for i in range(3)] if resolution > 1 else None
+    # Asserted where every 2-cell was reconstructed (a failed cell keeps the input values, with
+    # their critical points); printed otherwise.
+    if number(fd, "FailedTwoCells") == 0:
+        checks.equal(found, expected, "%s: critical points of the sampling at the input resolution" % label)
+        if fine is not None:
+            checks.equal(fine, expected, "%s: critical points of the %dx finer sampling" % (label, resolution))
+    else:
+        print("%s: %d failed 2-cells; critical points at the input resolution %s, finer %s" % (
+            label, number(fd, "FailedTwoCells"), found, fine))
+    raw = [int(number(fd, "RawInputCriticalPoints", i)) for i in range(3)]
+    print("%s: failed 2-cells %d; critical points expected %s, before topological sampling %s (it moved %d "
+          "vertices, at most %.3g = %.2f%% of the range); verdict %d (%d spurious, %d missing within one grid spacing)"
+          % (label, number(fd, "FailedTwoCells"), expected, raw, number(fd, "SamplingChangedVertices"),
+             number(fd, "SamplingMaximumChange"), 100 * number(fd, "SamplingMaximumChange") / field_range_of(fd),
+             number(fd, "TopologyVerified"), fd.GetArray("SpuriousCriticalPoints").GetNumberOfTuples(),
+             fd.GetArray("MissingCriticalPoints").GetNumberOfTuples()), flush=True)
+    values = vtk_to_numpy(out.GetPointData().GetArray("Reconstructed"))
+    checks.check(bool(np.all(np.isfinite(values))), "%s: finite values" % label)
+    # F o Phi itself (before topological sampling) interpolates the critical values.
+    exact = vtk_to_numpy(out.GetPointData().GetArray("ReconstructedExact"))
+    field_range = field_range_of(fd)
+    # At the nodes whose vertex lies in a reconstructed cell (a failed cell keeps input values).
+    cell_of = vtk_to_numpy(out.GetPointData().GetArray("ReconstructionCellId"))
+    vertices = c["cp_VertexId"].astype(int)
+    located = cell_of[vertices] >= 0
+    at_nodes = exact[vertices][located]
+    moved = float(np.max(np.abs(values[vertices] - exact[vertices]))) if len(vertices) else 0.0
+    worst = float(np.max(np.abs(at_nodes - c["cp_CriticalValue"][located]))) if len(at_nodes) else 0.0
+    if number(fd, "FailedTwoCells") == 0:
+        checks.check(worst <= 1e-9 * field_range, "%s: critical values interpolated (worst %.3g)" % (label, worst))
+        print("%s: topological sampling moved node values by up to %.3g (%.2f%% of the range)"
+              % (label, moved, 100 * moved / field_range))
+    else:  # a node next to a failed cell may be snapped to a neighbour's boundary
+        print("%s: critical values off by up to %.3g next to failed cells" % (label, worst))
+    return number(fd, "MaximumError"), number(fd, "RMSError"), field_range, number(fd, "BezierTriangles")
+
+
+def fetch_port(proxy, port):
+    return sm.Fetch(proxy, None, None, port)
+
+
+for name, source in inputs:
+    source.UpdatePipeline()
+    points = source.GetDataInformation().GetNumberOfPoints()
+    resolution = 4 if points <= 100000 else (2 if points <= 300000 else 1)
+    ms = MorseSmaleComplex(Input=source)
+    for percent in (2, 5, 25):
+        simplified = SimplifyMorseSmaleComplex(Input=ms, PersistenceThreshold=percent)
+        c = tt.fetch_complex(simplified)
+        for k in (4, 7):
+            smooth = Smooth1Cells(Input=simplified, CurveSegments=k)
+            reconstruct = Reconstruct2Cells(Input=smooth, OutputResolution=resolution)
+            label = "%s %d%% k=%d" % (name, percent, k)
+            linf, rms, field_range, triangles = check_reconstruction(label, reconstruct, c, resolution)
+            bezier = fetch_port(reconstruct, 1)
+            checks.equal(bezier.GetNumberOfCells(), int(triangles), "%s: Bezier triangles on port 1" % label)
+            checks.check(bezier.GetNumberOfCells() == 0 or bezier.GetCellType(0) == 76,
+                         "%s: cells are VTK_BEZIER_TRIANGLE" % label)
+            if resolution > 1:
+                image = fetch_port(reconstruct, 2)
+                checks.check(image.GetNumberOfPoints() > points, "%s: resampled image is finer" % label)
+            print("%s: %d critical points, L-inf error %.4g (%.2f%% of range), RMS %.4g (%.3f%%), %d Bezier triangles"
+                  % (label, len(c["cp_VertexId"]), linf, 100 * linf / field_range, rms, 100 * rms / field_range,
+                     triangles), flush=True)
+            Delete(reconstruct)
+            Delete(smooth)
+        Delete(simplified)
+checks.finish()
