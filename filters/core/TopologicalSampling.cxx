@@ -17,59 +17,115 @@ struct Key
   bool operator<(const Key& o) const { return this->Value < o.Value || (this->Value == o.Value && this->Vertex < o.Vertex); }
 };
 
-// One sweep from `seeds` over the graph given by `neighbours`, upwards (ascending) or
-// downwards. A vertex popped out of order (it lies in a pit the sweep reached only through a
-// higher pass) is moved just past the last popped one. Returns the number of changed vertices.
-template <typename Neighbours>
-Index Sweep(const std::vector<Index>& seeds, bool ascending, const Neighbours& neighbours, std::vector<double>& values,
-  std::vector<unsigned char>& visited, std::vector<Index>& touched)
+// A graph in compressed rows: the neighbours of v are Adjacent[Start[v] .. Start[v + 1]).
+struct Graph
 {
-  auto before = [ascending](const Key& a, const Key& b) { return ascending ? a < b : b < a; };
-  auto later = [&](const Key& a, const Key& b) { return before(b, a); }; // min-heap in sweep order
-  std::priority_queue<Key, std::vector<Key>, decltype(later)> queue(later);
-  for (Index s : seeds)
+  std::vector<Index> Start;
+  std::vector<Index> Adjacent;
+};
+
+// Whether v has no neighbour before it in the sweep order (a minimum when ascending).
+bool IsExtremum(const Graph& g, const std::vector<double>& values, Index v, bool ascending)
+{
+  if (g.Start[v] == g.Start[v + 1])
   {
-    if (!visited[s])
+    return false;
+  }
+  const Key key{ values[v], v };
+  for (Index i = g.Start[v]; i < g.Start[v + 1]; ++i)
+  {
+    const Index w = g.Adjacent[i];
+    const Key other{ values[w], w };
+    if (ascending ? other < key : key < other)
     {
-      visited[s] = 1;
-      touched.push_back(s);
-      queue.push({ values[s], s });
+      return false;
     }
   }
-  Index changed = 0;
-  bool hasLast = false;
-  Key last{ 0, 0 };
-  std::vector<Index> around;
-  while (!queue.empty())
+  return true;
+}
+
+// Removes the unwanted extremum v by a local flood (priority-flood depression filling, the
+// local form of Tierny and Pascucci's sweep): the region grown from v in sweep order up to the
+// first vertex that drains outside it (a neighbour before it, not in the region) or that is a
+// wanted extremum of the same kind, is then re-valued from that outlet inwards, every vertex
+// just past the neighbour it was reached from, so that each has a neighbour before it. Values
+// only move in the sweep direction. Returns the number of changed vertices.
+Index Fill(const Graph& g, std::vector<double>& values, Index v, bool ascending,
+  const std::vector<unsigned char>& wanted, unsigned char flag, std::vector<unsigned>& mark, unsigned& stamp)
+{
+  auto before = [ascending](const Key& a, const Key& b) { return ascending ? a < b : b < a; };
+  auto later = [&](const Key& a, const Key& b) { return before(b, a); };
+  std::priority_queue<Key, std::vector<Key>, decltype(later)> queue(later);
+  const unsigned seen = ++stamp;
+  mark[v] = seen;
+  queue.push({ values[v], v });
+  std::vector<Index> region;
+  Index outlet = InvalidIndex;
+  while (!queue.empty() && outlet == InvalidIndex)
   {
-    Key current = queue.top();
+    const Index u = queue.top().Vertex;
     queue.pop();
-    if (hasLast && !before(last, current))
+    const Key key{ values[u], u };
+    if (u != v && (wanted[u] & flag))
     {
-      // Just past `last` in the sweep order: the same value if the id already orders it after,
-      // else the next double.
-      double v = last.Value;
-      const bool idAfter = ascending ? current.Vertex > last.Vertex : current.Vertex < last.Vertex;
-      if (!idAfter)
-      {
-        v = std::nextafter(v, ascending ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity());
-      }
-      values[current.Vertex] = v;
-      current.Value = v;
-      ++changed;
+      outlet = u;
+      break;
     }
-    last = current;
-    hasLast = true;
-    around.clear();
-    neighbours(current.Vertex, around);
-    for (Index n : around)
+    for (Index i = g.Start[u]; i < g.Start[u + 1]; ++i)
     {
-      if (!visited[n])
+      const Index w = g.Adjacent[i];
+      if (mark[w] != seen && before({ values[w], w }, key))
       {
-        visited[n] = 1;
-        touched.push_back(n);
-        queue.push({ values[n], n });
+        outlet = u;
+        break;
       }
+    }
+    if (outlet != InvalidIndex)
+    {
+      break;
+    }
+    region.push_back(u);
+    for (Index i = g.Start[u]; i < g.Start[u + 1]; ++i)
+    {
+      const Index w = g.Adjacent[i];
+      if (mark[w] != seen)
+      {
+        mark[w] = seen;
+        queue.push({ values[w], w });
+      }
+    }
+  }
+  if (outlet == InvalidIndex)
+  {
+    return 0; // the whole component: nothing to drain into
+  }
+  // From the outlet inwards (breadth first over the region).
+  const unsigned inRegion = ++stamp;
+  for (Index r : region)
+  {
+    mark[r] = inRegion;
+  }
+  const double direction = ascending ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
+  std::vector<Index> front = { outlet };
+  Index changed = 0;
+  for (std::size_t k = 0; k < front.size(); ++k)
+  {
+    const Index p = front[k];
+    for (Index i = g.Start[p]; i < g.Start[p + 1]; ++i)
+    {
+      const Index r = g.Adjacent[i];
+      if (mark[r] != inRegion)
+      {
+        continue;
+      }
+      mark[r] = 0;
+      const double past = std::nextafter(values[p], direction);
+      if (ascending ? values[r] < past : values[r] > past)
+      {
+        values[r] = past;
+        ++changed;
+      }
+      front.push_back(r);
     }
   }
   return changed;
@@ -82,42 +138,40 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
   TopologicalSamplingReport report;
   const Index n = mesh.NumberOfVertices();
   const std::vector<double> original = values;
-  std::vector<unsigned char> visited(n, 0);
-  std::vector<Index> touched;
-  auto all = [&mesh](Index v, std::vector<Index>& out) {
-    for (Index i = mesh.VertexTriangleBegin(v); i < mesh.VertexTriangleEnd(v); ++i)
+  // Vertex adjacency (all edges, and boundary edges only), built once.
+  Graph all, boundary;
+  all.Start.assign(n + 1, 0);
+  boundary.Start.assign(n + 1, 0);
+  for (Index e = 0; e < mesh.NumberOfEdges(); ++e)
+  {
+    for (Index v : mesh.EdgeVertices[e])
     {
-      for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
+      ++all.Start[v + 1];
+      boundary.Start[v + 1] += mesh.IsBoundaryEdge(e) ? 1 : 0;
+    }
+  }
+  for (Index v = 0; v < n; ++v)
+  {
+    all.Start[v + 1] += all.Start[v];
+    boundary.Start[v + 1] += boundary.Start[v];
+  }
+  all.Adjacent.resize(all.Start[n]);
+  boundary.Adjacent.resize(boundary.Start[n]);
+  {
+    std::vector<Index> fill(all.Start.begin(), all.Start.end() - 1);
+    std::vector<Index> boundaryFill(boundary.Start.begin(), boundary.Start.end() - 1);
+    for (Index e = 0; e < mesh.NumberOfEdges(); ++e)
+    {
+      const Index a = mesh.EdgeVertices[e][0], b = mesh.EdgeVertices[e][1];
+      all.Adjacent[fill[a]++] = b;
+      all.Adjacent[fill[b]++] = a;
+      if (mesh.IsBoundaryEdge(e))
       {
-        if (w != v)
-        {
-          out.push_back(w);
-        }
+        boundary.Adjacent[boundaryFill[a]++] = b;
+        boundary.Adjacent[boundaryFill[b]++] = a;
       }
     }
-  };
-  auto alongBoundary = [&mesh](Index v, std::vector<Index>& out) {
-    for (Index i = mesh.VertexTriangleBegin(v); i < mesh.VertexTriangleEnd(v); ++i)
-    {
-      for (Index e : mesh.TriangleEdges[mesh.VertexTriangle(i)])
-      {
-        const auto& ends = mesh.EdgeVertices[e];
-        if (mesh.IsBoundaryEdge(e) && (ends[0] == v || ends[1] == v))
-        {
-          out.push_back(mesh.OtherEdgeVertex(e, v));
-        }
-      }
-    }
-  };
-  auto reset = [&]() {
-    for (Index v : touched)
-    {
-      visited[v] = 0;
-    }
-    touched.clear();
-  };
-  // Whether any vertex other than a wanted one is an extremum (of the whole link, or along the
-  // boundary curve): a cheap test that spares the sweeps when there is nothing to do.
+  }
   std::vector<unsigned char> wanted(n, 0);
   for (Index v : constraints.Minima)
   {
@@ -135,62 +189,55 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
   {
     wanted[v] |= 8;
   }
-  auto spuriousExtremum = [&]() {
-    std::vector<Index> around;
-    for (Index v = 0; v < n; ++v)
-    {
-      const Key key{ values[v], v };
-      auto check = [&](const auto& neighbours, unsigned char minimumFlag, unsigned char maximumFlag) {
-        around.clear();
-        neighbours(v, around);
-        bool lower = false, higher = false;
-        for (Index w : around)
-        {
-          const Key other{ values[w], w };
-          (other < key ? lower : higher) = true;
-        }
-        return (!lower && !(wanted[v] & minimumFlag)) || (!higher && !(wanted[v] & maximumFlag));
-      };
-      if (check(all, 1, 2) || (mesh.IsBoundaryVertex(v) && check(alongBoundary, 4, 8)))
-      {
-        return true;
-      }
-    }
-    return false;
+  // Passes: along the boundary curve first (stage 1's boundary rule), then whole links.
+  struct Pass
+  {
+    const Graph* G;
+    bool Ascending;
+    unsigned char Flag;
   };
+  const Pass passes[4] = { { &boundary, true, 4 }, { &boundary, false, 8 }, { &all, true, 1 }, { &all, false, 2 } };
+  std::vector<unsigned> mark(n, 0);
+  unsigned stamp = 0;
+  Index previousChanged = -1;
   for (report.Rounds = 1; report.Rounds <= maximumRounds; ++report.Rounds)
   {
-    if (!spuriousExtremum())
-    {
-      report.Converged = true;
-      break;
-    }
     Index changed = 0;
-    if (!constraints.BoundaryMinima.empty())
+    for (const Pass& pass : passes)
     {
-      changed += Sweep(constraints.BoundaryMinima, true, alongBoundary, values, visited, touched);
-      reset();
-    }
-    if (!constraints.BoundaryMaxima.empty())
-    {
-      changed += Sweep(constraints.BoundaryMaxima, false, alongBoundary, values, visited, touched);
-      reset();
-    }
-    if (!constraints.Minima.empty())
-    {
-      changed += Sweep(constraints.Minima, true, all, values, visited, touched);
-      reset();
-    }
-    if (!constraints.Maxima.empty())
-    {
-      changed += Sweep(constraints.Maxima, false, all, values, visited, touched);
-      reset();
+      std::vector<Index> candidates;
+      for (Index v = 0; v < n; ++v)
+      {
+        if (!(wanted[v] & pass.Flag) && IsExtremum(*pass.G, values, v, pass.Ascending))
+        {
+          candidates.push_back(v);
+        }
+      }
+      for (Index v : candidates)
+      {
+        if (IsExtremum(*pass.G, values, v, pass.Ascending))
+        {
+          changed += Fill(*pass.G, values, v, pass.Ascending, wanted, pass.Flag, mark, stamp);
+        }
+      }
+      if (stamp > std::numeric_limits<unsigned>::max() / 2)
+      {
+        std::fill(mark.begin(), mark.end(), 0u);
+        stamp = 0;
+      }
     }
     if (changed == 0)
     {
       report.Converged = true;
       break;
     }
+    // The same handful of changes again: a boundary and a whole-link constraint keep undoing
+    // each other by a few ulps; more rounds would only repeat it.
+    if (changed == previousChanged)
+    {
+      break;
+    }
+    previousChanged = changed;
   }
   report.Rounds = std::min(report.Rounds, maximumRounds);
   for (Index v = 0; v < n; ++v)

@@ -38,7 +38,10 @@ struct SamplingConstraints
                                      // critical boundary edge: a boundary saddle)
 };
 
-// Modifies `values` (one per mesh vertex) in place.
+// Modifies `values` (one per mesh vertex) in place. The alternation usually settles in one or
+// two rounds; where a boundary constraint and the whole-link ones disagree about a vertex it
+// can go on moving values by a few ulps per round, so it stops after `maximumRounds`
+// (Converged is then false, and a few spurious pairs may remain).
 TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
-  const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds = 50);
+  const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds = 6);
 } // namespace topospline

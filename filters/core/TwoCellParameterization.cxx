@@ -958,9 +958,22 @@ bool TwoCellParameterization::LocateInGrid(const BucketGrid& grid, const std::ve
     {
       continue;
     }
+    if (orientation * lambda[0] > 0 && orientation * lambda[1] > 0 && orientation * lambda[2] > 0)
+    {
+      // Strictly inside: no other triangle of a valid mesh contains the point, no need to
+      // compare depths (this is the common case, so it comes first).
+      for (int k2 = 0; k2 < 3; ++k2)
+      {
+        barycentric[k2] = lambda[k2] / sum;
+      }
+      triangle = t;
+      return true;
+    }
     // Sub-area over the opposite edge length = signed distance to that edge's line.
-    const double edges[3] = { std::hypot(q[0] - b[0], q[1] - b[1]), std::hypot(a[0] - q[0], a[1] - q[1]),
-      std::hypot(b[0] - a[0], b[1] - a[1]) };
+    auto length = [](const double* u, const double* w) {
+      return std::sqrt((u[0] - w[0]) * (u[0] - w[0]) + (u[1] - w[1]) * (u[1] - w[1]));
+    };
+    const double edges[3] = { length(q, b), length(a, q), length(b, a) };
     double depth = std::numeric_limits<double>::infinity();
     for (int k2 = 0; k2 < 3; ++k2)
     {

@@ -368,81 +368,98 @@ bool TwoCellReconstruction::Reconstruct(
       std::string message;
       const TwoCell& twoCell = complex.TwoCells[c];
       std::vector<double> walk, parameters;
-      bool mergeAtMinimum = true, mergeAtMaximum = true;
-      bool assembled = false;
-      for (int attempt = 0; attempt < 3; ++attempt)
-      {
+      auto assemble = [&](bool mergeAtMinimum, bool mergeAtMaximum) {
         if (!AssembleTwoCellSides(twoCell, smoothed, cell.Sides, message, mergeAtMinimum, mergeAtMaximum))
         {
-          break;
+          return false;
         }
         BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed), this->BoundarySamples, walk, parameters,
           boundaries[c]);
-        // A stem that ends inside the walk is the cell's own: keep it as a slit instead.
-        bool retry = false;
-        if (mergeAtMinimum && cell.Sides.MinimumShifted &&
-          InsidePolygon(walk, StartOf(smoothed, twoCell.Arcs[0])))
+        return true;
+      };
+      // The paper's rule first (merged 1-cells: the junction takes the corner); a stem that
+      // ends inside the resulting walk is the cell's own, and stays on its boundary as a slit.
+      if (!assemble(true, true))
+      {
+        cell.Error = message;
+        continue;
+      }
+      const bool stemAtMinimum = cell.Sides.MinimumShifted, stemAtMaximum = cell.Sides.MaximumShifted;
+      std::array<bool, 2> merge = { { !(stemAtMinimum && InsidePolygon(walk, StartOf(smoothed, twoCell.Arcs[0]))),
+        !(stemAtMaximum && InsidePolygon(walk, EndOf(smoothed, twoCell.Arcs[1]))) } };
+      // The point-in-polygon test can be fooled by a walk that is not simple: if the
+      // parameterization refuses the chosen assembly, the other choices for the stems follow.
+      std::vector<std::array<bool, 2>> choices = { merge };
+      if (stemAtMinimum)
+      {
+        choices.push_back({ { !merge[0], merge[1] } });
+      }
+      if (stemAtMaximum)
+      {
+        choices.push_back({ { merge[0], !merge[1] } });
+      }
+      if (stemAtMinimum && stemAtMaximum)
+      {
+        choices.push_back({ { !merge[0], !merge[1] } });
+      }
+      std::string firstError;
+      for (const auto& choice : choices)
+      {
+        if (!assemble(choice[0], choice[1]))
         {
-          mergeAtMinimum = false;
-          retry = true;
+          firstError = firstError.empty() ? message : firstError;
+          continue;
         }
-        if (mergeAtMaximum && cell.Sides.MaximumShifted && InsidePolygon(walk, EndOf(smoothed, twoCell.Arcs[1])))
+        // Cells of (almost) no area, e.g. a zero-persistence pair on the domain boundary whose
+        // 1-cells run on top of each other, hold no vertex: they are skipped, and counted.
+        double area = 0;
+        for (std::size_t i = 0, count = walk.size() / 2; i < count; ++i)
         {
-          mergeAtMaximum = false;
-          retry = true;
+          const std::size_t j = (i + 1) % count;
+          area += walk[2 * i] * walk[2 * j + 1] - walk[2 * j] * walk[2 * i + 1];
         }
-        if (!retry)
+        if (std::abs(0.5 * area) <= this->NegligibleArea)
         {
-          assembled = true;
+          cell.Negligible = true;
           break;
         }
+        cell.Bounds[0] = cell.Bounds[2] = std::numeric_limits<double>::infinity();
+        cell.Bounds[1] = cell.Bounds[3] = -std::numeric_limits<double>::infinity();
+        for (std::size_t i = 0; i < walk.size(); i += 2)
+        {
+          cell.Bounds[0] = std::min(cell.Bounds[0], walk[i]);
+          cell.Bounds[1] = std::max(cell.Bounds[1], walk[i]);
+          cell.Bounds[2] = std::min(cell.Bounds[2], walk[i + 1]);
+          cell.Bounds[3] = std::max(cell.Bounds[3], walk[i + 1]);
+        }
+        // The paper's interior triangle size is the mean boundary sample spacing; dense samples
+        // on short 1-cells (large k) would make it far finer than the input grid, which only
+        // costs time: it is kept at least MinimumMeshEdgeLength.
+        double perimeter = 0;
+        const std::size_t samples = walk.size() / 2;
+        for (std::size_t i = 0; i < samples; ++i)
+        {
+          const std::size_t j = (i + 1) % samples;
+          perimeter += std::hypot(walk[2 * j] - walk[2 * i], walk[2 * j + 1] - walk[2 * i + 1]);
+        }
+        const double spacing =
+          this->MeshEdgeLength > 0 ? this->MeshEdgeLength : perimeter / std::max<std::size_t>(samples, 1);
+        cell.Parameterization.TargetEdgeLength = std::max(spacing, this->MinimumMeshEdgeLength);
+        if (cell.Parameterization.Parameterize(walk, parameters, message))
+        {
+          cell.Valid = true;
+          break;
+        }
+        firstError = firstError.empty() ? "parameterization: " + message : firstError;
       }
-      if (!assembled)
+      if (cell.Negligible)
       {
-        cell.Error = message.empty() ? "its sides could not be assembled" : message;
-        continue;
-      }
-      // Cells of (almost) no area, e.g. a zero-persistence pair on the domain boundary whose
-      // 1-cells run on top of each other, hold no vertex: they are skipped, and counted.
-      double area = 0;
-      for (std::size_t i = 0, count = walk.size() / 2; i < count; ++i)
-      {
-        const std::size_t j = (i + 1) % count;
-        area += walk[2 * i] * walk[2 * j + 1] - walk[2 * j] * walk[2 * i + 1];
-      }
-      if (std::abs(0.5 * area) <= this->NegligibleArea)
-      {
-        cell.Negligible = true;
         cell.Error = "it has no area";
-        continue;
       }
-      cell.Bounds[0] = cell.Bounds[2] = std::numeric_limits<double>::infinity();
-      cell.Bounds[1] = cell.Bounds[3] = -std::numeric_limits<double>::infinity();
-      for (std::size_t i = 0; i < walk.size(); i += 2)
+      else if (!cell.Valid)
       {
-        cell.Bounds[0] = std::min(cell.Bounds[0], walk[i]);
-        cell.Bounds[1] = std::max(cell.Bounds[1], walk[i]);
-        cell.Bounds[2] = std::min(cell.Bounds[2], walk[i + 1]);
-        cell.Bounds[3] = std::max(cell.Bounds[3], walk[i + 1]);
+        cell.Error = firstError;
       }
-      // The paper's interior triangle size is the mean boundary sample spacing; dense samples
-      // on short 1-cells (large k) would make it far finer than the input grid, which only
-      // costs time: it is kept at least MinimumMeshEdgeLength.
-      double perimeter = 0;
-      const std::size_t samples = walk.size() / 2;
-      for (std::size_t i = 0; i < samples; ++i)
-      {
-        const std::size_t j = (i + 1) % samples;
-        perimeter += std::hypot(walk[2 * j] - walk[2 * i], walk[2 * j + 1] - walk[2 * i + 1]);
-      }
-      const double spacing = this->MeshEdgeLength > 0 ? this->MeshEdgeLength : perimeter / std::max<std::size_t>(samples, 1);
-      cell.Parameterization.TargetEdgeLength = std::max(spacing, this->MinimumMeshEdgeLength);
-      if (!cell.Parameterization.Parameterize(walk, parameters, message))
-      {
-        cell.Error = "parameterization: " + message;
-        continue;
-      }
-      cell.Valid = true;
     }
   });
   if (this->Hooks.Aborted())
