@@ -72,14 +72,14 @@ bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<Smoothin
   // piece that lies entirely on one side of the domain's box may touch that side: a boundary
   // stretch belongs to one piece at most (1-cells on the same vertices share their pieces),
   // and any other curve touching it would make the 2-cells of stage 4 pinch. Other pieces are
-  // kept a quarter of their sample spacing inside.
+  // kept a hundredth of their sample spacing inside.
   const std::size_t samples = piece.Points.size() / 2;
   double length = 0;
   for (std::size_t i = 1; i < samples; ++i)
   {
     length += std::hypot(piece.Points[2 * i] - piece.Points[2 * i - 2], piece.Points[2 * i + 1] - piece.Points[2 * i - 1]);
   }
-  const double margin = samples > 1 ? 0.25 * length / (samples - 1) : 0.0;
+  const double margin = samples > 1 ? 0.01 * length / (samples - 1) : 0.0;
   double box[4];
   for (int side = 0; side < 4; ++side)
   {

@@ -1,4 +1,4 @@
-"""Under mpiexec -n 2 pvbatch the pipeline (stages 1 to 3, on the built-in Shepard field and a
+"""Under mpiexec -n 2 pvbatch the pipeline (stages 1 to 4, on the built-in Shepard field and a
 terrain read by a reader that splits its image across processes) gives the same result as in
 one process: the complex is computed on the process of piece 0, from the whole input."""
 import os
@@ -15,10 +15,16 @@ for name, source in (("shepard", ShepardField()), ("rainier", XMLImageDataReader
     complex_ = MorseSmaleComplex(Input=source)
     simplified = SimplifyMorseSmaleComplex(Input=complex_, PersistenceThreshold=2)
     smoothed = Smooth1Cells(Input=simplified, CurveSegments=4)
-    for stage, proxy in (("complex", complex_), ("simplified", simplified), ("smoothed", smoothed)):
+    reconstruction = Reconstruct2Cells(Input=smoothed)
+    for stage, proxy in (("complex", complex_), ("simplified", simplified), ("smoothed", smoothed),
+                         ("reconstruction", reconstruction)):
         proxy.UpdatePipeline()
         info = proxy.GetDataInformation()
-        print("DIGEST", name, stage, info.GetNumberOfPoints(), info.GetNumberOfCells())
+        extra = ""
+        if stage == "reconstruction":
+            values = info.GetPointDataInformation().GetArrayInformation("Reconstructed")
+            extra = " %.12g %.12g" % values.GetComponentRange(0)
+        print("DIGEST", name, stage, info.GetNumberOfPoints(), info.GetNumberOfCells(), extra)
 """
 terrain = tt.find_dataset("rainier_ned1_1970_crop458x306.vti")
 script = SCRIPT % {"plugin": tt.plugin_path(), "terrain": terrain}
@@ -38,7 +44,7 @@ else:
         checks.equal(result.returncode, 0, "%s run exits cleanly (%s)" % (label, output[-500:]))
         checks.check("ERR|" not in output, "%s run logs no error (%s)" % (label, output[-500:]))
         runs[label] = sorted(set(line for line in result.stdout.splitlines() if line.startswith("DIGEST")))
-    checks.equal(len(runs["serial"]), 6, "serial run reports every stage")
+    checks.equal(len(runs["serial"]), 8, "serial run reports every stage")
     checks.equal(runs["2 processes"], runs["serial"], "2 processes give the serial result")
     print("\n".join(runs["serial"]))
 checks.finish()

@@ -1,5 +1,6 @@
-"""The ParaView GUI starts with the plugin, runs stages 1 to 3 on the built-in Shepard field in
-its own render view (drawn in the style of the paper's figure 6) and saves a screenshot;
+"""The ParaView GUI starts with the plugin, runs the four stages on the built-in Shepard field in
+its own render view (the reconstruction with the smoothed 1-cells, in the style of the paper's
+figure 6) and saves a screenshot;
 under xvfb-run. (A GUI start-up script that creates layouts and views hangs the 5.11 GUI
 here, so this uses the GUI's own view.)"""
 import os
@@ -21,8 +22,9 @@ LoadPlugin(os.environ["TOPOSPLINE_PLUGIN"], remote=False, ns=globals())
 field = ShepardField()
 field.UpdatePipeline()
 smooth = Smooth1Cells(Input=SimplifyMorseSmaleComplex(Input=MorseSmaleComplex(Input=field), PersistenceThreshold=25))
+reconstruction = Reconstruct2Cells(Input=smooth)
 view = GetActiveViewOrCreate("RenderView")
-style.field_with_isolines(field, "Shepard", view)
+style.field_with_isolines(reconstruction, "Reconstructed", view)
 style.complex_lines(smooth, view)
 style.view_from_above(view)
 SaveScreenshot(%(shot)r, view, ImageResolution=[1000, 800])
