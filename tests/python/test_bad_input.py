@@ -67,6 +67,32 @@ CASES = {
     "smoothing input is not a complex": ("ms = Smooth1Cells(Input=GroupDatasets(Input=[TrigonometricField()]))",
                                          "not a Morse-Smale complex"),
 }
+# Stage 4 and the one-step filter: their first output is a data set; bad input leaves it empty.
+RECONSTRUCTION_EPILOGUE = """
+ms.UpdatePipeline()
+out = sm.Fetch(ms)
+print("POINTS", out.GetNumberOfPoints())
+"""
+SMOOTHED = "sm1 = Smooth1Cells(Input=SimplifyMorseSmaleComplex(Input=MorseSmaleComplex(Input=TrigonometricField())))\n"
+RECONSTRUCTION_CASES = {
+    "reconstruction input not smoothed": ("ms = Reconstruct2Cells(Input=SimplifyMorseSmaleComplex("
+                                          "Input=MorseSmaleComplex(Input=TrigonometricField())))",
+                                          "no smoothed 1-cells", 0),
+    "reconstruction input is not a complex": ("ms = Reconstruct2Cells(Input=GroupDatasets(Input=[TrigonometricField()]))",
+                                              "not a Morse-Smale complex", 0),
+    "boundary samples 0": (SMOOTHED + "ms = Reconstruct2Cells(Input=sm1, BoundarySamples=0)",
+                           "Boundary Samples must be in [1, 1000]", 0),
+    "output resolution absurd": (SMOOTHED + "ms = Reconstruct2Cells(Input=sm1, OutputResolution=1000)",
+                                 "Output Resolution must be in [1, 64]", 0),
+    "one step on a 3D image": ("ms = TopoSplineReconstruction(Input=Wavelet())", "the image is 3D", 0),
+    "one step with NaN values": ("v = np.random.rand(100); v[3] = np.nan\n"
+                                 "ms = TopoSplineReconstruction(Input=producer(image(v, (10, 10, 1))))", "non-finite", 0),
+    # Not errors, but must neither crash nor hang: a plateau and a tiny noisy field.
+    "plateau through all stages": ("ms = TopoSplineReconstruction(Input=producer(image(np.r_[np.zeros(60), "
+                                   "np.random.rand(40)], (10, 10, 1))), PersistenceThreshold=0)", "", None),
+    "tiny noise field through all stages": ("ms = TopoSplineReconstruction(Input=producer(image(np.random.rand(16), "
+                                            "(4, 4, 1))), PersistenceThreshold=0)", "", None),
+}
 # Not an error: a stale or mistyped array name falls back to the active scalars, with a warning.
 FALLBACKS = {
     "missing array name": ("ms = MorseSmaleComplex(Input=TrigonometricField())\n"
@@ -87,4 +113,14 @@ for name, (body, expected) in CASES.items():
     run(name, body, expected, 0)
 for name, (body, expected) in FALLBACKS.items():
     run(name, body, expected, 4)
+for name, (body, expected, points) in RECONSTRUCTION_CASES.items():
+    result = subprocess.run(["pvpython", "--force-offscreen-rendering", "-c", PRELUDE + body + RECONSTRUCTION_EPILOGUE],
+                            capture_output=True, text=True, timeout=300)
+    output = result.stdout + result.stderr
+    checks.equal(result.returncode, 0, "%s: exits cleanly (output: %s)" % (name, output[-500:]))
+    checks.check(expected in output, "%s: message contains %r (output: %s)" % (name, expected, output[-500:]))
+    if points is not None:
+        checks.check("POINTS %d" % points in output, "%s: empty output (%s)" % (name, output[-300:]))
+    else:
+        checks.check("POINTS 100" in output or "POINTS 16" in output, "%s: output on the input geometry" % name)
 checks.finish()

@@ -23,7 +23,7 @@ for name, source in (("shepard", ShepardField()), ("rainier", XMLImageDataReader
         extra = ""
         if stage == "reconstruction":
             values = info.GetPointDataInformation().GetArrayInformation("Reconstructed")
-            extra = " %.12g %.12g" % values.GetComponentRange(0)
+            extra = " %%.12g %%.12g" %% values.GetComponentRange(0)
         print("DIGEST", name, stage, info.GetNumberOfPoints(), info.GetNumberOfCells(), extra)
 """
 terrain = tt.find_dataset("rainier_ned1_1970_crop458x306.vti")
