@@ -19,31 +19,37 @@ double Seconds(Clock::time_point start)
 }
 
 // Samples one side, forward from its lower corner: c points per Bezier segment plus the end
-// point, with the side parameter tau = (segment + t) / segments of each.
-void SampleSide(const SideSegments& side, int c, std::vector<double>& xy, std::vector<double>& tau)
+// point, with the side parameter tau of each: segment j of piece i covers m_i grid segments of
+// the N along the side (ChooseGridLayout).
+void SampleSide(const SideSegments& side, const std::vector<int>& multipliers, int n, int c, std::vector<double>& xy,
+  std::vector<double>& tau)
 {
-  const int total = static_cast<int>(side.Curve.size());
   double point[2];
-  for (int j = 0; j < total; ++j)
+  int segment = 0, offset = 0;
+  for (std::size_t i = 0; i < side.Pieces.size(); ++i)
   {
-    const double* curve = side.Curve[j].data();
-    for (int i = 0; i < c; ++i)
+    for (int j = 0; j < side.Pieces[i]; ++j, ++segment)
     {
-      const double t = static_cast<double>(i) / c;
-      // t = 0 is the control point itself, bit for bit: neighbouring cells and the two sides
-      // of a slit then share their samples exactly.
-      if (i == 0)
+      const double* curve = side.Curve[segment].data();
+      for (int k = 0; k < c; ++k)
       {
-        point[0] = curve[0];
-        point[1] = curve[1];
+        const double t = static_cast<double>(k) / c;
+        // t = 0 is the control point itself, bit for bit: neighbouring cells and the two
+        // sides of a slit then share their samples exactly.
+        if (k == 0)
+        {
+          point[0] = curve[0];
+          point[1] = curve[1];
+        }
+        else
+        {
+          CubicBezierSpline::EvaluateSegment(curve, 2, t, point);
+        }
+        xy.insert(xy.end(), point, point + 2);
+        tau.push_back((offset + (j + t) * multipliers[i]) / n);
       }
-      else
-      {
-        CubicBezierSpline::EvaluateSegment(curve, 2, t, point);
-      }
-      xy.insert(xy.end(), point, point + 2);
-      tau.push_back((j + t) / total);
     }
+    offset += side.Pieces[i] * multipliers[i];
   }
   const double* end = side.Curve.back().data() + 6;
   xy.insert(xy.end(), end, end + 2);
@@ -52,14 +58,32 @@ void SampleSide(const SideSegments& side, int c, std::vector<double>& xy, std::v
 
 // The closed walk around a cell: bottom and right forwards, top and left backwards (each
 // side without its last point, the next side's first), with the (u, v) of every sample, and
-// the height segments of the four sides.
-void BuildBoundaryWalk(std::array<SideSegments, 4>&& segments, int c, std::vector<double>& walk,
+// the height segments of the four sides subdivided to the grid layout. False when no grid
+// size up to `maximum` fits the sides.
+bool BuildBoundaryWalk(const std::array<SideSegments, 4>& segments, int c, int maximum, std::vector<double>& walk,
   std::vector<double>& parameters, MonotoneSurfaceBoundary& boundary)
 {
+  std::array<std::vector<int>, 4> multipliers;
+  const int n = ChooseGridLayout(segments, maximum, multipliers);
+  if (n == 0)
+  {
+    return false;
+  }
   std::array<std::vector<double>, 4> xy, tau;
+  std::array<BezierSide, 4> heights;
   for (int s = 0; s < 4; ++s)
   {
-    SampleSide(segments[s], c, xy[s], tau[s]);
+    SampleSide(segments[s], multipliers[s], n, c, xy[s], tau[s]);
+    int first = 0;
+    for (std::size_t i = 0; i < segments[s].Pieces.size(); ++i)
+    {
+      const int k = segments[s].Pieces[i];
+      const BezierSide piece(segments[s].Height.begin() + first, segments[s].Height.begin() + first + k);
+      BezierSide subdivided;
+      SubdivideSide(piece, k * multipliers[s][i], subdivided);
+      heights[s].insert(heights[s].end(), subdivided.begin(), subdivided.end());
+      first += k;
+    }
   }
   walk.clear();
   parameters.clear();
@@ -78,10 +102,11 @@ void BuildBoundaryWalk(std::array<SideSegments, 4>&& segments, int c, std::vecto
   append(TwoCellSides::Right, true, 1, 0, 0, 1);  // (1, tau)
   append(TwoCellSides::Top, false, 0, 1, 1, 0);   // (tau, 1), from tau = 1 down
   append(TwoCellSides::Left, false, 0, 0, 0, 1);  // (0, tau), from tau = 1 down
-  boundary.Bottom = std::move(segments[TwoCellSides::Bottom].Height);
-  boundary.Right = std::move(segments[TwoCellSides::Right].Height);
-  boundary.Top = std::move(segments[TwoCellSides::Top].Height);
-  boundary.Left = std::move(segments[TwoCellSides::Left].Height);
+  boundary.Bottom = std::move(heights[TwoCellSides::Bottom]);
+  boundary.Right = std::move(heights[TwoCellSides::Right]);
+  boundary.Top = std::move(heights[TwoCellSides::Top]);
+  boundary.Left = std::move(heights[TwoCellSides::Left]);
+  return true;
 }
 
 // Even-odd point-in-polygon test.
@@ -230,9 +255,23 @@ bool AssembleTwoCellSides(const TwoCell& cell, const OneCellSmoothingResult& smo
     sides.Slit = true;
   }
   // A side of zero length (a 1-cell of one point: a saddle on its extremum's vertex) is no
-  // side: the cell has 3 corners.
+  // side: the cell has 3 corners. Likewise a side that ends where it starts: on the domain
+  // boundary, a maximum can sit on its saddle's vertex, and the ascending 1-cell between them
+  // is a loop through a few triangles around that vertex (well below a grid cell).
   for (auto& side : sides.Pieces)
   {
+    if (!side.empty() && side.front() >= 0 && side.back() >= 0 &&
+      side.front() < static_cast<Index>(smoothed.Pieces.size()) &&
+      side.back() < static_cast<Index>(smoothed.Pieces.size()))
+    {
+      const auto& first = smoothed.Pieces[side.front()].Curve.ControlPoints;
+      const auto& last = smoothed.Pieces[side.back()].Curve.ControlPoints;
+      if (!first.empty() && !last.empty() && first[0] == last[last.size() - 2] && first[1] == last.back())
+      {
+        side.clear();
+        continue;
+      }
+    }
     bool degenerate = !side.empty();
     for (Index p : side)
     {
@@ -281,6 +320,58 @@ bool AssembleTwoCellSides(const TwoCell& cell, const OneCellSmoothingResult& smo
   return true;
 }
 
+int ChooseGridLayout(const std::array<SideSegments, 4>& sides, int maximum, std::array<std::vector<int>, 4>& multipliers)
+{
+  int lowest = 1;
+  for (const auto& side : sides)
+  {
+    lowest = std::max(lowest, static_cast<int>(side.Curve.size()));
+  }
+  // reach[s][r]: the piece whose count ends a way of writing r as a sum of the side's piece
+  // counts (-1: none; r = 0 needs none), an unbounded coin problem per side.
+  std::array<std::vector<int>, 4> reach;
+  for (int s = 0; s < 4; ++s)
+  {
+    reach[s].assign(std::max(maximum - static_cast<int>(sides[s].Curve.size()), 0) + 1, -1);
+    for (int r = 1; r < static_cast<int>(reach[s].size()); ++r)
+    {
+      for (std::size_t i = 0; i < sides[s].Pieces.size() && reach[s][r] < 0; ++i)
+      {
+        const int k = sides[s].Pieces[i];
+        if (k <= r && (r == k || reach[s][r - k] >= 0))
+        {
+          reach[s][r] = static_cast<int>(i);
+        }
+      }
+    }
+  }
+  for (int n = lowest; n <= maximum; ++n)
+  {
+    bool fits = true;
+    for (int s = 0; s < 4 && fits; ++s)
+    {
+      const int extra = n - static_cast<int>(sides[s].Curve.size());
+      fits = extra == 0 || (extra > 0 && reach[s][extra] >= 0);
+    }
+    if (!fits)
+    {
+      continue;
+    }
+    for (int s = 0; s < 4; ++s)
+    {
+      multipliers[s].assign(sides[s].Pieces.size(), 1);
+      for (int r = n - static_cast<int>(sides[s].Curve.size()); r > 0;)
+      {
+        const int i = reach[s][r];
+        ++multipliers[s][i];
+        r -= sides[s].Pieces[i];
+      }
+    }
+    return n;
+  }
+  return 0;
+}
+
 std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed)
 {
   std::array<SideSegments, 4> result;
@@ -289,6 +380,7 @@ std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const
     for (Index p : sides.Pieces[s])
     {
       const SmoothedPiece& piece = smoothed.Pieces[p];
+      result[s].Pieces.push_back(piece.Curve.Segments);
       for (int j = 0; j < piece.Curve.Segments; ++j)
       {
         std::array<double, 8> curve;
@@ -321,6 +413,7 @@ std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const
       CubicHeightSegment lower, upper;
       SplitCubicSegment(whole.Height[0], 0.5, lower, upper);
       halved.Height = { lower, upper };
+      halved.Pieces = { 2 };
       whole = std::move(halved);
     }
     const std::size_t half = whole.Curve.size() / 2;
@@ -329,6 +422,21 @@ std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const
     lower.Height.assign(whole.Height.begin(), whole.Height.begin() + half);
     upper.Curve.assign(whole.Curve.begin() + half, whole.Curve.end());
     upper.Height.assign(whole.Height.begin() + half, whole.Height.end());
+    // The piece counts of both halves (the piece cut at `half` goes partly to each).
+    int seen = 0;
+    for (int k : whole.Pieces)
+    {
+      const int below = std::clamp(static_cast<int>(half) - seen, 0, k);
+      if (below > 0)
+      {
+        lower.Pieces.push_back(below);
+      }
+      if (k - below > 0)
+      {
+        upper.Pieces.push_back(k - below);
+      }
+      seen += k;
+    }
     const bool bottomPair = split == TwoCellSides::Bottom || split == TwoCellSides::Right;
     result[bottomPair ? TwoCellSides::Bottom : TwoCellSides::Left] = std::move(lower);
     result[bottomPair ? TwoCellSides::Right : TwoCellSides::Top] = std::move(upper);
@@ -373,8 +481,12 @@ bool TwoCellReconstruction::Reconstruct(
         {
           return false;
         }
-        BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed), this->BoundarySamples, walk, parameters,
-          boundaries[c]);
+        if (!BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed), this->BoundarySamples,
+              this->MaximumGridSize, walk, parameters, boundaries[c]))
+        {
+          message = "its sides need more than " + std::to_string(this->MaximumGridSize) + " segments each";
+          return false;
+        }
         return true;
       };
       // The paper's rule first (merged 1-cells: the junction takes the corner); a stem that
@@ -480,20 +592,8 @@ bool TwoCellReconstruction::Reconstruct(
       {
         continue;
       }
-      MonotoneSurfaceBoundary& boundary = boundaries[c];
-      const int count = CommonSegmentCount(boundary.Bottom, boundary.Left, boundary.Top, boundary.Right);
-      if (count < 1 || count > this->MaximumGridSize)
-      {
-        cell.Valid = false;
-        cell.Error = "its sides need " + std::to_string(count) + " segments each after subdivision (more than " +
-          std::to_string(this->MaximumGridSize) + ")";
-        continue;
-      }
-      MonotoneSurfaceBoundary subdivided;
-      SubdivideSide(boundary.Bottom, count, subdivided.Bottom);
-      SubdivideSide(boundary.Left, count, subdivided.Left);
-      SubdivideSide(boundary.Top, count, subdivided.Top);
-      SubdivideSide(boundary.Right, count, subdivided.Right);
+      const MonotoneSurfaceBoundary& subdivided = boundaries[c]; // already at the grid layout
+      const int count = static_cast<int>(subdivided.Bottom.size());
       std::string message;
       MonotoneSurfaceOptions options;
       // Subdivision and the B-spline conversion round the segment joins by ~1e-12 relative to

@@ -68,7 +68,17 @@ struct SideSegments
 {
   std::vector<std::array<double, 8>> Curve;
   BezierSide Height;
+  std::vector<int> Pieces; // segments of each piece along the side, in order (sum: Curve.size())
 };
+
+// The grid size N of a cell's surface and, per side and piece, how many grid segments each of
+// the piece's Bezier segments covers. The grid is uniform, so within a piece the split must be
+// uniform (its parameter speed must not jump); between pieces it need not be: pieces meet at
+// junction points, where the heights have zero slope whatever the speed. So N need not be the
+// least common multiple of the four sides' counts: any N that every side can reach as
+// sum(k_i m_i), m_i >= 1, will do; the smallest one is taken. Returns 0 when none is at most
+// maximum.
+int ChooseGridLayout(const std::array<SideSegments, 4>& sides, int maximum, std::array<std::vector<int>, 4>& multipliers);
 
 // The segments of the four sides (Bottom, Right, Top, Left), with an empty side made up from
 // half of its partner (TwoCellSides::SplitSides), cut at the segment boundary nearest the middle.
