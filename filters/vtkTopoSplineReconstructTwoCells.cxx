@@ -266,10 +266,11 @@ void BuildTopology(const topospline::PlanarScalarField& field, topospline::Trian
 // `vertexAt`, become the only extrema of the sampled values (TopologicalSampling.h).
 topospline::TopologicalSamplingReport EnforceComplexTopology(const topospline::MorseSmaleComplex& complex,
   const topospline::TriangleMeshTopology& domainMesh, const std::vector<double>& domainPoints,
-  const topospline::TriangleMeshTopology& mesh, const std::function<Index(const double*)>& vertexAt,
-  vtkDoubleArray* values)
+  const topospline::PlanarScalarField& sampling, const topospline::TriangleMeshTopology& mesh,
+  const std::function<Index(const double*)>& vertexAt, double spacing, vtkDoubleArray* values, int& displacedSaddles)
 {
   topospline::SamplingConstraints constraints;
+  std::vector<Index> saddles;
   for (const auto& cp : complex.CriticalPoints)
   {
     const Index v = vertexAt(&domainPoints[2 * static_cast<std::size_t>(cp.Vertex)]);
@@ -289,14 +290,32 @@ topospline::TopologicalSamplingReport EnforceComplexTopology(const topospline::M
     {
       constraints.Maxima.push_back(v);
     }
-    else if (cp.Cell >= 0 && cp.Cell < domainMesh.NumberOfEdges() && domainMesh.IsBoundaryEdge(cp.Cell) &&
-      mesh.IsBoundaryVertex(v))
+    else
     {
-      constraints.BoundaryMaxima.push_back(v);
+      saddles.push_back(v);
+      if (cp.Cell >= 0 && cp.Cell < domainMesh.NumberOfEdges() && domainMesh.IsBoundaryEdge(cp.Cell) &&
+        mesh.IsBoundaryVertex(v))
+      {
+        constraints.BoundaryMaxima.push_back(v);
+      }
     }
   }
   std::vector<double> sampled(values->GetPointer(0), values->GetPointer(0) + values->GetNumberOfTuples());
-  const auto report = topospline::EnforceCriticalVertices(mesh, constraints, sampled);
+  auto report = topospline::EnforceCriticalVertices(mesh, constraints, sampled);
+  // Saddles left a few vertices from their nodes in flat passes are moved onto them.
+  displacedSaddles =
+    topospline::RelocateSaddles(sampling, mesh, constraints, saddles, spacing * (1 + 1e-9), 4 * spacing, sampled);
+  report.ChangedVertices = 0;
+  report.MaximumChange = 0;
+  for (vtkIdType v = 0; v < values->GetNumberOfTuples(); ++v)
+  {
+    const double before = values->GetValue(v);
+    if (sampled[v] != before)
+    {
+      ++report.ChangedVertices;
+      report.MaximumChange = std::max(report.MaximumChange, std::abs(sampled[v] - before));
+    }
+  }
   std::copy(sampled.begin(), sampled.end(), values->GetPointer(0));
   return report;
 }
@@ -486,6 +505,7 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
   BuildTopology(domainField, domainMesh, error);
   vtkSmartPointer<vtkDoubleArray> rawValues;
   topospline::TopologicalSamplingReport sampling;
+  int displacedSaddles = 0;
   if (this->TopologicalSampling)
   {
     vtkLogScopeF(TRACE, "topological sampling");
@@ -495,11 +515,11 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
     rawValues->DeepCopy(values);
     rawValues->SetName(names::ExactReconstruction);
     output->GetPointData()->AddArray(rawValues);
-    sampling = EnforceComplexTopology(complex, domainMesh, domainField.Points, domainMesh,
+    sampling = EnforceComplexTopology(complex, domainMesh, domainField.Points, domainField, domainMesh,
       [&domainField](const double* xy) {
         return static_cast<Index>((xy - domainField.Points.data()) / 2);
       },
-      values);
+      GridSpacing(domain, domainField), values, displacedSaddles);
     for (vtkIdType v = 0; v < n; ++v)
     {
       difference->SetValue(v, values->GetValue(v) - original->GetComponent(v, 0));
@@ -632,13 +652,15 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
       const double* o = resampledOutput->GetOrigin();
       const double* h = resampledOutput->GetSpacing();
       const int ni = dims[plane.U], nj = dims[plane.V];
-      const auto fineReport = EnforceComplexTopology(complex, domainMesh, domainField.Points, fineMesh,
+      int fineDisplaced = 0;
+      const auto fineReport = EnforceComplexTopology(complex, domainMesh, domainField.Points, fine, fineMesh,
         [&](const double* xy) {
           const int i = std::clamp(static_cast<int>(std::lround((xy[0] - o[plane.U]) / h[plane.U])), 0, ni - 1);
           const int j = std::clamp(static_cast<int>(std::lround((xy[1] - o[plane.V]) / h[plane.V])), 0, nj - 1);
           return static_cast<Index>(j * ni + i);
         },
-        resampled);
+        GridSpacing(domain, domainField), resampled, fineDisplaced);
+      displacedSaddles += fineDisplaced;
       sampling.ChangedVertices += fineReport.ChangedVertices;
       sampling.MaximumChange = std::max(sampling.MaximumChange, fineReport.MaximumChange);
       sampling.Converged = sampling.Converged && fineReport.Converged;
@@ -675,6 +697,7 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
     AddNumbers(fd, "SamplingChangedVertices", { static_cast<double>(sampling.ChangedVertices) });
     AddNumbers(fd, "SamplingMaximumChange", { sampling.MaximumChange });
     AddNumbers(fd, "SamplingConverged", { sampling.Converged ? 1.0 : 0.0 });
+    AddNumbers(fd, "SamplingDisplacedSaddles", { static_cast<double>(displacedSaddles) });
   }
   if (report.ViolatingPatches > 0)
   {

@@ -250,4 +250,110 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
   }
   return report;
 }
+
+int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, const std::vector<Index>& wantedSaddles, double tolerance, double reach,
+  std::vector<double>& values, int maximumRounds, int maximumMissing)
+{
+  PlanarScalarField sampled = field;
+  const auto& p = field.Points;
+  auto distance = [&p](Index a, Index b) { return std::hypot(p[2 * a] - p[2 * b], p[2 * a + 1] - p[2 * b + 1]); };
+  // Unmatched wanted saddles and the found saddles no wanted one claims, for `current`.
+  auto unmatched = [&](const std::vector<double>& current, std::vector<Index>& missing, std::vector<Index>& spare) {
+    sampled.Values = current;
+    MorseSmaleComplexExtraction extraction;
+    MorseSmaleComplex found;
+    std::string error;
+    missing.clear();
+    spare.clear();
+    if (!extraction.Extract(sampled, found, error))
+    {
+      missing = wantedSaddles;
+      return;
+    }
+    std::vector<Index> saddles;
+    for (const CriticalPoint& cp : found.CriticalPoints)
+    {
+      if (cp.MorseIndex == 1)
+      {
+        saddles.push_back(cp.Vertex);
+      }
+    }
+    std::vector<char> used(saddles.size(), 0);
+    for (Index w : wantedSaddles)
+    {
+      std::size_t best = saddles.size();
+      for (std::size_t i = 0; i < saddles.size(); ++i)
+      {
+        if (!used[i] && distance(w, saddles[i]) <= tolerance &&
+          (best == saddles.size() || distance(w, saddles[i]) < distance(w, saddles[best])))
+        {
+          best = i;
+        }
+      }
+      if (best < saddles.size())
+      {
+        used[best] = 1;
+      }
+      else
+      {
+        missing.push_back(w);
+      }
+    }
+    for (std::size_t i = 0; i < saddles.size(); ++i)
+    {
+      if (!used[i])
+      {
+        spare.push_back(saddles[i]);
+      }
+    }
+  };
+  std::vector<Index> missing, spare;
+  unmatched(values, missing, spare);
+  // Each round costs an extraction of the whole sampling: worth it for the few saddles of a
+  // flat pass, not when many are missing (a failed 2-cell keeps the input's own saddles).
+  if (static_cast<int>(missing.size()) > maximumMissing)
+  {
+    return static_cast<int>(missing.size());
+  }
+  for (int round = 0; round < maximumRounds && !missing.empty(); ++round)
+  {
+    std::vector<double> trial = values;
+    bool moved = false;
+    for (Index w : missing)
+    {
+      Index nearest = InvalidIndex;
+      for (Index f : spare)
+      {
+        if (distance(w, f) <= reach && (nearest == InvalidIndex || distance(w, f) < distance(w, nearest)))
+        {
+          nearest = f;
+        }
+      }
+      if (nearest == InvalidIndex)
+      {
+        continue;
+      }
+      const bool raise = trial[nearest] <= trial[w];
+      trial[nearest] = std::nextafter(trial[w], raise ? std::numeric_limits<double>::infinity()
+                                                      : -std::numeric_limits<double>::infinity());
+      moved = true;
+    }
+    if (!moved)
+    {
+      break;
+    }
+    EnforceCriticalVertices(mesh, constraints, trial);
+    std::vector<Index> trialMissing, trialSpare;
+    unmatched(trial, trialMissing, trialSpare);
+    if (trialMissing.size() >= missing.size())
+    {
+      break;
+    }
+    values = std::move(trial);
+    missing = std::move(trialMissing);
+    spare = std::move(trialSpare);
+  }
+  return static_cast<int>(missing.size());
+}
 } // namespace topospline

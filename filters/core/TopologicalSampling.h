@@ -15,6 +15,7 @@
 #pragma once
 
 #include "CoreTypes.h"
+#include "MorseSmaleComplexExtraction.h"
 #include "TriangleMeshTopology.h"
 
 #include <vector>
@@ -44,4 +45,15 @@ struct SamplingConstraints
 // (Converged is then false, and a few spurious pairs may remain).
 TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds = 6);
+// After EnforceCriticalVertices the extrema are the wanted ones, but a saddle can sit a few
+// vertices from its node in a nearly flat pass. Each round extracts the complex of `field`
+// with `values`; for every wanted saddle with no saddle within `tolerance`, the nearest
+// unmatched saddle within `reach` is moved past the wanted saddle's value (raised if it is
+// lower: the pass then lies elsewhere along the ridge; lowered if higher), and the extrema are
+// enforced again. A round is kept only if it leaves fewer unmatched saddles. Nothing is tried
+// when more than `maximumMissing` are unmatched. Returns the number of unmatched wanted saddles
+// left.
+int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, const std::vector<Index>& wantedSaddles, double tolerance, double reach,
+  std::vector<double>& values, int maximumRounds = 3, int maximumMissing = 10);
 } // namespace topospline
