@@ -4,6 +4,7 @@
 
 #include "SyntheticFields.h" // core: GridTriangles
 
+#include <vtkAlgorithm.h>
 #include <vtkArrayDispatch.h>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
@@ -24,6 +25,7 @@
 #include <vtkPolyData.h>
 #include <vtkSMPTools.h>
 #include <vtkSmartPointer.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkStringArray.h>
 
 #include <algorithm>
@@ -606,5 +608,35 @@ bool FromMultiBlock(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& 
     complex.TwoCellId[v] = static_cast<Index>(cellId->GetComponent(v, 0));
   }
   return true;
+}
+
+void AcceptPlanarDomains(vtkInformation* info)
+{
+  info->Remove(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE());
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkUnstructuredGrid");
+}
+
+void RequestWholeInput(vtkInformation* inInfo)
+{
+  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
+  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
+  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
+  if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+  {
+    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(),
+      inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()), 6);
+  }
+}
+
+void AddFieldNumbers(vtkFieldData* fieldData, const char* name, std::initializer_list<double> values)
+{
+  auto array = NewArray<vtkDoubleArray>(name);
+  for (double v : values)
+  {
+    array->InsertNextValue(v);
+  }
+  fieldData->AddArray(array);
 }
 }

@@ -7,11 +7,13 @@
 
 #include <vtkSmartPointer.h>
 
+#include <initializer_list>
 #include <string>
 
 class vtkDataArray;
 class vtkInformation;
 class vtkDataSet;
+class vtkFieldData;
 class vtkMultiBlockDataSet;
 
 namespace vtkTopoSplineDomainConversion
@@ -79,4 +81,13 @@ vtkSmartPointer<ArrayT> NewArray(const char* name, int components = 1, vtkIdType
 
 // The "Segmentation" block of a complex, or nullptr.
 vtkDataSet* SegmentationOf(vtkMultiBlockDataSet* input);
+
+// Input ports of the filters that take a field: 2D images and planar triangle meshes.
+void AcceptPlanarDomains(vtkInformation* inputPortInformation);
+
+// The complex is global: every process asks for the whole input (RequestUpdateExtent).
+void RequestWholeInput(vtkInformation* inputInformation);
+
+// Field data: a double array `name` holding `values`.
+void AddFieldNumbers(vtkFieldData* fieldData, const char* name, std::initializer_list<double> values);
 }

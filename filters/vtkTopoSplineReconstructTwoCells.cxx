@@ -25,9 +25,7 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkSMPTools.h>
-#include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkStringArray.h>
-#include <vtkUnsignedCharArray.h>
 #include <vtkUnstructuredGrid.h>
 
 #include <algorithm>
@@ -69,7 +67,7 @@ vtkDataSet* EnsureGeometryOutput(vtkInformation* info, vtkDataSet* domain)
 {
   vtkDataObject* current = info->Get(vtkDataObject::DATA_OBJECT());
   const char* wanted = domain ? domain->GetClassName() : "vtkImageData";
-  if (!current || !current->IsA(wanted) || std::string(current->GetClassName()) != wanted)
+  if (!current || std::string(current->GetClassName()) != wanted)
   {
     vtkSmartPointer<vtkDataSet> created;
     if (domain)
@@ -263,71 +261,25 @@ void BuildTopology(const topospline::PlanarScalarField& field, topospline::Trian
 }
 
 // Topological sampling: the complex's critical points, placed on the sampling's vertices by
-// `vertexAt`, become the only extrema of the sampled values (TopologicalSampling.h).
+// `vertexAt` (a vertex of the domain to one of the sampling), become the only extrema of the
+// sampled values (TopologicalSampling.h).
 topospline::TopologicalSamplingReport EnforceComplexTopology(const topospline::MorseSmaleComplex& complex,
-  const topospline::TriangleMeshTopology& domainMesh, const std::vector<double>& domainPoints,
-  const topospline::PlanarScalarField& sampling, const topospline::TriangleMeshTopology& mesh,
-  const std::function<Index(const double*)>& vertexAt, double spacing, vtkDoubleArray* values, int& displacedSaddles)
+  const topospline::TriangleMeshTopology& domainMesh, const topospline::PlanarScalarField& sampling,
+  const topospline::TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, double spacing,
+  vtkDoubleArray* values, int& displacedSaddles)
 {
-  topospline::SamplingConstraints constraints;
-  std::vector<Index> saddles;
-  for (const auto& cp : complex.CriticalPoints)
-  {
-    const Index v = vertexAt(&domainPoints[2 * static_cast<std::size_t>(cp.Vertex)]);
-    if (v < 0 || v >= mesh.NumberOfVertices())
-    {
-      continue;
-    }
-    if (cp.MorseIndex == 0)
-    {
-      constraints.Minima.push_back(v);
-      if (mesh.IsBoundaryVertex(v))
-      {
-        constraints.BoundaryMinima.push_back(v);
-      }
-    }
-    else if (cp.MorseIndex == 2)
-    {
-      constraints.Maxima.push_back(v);
-    }
-    else
-    {
-      saddles.push_back(v);
-      if (cp.Cell >= 0 && cp.Cell < domainMesh.NumberOfEdges() && domainMesh.IsBoundaryEdge(cp.Cell) &&
-        mesh.IsBoundaryVertex(v))
-      {
-        constraints.BoundaryMaxima.push_back(v);
-      }
-    }
-  }
-  std::vector<double> sampled(values->GetPointer(0), values->GetPointer(0) + values->GetNumberOfTuples());
+  const auto constraints = topospline::ComplexConstraints(complex, domainMesh, mesh, vertexAt);
+  const std::vector<double> before(values->GetPointer(0), values->GetPointer(0) + values->GetNumberOfTuples());
+  std::vector<double> sampled = before;
   auto report = topospline::EnforceCriticalVertices(mesh, constraints, sampled);
   // Saddles left a few vertices from their nodes in flat passes are moved onto them.
   displacedSaddles =
-    topospline::RelocateSaddles(sampling, mesh, constraints, saddles, spacing * (1 + 1e-9), 4 * spacing, sampled);
+    topospline::RelocateSaddles(sampling, mesh, constraints, spacing * (1 + 1e-9), 4 * spacing, sampled);
   report.ChangedVertices = 0;
   report.MaximumChange = 0;
-  for (vtkIdType v = 0; v < values->GetNumberOfTuples(); ++v)
-  {
-    const double before = values->GetValue(v);
-    if (sampled[v] != before)
-    {
-      ++report.ChangedVertices;
-      report.MaximumChange = std::max(report.MaximumChange, std::abs(sampled[v] - before));
-    }
-  }
+  topospline::CountChanges(before, sampled, report);
   std::copy(sampled.begin(), sampled.end(), values->GetPointer(0));
   return report;
-}
-
-void AddNumbers(vtkFieldData* fd, const char* name, std::initializer_list<double> values)
-{
-  auto array = conversion::NewArray<vtkDoubleArray>(name);
-  for (double v : values)
-  {
-    array->InsertNextValue(v);
-  }
-  fd->AddArray(array);
 }
 
 void AddPoints(vtkFieldData* fd, const char* name, const std::vector<topospline::CriticalPointLocation>& points)
@@ -429,7 +381,10 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
   // The 2-cells, in parallel.
   topospline::TwoCellReconstruction reconstruction;
   reconstruction.BoundarySamples = this->BoundarySamples;
-  reconstruction.SnapDistance = GridSpacing(domain, domainField);
+  // One grid spacing: how far a vertex may lie outside the smoothed cells, and how far a
+  // critical point of a sampling may lie from its node.
+  const double gridSpacing = GridSpacing(domain, domainField);
+  reconstruction.SnapDistance = gridSpacing;
   const double edge = MeanEdgeLength(domainField);
   reconstruction.MinimumMeshEdgeLength = 2 * edge;
   reconstruction.NegligibleArea = edge * edge;
@@ -515,11 +470,8 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
     rawValues->DeepCopy(values);
     rawValues->SetName(names::ExactReconstruction);
     output->GetPointData()->AddArray(rawValues);
-    sampling = EnforceComplexTopology(complex, domainMesh, domainField.Points, domainField, domainMesh,
-      [&domainField](const double* xy) {
-        return static_cast<Index>((xy - domainField.Points.data()) / 2);
-      },
-      GridSpacing(domain, domainField), values, displacedSaddles);
+    sampling = EnforceComplexTopology(complex, domainMesh, domainField, domainMesh, [](Index v) { return v; },
+      gridSpacing, values, displacedSaddles);
     for (vtkIdType v = 0; v < n; ++v)
     {
       difference->SetValue(v, values->GetValue(v) - original->GetComponent(v, 0));
@@ -653,13 +605,14 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
       const double* h = resampledOutput->GetSpacing();
       const int ni = dims[plane.U], nj = dims[plane.V];
       int fineDisplaced = 0;
-      const auto fineReport = EnforceComplexTopology(complex, domainMesh, domainField.Points, fine, fineMesh,
-        [&](const double* xy) {
+      const auto fineReport = EnforceComplexTopology(complex, domainMesh, fine, fineMesh,
+        [&](Index v) {
+          const double* xy = &domainField.Points[2 * static_cast<std::size_t>(v)];
           const int i = std::clamp(static_cast<int>(std::lround((xy[0] - o[plane.U]) / h[plane.U])), 0, ni - 1);
           const int j = std::clamp(static_cast<int>(std::lround((xy[1] - o[plane.V]) / h[plane.V])), 0, nj - 1);
           return static_cast<Index>(j * ni + i);
         },
-        GridSpacing(domain, domainField), resampled, fineDisplaced);
+        gridSpacing, resampled, fineDisplaced);
       displacedSaddles += fineDisplaced;
       sampling.ChangedVertices += fineReport.ChangedVertices;
       sampling.MaximumChange = std::max(sampling.MaximumChange, fineReport.MaximumChange);
@@ -674,30 +627,30 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
   // Field data: what was done and how well.
   vtkFieldData* fd = output->GetFieldData();
   fd->PassData(input->GetFieldData());
-  AddNumbers(fd, "TwoCells", { static_cast<double>(report.Cells) });
-  AddNumbers(fd, "FailedTwoCells", { static_cast<double>(report.FailedCells) });
-  AddNumbers(fd, "NegligibleTwoCells", { static_cast<double>(report.NegligibleCells) });
-  AddNumbers(fd, "SlitTwoCells", { static_cast<double>(report.SlitCells) });
-  AddNumbers(fd, "ShiftedCorners", { static_cast<double>(report.ShiftedCorners) });
-  AddNumbers(fd, "ViolatingPatches", { static_cast<double>(report.ViolatingPatches) });
-  AddNumbers(fd, "LinearizedDiagonals", { static_cast<double>(report.LinearizedDiagonals) });
-  AddNumbers(fd, "BezierTriangles", { static_cast<double>(report.BezierTriangles) });
-  AddNumbers(fd, "MeshTriangles", { static_cast<double>(report.MeshTriangles) });
-  AddNumbers(fd, "MaximumGridSize", { static_cast<double>(report.MaximumGridSize) });
-  AddNumbers(fd, "SnappedPoints", { static_cast<double>(snapped.load()) });
-  AddNumbers(fd, "UnreconstructedPoints", { static_cast<double>(missed.load()) });
-  AddNumbers(fd, "MaximumError", { maximumError });
-  AddNumbers(fd, "RMSError", { rmsError });
-  AddNumbers(fd, "ValueRange", { range[0], range[1] });
-  AddNumbers(fd, "ParameterizationSeconds", { report.ParameterizationSeconds });
-  AddNumbers(fd, "SurfaceSeconds", { report.SurfaceSeconds });
-  AddNumbers(fd, "EvaluationSeconds", { evaluationSeconds });
+  conversion::AddFieldNumbers(fd, "TwoCells", { static_cast<double>(report.Cells) });
+  conversion::AddFieldNumbers(fd, "FailedTwoCells", { static_cast<double>(report.FailedCells) });
+  conversion::AddFieldNumbers(fd, "NegligibleTwoCells", { static_cast<double>(report.NegligibleCells) });
+  conversion::AddFieldNumbers(fd, "SlitTwoCells", { static_cast<double>(report.SlitCells) });
+  conversion::AddFieldNumbers(fd, "ShiftedCorners", { static_cast<double>(report.ShiftedCorners) });
+  conversion::AddFieldNumbers(fd, "ViolatingPatches", { static_cast<double>(report.ViolatingPatches) });
+  conversion::AddFieldNumbers(fd, "LinearizedDiagonals", { static_cast<double>(report.LinearizedDiagonals) });
+  conversion::AddFieldNumbers(fd, "BezierTriangles", { static_cast<double>(report.BezierTriangles) });
+  conversion::AddFieldNumbers(fd, "MeshTriangles", { static_cast<double>(report.MeshTriangles) });
+  conversion::AddFieldNumbers(fd, "MaximumGridSize", { static_cast<double>(report.MaximumGridSize) });
+  conversion::AddFieldNumbers(fd, "SnappedPoints", { static_cast<double>(snapped.load()) });
+  conversion::AddFieldNumbers(fd, "UnreconstructedPoints", { static_cast<double>(missed.load()) });
+  conversion::AddFieldNumbers(fd, "MaximumError", { maximumError });
+  conversion::AddFieldNumbers(fd, "RMSError", { rmsError });
+  conversion::AddFieldNumbers(fd, "ValueRange", { range[0], range[1] });
+  conversion::AddFieldNumbers(fd, "ParameterizationSeconds", { report.ParameterizationSeconds });
+  conversion::AddFieldNumbers(fd, "SurfaceSeconds", { report.SurfaceSeconds });
+  conversion::AddFieldNumbers(fd, "EvaluationSeconds", { evaluationSeconds });
   if (this->TopologicalSampling)
   {
-    AddNumbers(fd, "SamplingChangedVertices", { static_cast<double>(sampling.ChangedVertices) });
-    AddNumbers(fd, "SamplingMaximumChange", { sampling.MaximumChange });
-    AddNumbers(fd, "SamplingConverged", { sampling.Converged ? 1.0 : 0.0 });
-    AddNumbers(fd, "SamplingDisplacedSaddles", { static_cast<double>(displacedSaddles) });
+    conversion::AddFieldNumbers(fd, "SamplingChangedVertices", { static_cast<double>(sampling.ChangedVertices) });
+    conversion::AddFieldNumbers(fd, "SamplingMaximumChange", { sampling.MaximumChange });
+    conversion::AddFieldNumbers(fd, "SamplingConverged", { sampling.Converged ? 1.0 : 0.0 });
+    conversion::AddFieldNumbers(fd, "SamplingDisplacedSaddles", { static_cast<double>(displacedSaddles) });
   }
   if (report.ViolatingPatches > 0)
   {
@@ -715,7 +668,7 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
     vtkLogScopeF(TRACE, "verify topology");
     const auto verifyStart = std::chrono::steady_clock::now();
     const auto expected = topospline::CriticalPointLocations(complex, domainField.Points);
-    const double tolerance = GridSpacing(domain, domainField) * (1 + 1e-9);
+    const double tolerance = gridSpacing * (1 + 1e-9);
     bool verified = true;
     std::vector<topospline::CriticalPointLocation> spurious, missing;
     // `judged`: the check is on an output (the raw sampling before topological sampling is
@@ -733,9 +686,9 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
         return;
       }
       const auto& c = check.Comparison;
-      AddNumbers(fd, (p + "CriticalPoints").c_str(),
+      conversion::AddFieldNumbers(fd, (p + "CriticalPoints").c_str(),
         { static_cast<double>(c.Found[0]), static_cast<double>(c.Found[1]), static_cast<double>(c.Found[2]) });
-      AddNumbers(fd, (p + "CriticalPointDistance").c_str(), { c.MaximumDistance });
+      conversion::AddFieldNumbers(fd, (p + "CriticalPointDistance").c_str(), { c.MaximumDistance });
       if (!judged)
       {
         return;
@@ -762,7 +715,7 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
     {
       record("Resampled", CheckTopology(resampledOutput, resampled, expected, tolerance), true);
     }
-    AddNumbers(fd, "ExpectedCriticalPoints", { 0, 0, 0 });
+    conversion::AddFieldNumbers(fd, "ExpectedCriticalPoints", { 0, 0, 0 });
     {
       auto* e = vtkDoubleArray::SafeDownCast(fd->GetArray("ExpectedCriticalPoints"));
       for (const auto& cp : expected)
@@ -770,10 +723,10 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
         e->SetValue(cp.MorseIndex, e->GetValue(cp.MorseIndex) + 1);
       }
     }
-    AddNumbers(fd, "TopologyVerified", { verified ? 1.0 : 0.0 });
+    conversion::AddFieldNumbers(fd, "TopologyVerified", { verified ? 1.0 : 0.0 });
     AddPoints(fd, "SpuriousCriticalPoints", spurious);
     AddPoints(fd, "MissingCriticalPoints", missing);
-    AddNumbers(fd, "VerificationSeconds",
+    conversion::AddFieldNumbers(fd, "VerificationSeconds",
       { std::chrono::duration<double>(std::chrono::steady_clock::now() - verifyStart).count() });
   }
   this->UpdateProgress(1.0);

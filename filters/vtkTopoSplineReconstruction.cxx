@@ -1,5 +1,6 @@
 #include "vtkTopoSplineReconstruction.h"
 
+#include "vtkTopoSplineDomainConversion.h"
 #include "vtkTopoSplineMorseSmaleComplex.h"
 #include "vtkTopoSplineReconstructTwoCells.h"
 #include "vtkTopoSplineSimplifyMorseSmaleComplex.h"
@@ -12,9 +13,7 @@
 #include <vtkInformationVector.h>
 #include <vtkLogger.h>
 #include <vtkObjectFactory.h>
-#include <vtkStreamingDemandDrivenPipeline.h>
 
-#include <algorithm>
 
 vtkStandardNewMacro(vtkTopoSplineReconstruction);
 
@@ -41,10 +40,7 @@ vtkTopoSplineReconstruction::~vtkTopoSplineReconstruction()
 
 int vtkTopoSplineReconstruction::FillInputPortInformation(int, vtkInformation* info)
 {
-  info->Remove(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE());
-  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
-  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
-  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkUnstructuredGrid");
+  vtkTopoSplineDomainConversion::AcceptPlanarDomains(info);
   return 1;
 }
 
@@ -52,15 +48,7 @@ int vtkTopoSplineReconstruction::RequestUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
 {
   // Like "Morse-Smale Complex": the complex needs the whole domain.
-  vtkInformation* in = inputVector[0]->GetInformationObject(0);
-  in->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
-  in->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
-  in->Set(vtkStreamingDemandDrivenPipeline::EXACT_EXTENT(), 1);
-  if (in->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
-  {
-    in->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(),
-      in->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()), 6);
-  }
+  vtkTopoSplineDomainConversion::RequestWholeInput(inputVector[0]->GetInformationObject(0));
   return 1;
 }
 

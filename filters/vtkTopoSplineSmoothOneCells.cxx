@@ -314,20 +314,17 @@ int vtkTopoSplineSmoothOneCells::RequestData(
     l1 += p.L1Error;
     free += p.UnconstrainedL1Error;
   }
-  auto addNumber = [&](const char* name, double value) {
-    auto array = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>(name);
-    array->InsertNextValue(value);
-    output->GetFieldData()->AddArray(array);
-  };
-  addNumber("CurveSegments", this->CurveSegments);
-  addNumber("NumberOfPieces", static_cast<double>(result.Pieces.size()));
-  addNumber("AdaptedPieces", result.AdaptedPieces);
-  addNumber("RemainingCrossings", result.RemainingCrossings);
-  addNumber("PiecesOutsideDomain", result.PiecesOutsideDomain);
-  addNumber("ClampedPieces", result.ClampedPieces);
-  addNumber("L1Error", l1);
-  addNumber("UnconstrainedL1Error", free);
-  addNumber("JunctionMargin", result.JunctionMargin);
+  vtkFieldData* fd = output->GetFieldData();
+  using vtkTopoSplineDomainConversion::AddFieldNumbers;
+  AddFieldNumbers(fd, "CurveSegments", { static_cast<double>(this->CurveSegments) });
+  AddFieldNumbers(fd, "NumberOfPieces", { static_cast<double>(result.Pieces.size()) });
+  AddFieldNumbers(fd, "AdaptedPieces", { static_cast<double>(result.AdaptedPieces) });
+  AddFieldNumbers(fd, "RemainingCrossings", { static_cast<double>(result.RemainingCrossings) });
+  AddFieldNumbers(fd, "PiecesOutsideDomain", { static_cast<double>(result.PiecesOutsideDomain) });
+  AddFieldNumbers(fd, "ClampedPieces", { static_cast<double>(result.ClampedPieces) });
+  AddFieldNumbers(fd, "L1Error", { l1 });
+  AddFieldNumbers(fd, "UnconstrainedL1Error", { free });
+  AddFieldNumbers(fd, "JunctionMargin", { result.JunctionMargin });
   this->UpdateProgress(1.0);
   return 1;
 }

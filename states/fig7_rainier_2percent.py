@@ -21,9 +21,5 @@ simplified = SimplifyMorseSmaleComplex(registrationName="Simplified 2%", Input=c
 smooth = Smooth1Cells(registrationName="Smoothed k=7", Input=simplified, CurveSegments=7)
 reconstruction = Reconstruct2Cells(registrationName="Reconstruction", Input=smooth, VerifyTopology=0)
 layout = CreateLayout("Figure 7")
-for where, (source, array) in enumerate(((terrain, "elevation"), (reconstruction, "Reconstructed"))):
-    view = CreateView("RenderView")
-    AssignViewToLayout(view=view, layout=layout, hint=where)
-    style.field_with_isolines(source, array, view)
-    style.complex_lines(smooth, view)
-    style.view_from_above(view)
+style.panel(layout, 0, terrain, "elevation", smooth)
+style.panel(layout, 1, reconstruction, "Reconstructed", smooth)

@@ -17,9 +17,5 @@ complex_.ScalarField = ["POINTS", "Trigonometric"]
 smooth = Smooth1Cells(registrationName="Smoothed k=7", Input=complex_, CurveSegments=7)
 reconstruction = Reconstruct2Cells(registrationName="Reconstruction", Input=smooth, VerifyTopology=0)
 layout = CreateLayout("Figure 8")
-for where, (source, array) in enumerate(((field, "Trigonometric"), (reconstruction, "Reconstructed"))):
-    view = CreateView("RenderView")
-    AssignViewToLayout(view=view, layout=layout, hint=where)
-    style.field_with_isolines(source, array, view)
-    style.complex_lines(smooth, view)
-    style.view_from_above(view)
+style.panel(layout, 0, field, "Trigonometric", smooth)
+style.panel(layout, 1, reconstruction, "Reconstructed", smooth)

@@ -41,3 +41,14 @@ def view_from_above(view):
     view.OrientationAxesVisibility = 0
     view.CameraParallelProjection = 1
     ResetCamera(view)
+
+
+def panel(layout, where, source, array, lines):
+    """One view of a figure: `array` of `source` with isolines and the smoothed 1-cells of
+    `lines`, seen from above, at position `where` of `layout`."""
+    view = CreateView("RenderView")
+    AssignViewToLayout(view=view, layout=layout, hint=where)
+    field_with_isolines(source, array, view)
+    complex_lines(lines, view)
+    view_from_above(view)
+    return view

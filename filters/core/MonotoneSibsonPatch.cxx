@@ -499,27 +499,9 @@ bool MonotoneSibsonSurface::Build(
     }
   }
 
-  // Interior values: discrete Laplace equation (5-point stencil) with the boundary values, or
-  // the Coons patch of the four sides blended by cubic Hermite functions.
+  // Interior values: discrete Laplace equation (5-point stencil) with the boundary values.
   const int m = n - 1;
-  if (m > 0 && options.Interior == MonotoneSurfaceOptions::CoonsInterior)
-  {
-    auto h1 = [](double t) { return t * t * (3 - 2 * t); };
-    const double z00 = this->Z[this->Node(0, 0)], z10 = this->Z[this->Node(n, 0)];
-    const double z01 = this->Z[this->Node(0, n)], z11 = this->Z[this->Node(n, n)];
-    for (int j = 1; j < n; ++j)
-    {
-      const double b = h1(static_cast<double>(j) / n), a = 1 - b;
-      for (int i = 1; i < n; ++i)
-      {
-        const double d = h1(static_cast<double>(i) / n), c = 1 - d;
-        this->Z[this->Node(i, j)] = a * this->Z[this->Node(i, 0)] + b * this->Z[this->Node(i, n)] +
-          c * this->Z[this->Node(0, j)] + d * this->Z[this->Node(n, j)] -
-          (c * a * z00 + d * a * z10 + c * b * z01 + d * b * z11);
-      }
-    }
-  }
-  else if (m > 0)
+  if (m > 0)
   {
     std::vector<Eigen::Triplet<double>> entries;
     entries.reserve(5 * m * m);

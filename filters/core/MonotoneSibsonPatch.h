@@ -165,15 +165,6 @@ struct MonotoneSurfaceOptions
   // the one-sided difference into the interior values, which makes a crease whose sampling
   // shows spurious critical points along the 1-cells.
   bool FlatAcrossBoundary = false;
-  // Interior node values before the monotonicity corrections: the paper's discrete Laplace
-  // solve, or the Coons patch of the four sides with cubic Hermite blending (flat across the
-  // sides wherever the corners have zero derivatives).
-  enum InteriorValues
-  {
-    LaplaceInterior = 0,
-    CoonsInterior = 1
-  };
-  InteriorValues Interior = LaplaceInterior;
   int DiagonalLimiterRounds = 8;
 };
 

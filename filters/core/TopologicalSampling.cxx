@@ -240,21 +240,64 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
     previousChanged = changed;
   }
   report.Rounds = std::min(report.Rounds, maximumRounds);
-  for (Index v = 0; v < n; ++v)
-  {
-    if (values[v] != original[v])
-    {
-      ++report.ChangedVertices;
-      report.MaximumChange = std::max(report.MaximumChange, std::abs(values[v] - original[v]));
-    }
-  }
+  CountChanges(original, values, report);
   return report;
 }
 
-int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
-  const SamplingConstraints& constraints, const std::vector<Index>& wantedSaddles, double tolerance, double reach,
-  std::vector<double>& values, int maximumRounds, int maximumMissing)
+SamplingConstraints ComplexConstraints(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
+  const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt)
 {
+  SamplingConstraints constraints;
+  for (const CriticalPoint& cp : complex.CriticalPoints)
+  {
+    const Index v = vertexAt(cp.Vertex);
+    if (v < 0 || v >= mesh.NumberOfVertices())
+    {
+      continue;
+    }
+    if (cp.MorseIndex == 0)
+    {
+      constraints.Minima.push_back(v);
+      if (mesh.IsBoundaryVertex(v))
+      {
+        constraints.BoundaryMinima.push_back(v);
+      }
+    }
+    else if (cp.MorseIndex == 2)
+    {
+      constraints.Maxima.push_back(v);
+    }
+    else
+    {
+      constraints.Saddles.push_back(v);
+      if (cp.Cell >= 0 && cp.Cell < complexMesh.NumberOfEdges() && complexMesh.IsBoundaryEdge(cp.Cell) &&
+        mesh.IsBoundaryVertex(v))
+      {
+        constraints.BoundaryMaxima.push_back(v);
+      }
+    }
+  }
+  return constraints;
+}
+
+void CountChanges(const std::vector<double>& before, const std::vector<double>& after,
+  TopologicalSamplingReport& report)
+{
+  for (std::size_t v = 0; v < before.size() && v < after.size(); ++v)
+  {
+    if (after[v] != before[v])
+    {
+      ++report.ChangedVertices;
+      report.MaximumChange = std::max(report.MaximumChange, std::abs(after[v] - before[v]));
+    }
+  }
+}
+
+int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, double tolerance, double reach, std::vector<double>& values,
+  int maximumRounds, int maximumMissing)
+{
+  const std::vector<Index>& wantedSaddles = constraints.Saddles;
   PlanarScalarField sampled = field;
   const auto& p = field.Points;
   auto distance = [&p](Index a, Index b) { return std::hypot(p[2 * a] - p[2 * b], p[2 * a + 1] - p[2 * b + 1]); };

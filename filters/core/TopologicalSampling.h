@@ -18,6 +18,7 @@
 #include "MorseSmaleComplexExtraction.h"
 #include "TriangleMeshTopology.h"
 
+#include <functional>
 #include <vector>
 
 namespace topospline
@@ -37,7 +38,18 @@ struct SamplingConstraints
   std::vector<Index> BoundaryMinima; // wanted minima along the boundary curve (boundary vertices)
   std::vector<Index> BoundaryMaxima; // wanted maxima along the boundary curve (higher vertex of a
                                      // critical boundary edge: a boundary saddle)
+  std::vector<Index> Saddles;        // vertices of the wanted saddles (RelocateSaddles)
 };
+
+// The critical points of `complex`, extracted on `complexMesh`, as constraints on a sampling
+// with mesh `mesh`: `vertexAt` gives the sampling's vertex for a vertex of `complexMesh`
+// (InvalidIndex: none). A saddle of a boundary edge is a wanted maximum along the boundary.
+SamplingConstraints ComplexConstraints(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
+  const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt);
+
+// Adds to `report` how many of `after` differ from `before`, and by how much at most.
+void CountChanges(const std::vector<double>& before, const std::vector<double>& after,
+  TopologicalSamplingReport& report);
 
 // Modifies `values` (one per mesh vertex) in place. The alternation usually settles in one or
 // two rounds; where a boundary constraint and the whole-link ones disagree about a vertex it
@@ -47,13 +59,13 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
   const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds = 6);
 // After EnforceCriticalVertices the extrema are the wanted ones, but a saddle can sit a few
 // vertices from its node in a nearly flat pass. Each round extracts the complex of `field`
-// with `values`; for every wanted saddle with no saddle within `tolerance`, the nearest
+// with `values`; for every wanted saddle (constraints.Saddles) with no saddle within `tolerance`, the nearest
 // unmatched saddle within `reach` is moved past the wanted saddle's value (raised if it is
 // lower: the pass then lies elsewhere along the ridge; lowered if higher), and the extrema are
 // enforced again. A round is kept only if it leaves fewer unmatched saddles. Nothing is tried
 // when more than `maximumMissing` are unmatched. Returns the number of unmatched wanted saddles
 // left.
 int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
-  const SamplingConstraints& constraints, const std::vector<Index>& wantedSaddles, double tolerance, double reach,
-  std::vector<double>& values, int maximumRounds = 3, int maximumMissing = 10);
+  const SamplingConstraints& constraints, double tolerance, double reach, std::vector<double>& values,
+  int maximumRounds = 3, int maximumMissing = 10);
 } // namespace topospline

@@ -554,8 +554,7 @@ bool TwoCellReconstruction::Reconstruct(
           const std::size_t j = (i + 1) % samples;
           perimeter += std::hypot(walk[2 * j] - walk[2 * i], walk[2 * j + 1] - walk[2 * i + 1]);
         }
-        const double spacing =
-          this->MeshEdgeLength > 0 ? this->MeshEdgeLength : perimeter / std::max<std::size_t>(samples, 1);
+        const double spacing = perimeter / std::max<std::size_t>(samples, 1);
         cell.Parameterization.TargetEdgeLength = std::max(spacing, this->MinimumMeshEdgeLength);
         if (cell.Parameterization.Parameterize(walk, parameters, message))
         {
@@ -599,9 +598,11 @@ bool TwoCellReconstruction::Reconstruct(
       // Subdivision and the B-spline conversion round the segment joins by ~1e-12 relative to
       // the values, which can exceed 1e-9 of a small cell's own range.
       options.ConsistencyTolerance = 1e-7;
-      options.FlatAcrossBoundary = this->FlatAcrossOneCells;
-      options.Interior = this->CoonsInterior ? MonotoneSurfaceOptions::CoonsInterior : MonotoneSurfaceOptions::LaplaceInterior;
-      cell.SurfaceConditionsHold = cell.Surface.Build(subdivided, message, options);
+      // A flat valley floor or ridge top along the 1-cells (see MonotoneSurfaceOptions).
+      options.FlatAcrossBoundary = true;
+      // False also when the conditions are infeasible somewhere: the surface is then built
+      // anyway and its violating cells are counted (Surface.Report()).
+      cell.Surface.Build(subdivided, message, options);
       if (cell.Surface.GetGridSize() != count)
       {
         // Malformed boundary data (not merely infeasible conditions): no surface at all.

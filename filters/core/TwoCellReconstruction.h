@@ -95,7 +95,6 @@ struct ReconstructedTwoCell
   double Bounds[4] = { 0, 0, 0, 0 }; // xmin, xmax, ymin, ymax of the boundary samples
   TwoCellParameterization Parameterization;
   MonotoneSibsonSurface Surface;
-  bool SurfaceConditionsHold = false; // MonotoneSibsonSurface::Build succeeded: no violating cell
 };
 
 struct TwoCellReconstructionReport
@@ -127,27 +126,20 @@ class TwoCellReconstruction
 public:
   // c in the paper: samples per boundary Bezier segment.
   int BoundarySamples = 5;
-  // Cells whose sides need more segments than this after subdivision (the least common
-  // multiple of the four sides' counts) are not reconstructed.
+  // Cells whose sides need more grid segments than this (ChooseGridLayout) are not
+  // reconstructed.
   int MaximumGridSize = 512;
   // A point outside every cell by at most this distance (the smoothed boundary differs from
   // the jagged one) takes the value of the nearest boundary point. <= 0: 1e-3 of the domain.
   double SnapDistance = 0;
-  // Target edge length of the cell triangulations; <= 0: the mean boundary sample spacing
-  // (the paper's choice). Phi is piecewise linear on these triangles, so F o Phi has a kink
-  // across every triangle edge: triangles much larger than the input's grid spacing show in a
-  // sampling of the result.
-  double MeshEdgeLength = 0;
-  // Lower bound of that target (the filter passes the input's grid spacing).
+  // Cell triangulations aim at the mean boundary sample spacing (the paper's choice), but at
+  // no less than this (the filter passes twice the input's mean grid edge: finer triangles
+  // only cost time).
   double MinimumMeshEdgeLength = 0;
   // Cells whose boundary encloses at most this area are skipped (the filter passes the square
   // of the mean grid edge: such a cell holds at most a vertex or two, which take the value of
   // the nearest cell boundary).
   double NegligibleArea = 0;
-  // Zero cross-boundary derivatives of every surface (MonotoneSurfaceOptions::FlatAcrossBoundary).
-  bool FlatAcrossOneCells = true;
-  // Interior values from the Coons patch instead of the Laplace solve (MonotoneSurfaceOptions).
-  bool CoonsInterior = false;
   ParallelFor Parallel = SequentialFor;
   ProgressHooks Hooks;
 

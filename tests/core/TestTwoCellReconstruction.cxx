@@ -246,28 +246,9 @@ void CheckReconstruction(const char* name, const GridField& grid, double percent
       static_cast<Index>(expected.size()));
     TriangleMeshTopology mesh;
     mesh.BuildGrid(sampled.GridDimensions[0], sampled.GridDimensions[1], SequentialFor);
-    SamplingConstraints constraints;
     const int nx = grid.Dimensions[0], fineX = sampled.GridDimensions[0];
-    for (const CriticalPoint& cp : p.Simplified.Complex.CriticalPoints)
-    {
-      const Index v = (cp.Vertex / nx) * factor * fineX + (cp.Vertex % nx) * factor;
-      if (cp.MorseIndex == 0)
-      {
-        constraints.Minima.push_back(v);
-        if (mesh.IsBoundaryVertex(v))
-        {
-          constraints.BoundaryMinima.push_back(v);
-        }
-      }
-      else if (cp.MorseIndex == 2)
-      {
-        constraints.Maxima.push_back(v);
-      }
-      else if (inputMesh.IsBoundaryEdge(cp.Cell) && mesh.IsBoundaryVertex(v))
-      {
-        constraints.BoundaryMaxima.push_back(v); // a saddle of a boundary edge of the input grid
-      }
-    }
+    const SamplingConstraints constraints = ComplexConstraints(p.Simplified.Complex, inputMesh, mesh,
+      [&](Index v) { return (v / nx) * factor * fineX + (v % nx) * factor; });
     const auto repair = EnforceCriticalVertices(mesh, constraints, sampled.Values);
     MorseSmaleComplex repaired;
     CHECK(extraction.Extract(sampled, repaired, error));
@@ -529,26 +510,7 @@ TEST_CASE(TopologicalSamplingRemovesNoiseExtrema)
     CHECK(extraction.Extract(noisy, before, error));
     TriangleMeshTopology mesh;
     mesh.BuildGrid(smooth.Dimensions[0], smooth.Dimensions[1], SequentialFor);
-    SamplingConstraints constraints;
-    for (const CriticalPoint& cp : wanted.CriticalPoints)
-    {
-      if (cp.MorseIndex == 0)
-      {
-        constraints.Minima.push_back(cp.Vertex);
-        if (mesh.IsBoundaryVertex(cp.Vertex))
-        {
-          constraints.BoundaryMinima.push_back(cp.Vertex);
-        }
-      }
-      else if (cp.MorseIndex == 2)
-      {
-        constraints.Maxima.push_back(cp.Vertex);
-      }
-      else if (mesh.IsBoundaryEdge(cp.Cell))
-      {
-        constraints.BoundaryMaxima.push_back(cp.Vertex);
-      }
-    }
+    const SamplingConstraints constraints = ComplexConstraints(wanted, mesh, mesh, [](Index v) { return v; });
     const auto report = EnforceCriticalVertices(mesh, constraints, noisy.Values);
     MorseSmaleComplex after;
     CHECK(extraction.Extract(noisy, after, error));
