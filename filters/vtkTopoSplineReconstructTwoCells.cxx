@@ -25,6 +25,7 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkSMPTools.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkStringArray.h>
 #include <vtkUnstructuredGrid.h>
 
@@ -320,6 +321,38 @@ int vtkTopoSplineReconstructTwoCells::RequestDataObject(
   return 1;
 }
 
+int vtkTopoSplineReconstructTwoCells::RequestInformation(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  // The resampled image's extent: the input grid's refined by Output Resolution, from 0 (see
+  // RequestData), or empty. Left as copied from the input, the port would ask for an extent
+  // its data never covers and the whole filter would run again at every update of it.
+  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  vtkInformation* resampledInfo = outputVector->GetInformationObject(2);
+  const int f = this->OutputResolution;
+  int extent[6] = { 0, -1, 0, -1, 0, -1 };
+  if (f > 1 && inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+  {
+    int input[6];
+    inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), input);
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      extent[2 * axis] = 0;
+      extent[2 * axis + 1] = std::max(0, input[2 * axis + 1] - input[2 * axis]) * f;
+    }
+  }
+  if (f > 1 && !inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+  {
+    // Not an image: the extent is known only once the domain's bounds are.
+    resampledInfo->Remove(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT());
+  }
+  else
+  {
+    resampledInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
+  }
+  return 1;
+}
+
 int vtkTopoSplineReconstructTwoCells::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -554,8 +587,9 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
     double origin[3] = { 0, 0, 0 }, spacing[3] = { 1, 1, 1 };
     if (auto* image = vtkImageData::SafeDownCast(domain))
     {
+      // From the image's first point: its extent need not start at 0 (e.g. a cropped image).
       image->GetDimensions(dims);
-      image->GetOrigin(origin);
+      image->GetPoint(0, origin);
       image->GetSpacing(spacing);
       for (int axis : { plane.U, plane.V })
       {

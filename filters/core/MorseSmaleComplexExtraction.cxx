@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 
 namespace topospline
@@ -69,8 +70,8 @@ double TurningAngle(double rx, double ry, double dx, double dy)
 }
 } // namespace
 
-void MorseSmaleComplexExtraction::SortAroundExtremum(
-  const MorseSmaleComplex& complex, Index extremum, std::vector<Index>& arcs)
+void MorseSmaleComplexExtraction::SortAroundExtremum(const MorseSmaleComplex& complex,
+  const std::vector<double>& saddleEnds, Index extremum, std::vector<Index>& arcs)
 {
   // The 1-cells of an extremum form a planar tree rooted at it (V-paths merge and never
   // split): descending ones as vertex paths, ascending ones as triangle paths (through the
@@ -88,6 +89,7 @@ void MorseSmaleComplexExtraction::SortAroundExtremum(
       const size_t i = minimum ? p : arc.Values.size() - 1 - p;
       paths[k].push_back({ arc.Points[2 * i], arc.Points[2 * i + 1] });
     }
+    paths[k].push_back({ saddleEnds[2 * arcs[k]], saddleEnds[2 * arcs[k] + 1] });
   }
   auto pathOf = [&](Index a) -> const std::vector<std::array<double, 2>>& {
     return paths[std::lower_bound(arcs.begin(), arcs.end(), a) - arcs.begin()];
@@ -475,12 +477,88 @@ bool MorseSmaleComplexExtraction::Extract(
     }
   }
 
-  // Pair sectors into 2-cells. Two sectors form a 2-cell when they share (minimum, maximum)
-  // and open into the same region. A cell thinner than the mesh may have no region (no vertex
-  // off its separatrices) or fall apart into two: within a (minimum, maximum) group, the
-  // sectors left over after pairing by region pair up when exactly two are left.
-  std::vector<Index> bySector(sectors.size());
-  std::iota(bySector.begin(), bySector.end(), 0);
+  // The 1-cells of each extremum (descending ones for minima, ascending ones for maxima),
+  // counter-clockwise around it, and each 1-cell's place in its extremum's order. Each 1-cell
+  // ends at the midpoint of its saddle edge: two saddles that share their highest vertex
+  // share a 1-cell path up to it, and only their edges tell the two apart.
+  std::vector<double> saddleEdgeMidpoints(2 * complex.Separatrices.size());
+  std::vector<std::vector<Index>> arcsOfExtremum(cps.size());
+  for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
+  {
+    const Separatrix& arc = complex.Separatrices[a];
+    const bool descending = arc.Type == Separatrix::Descending;
+    arcsOfExtremum[descending ? arc.Source : arc.Destination].push_back(a);
+    const Index edge = cps[descending ? arc.Destination : arc.Source].Cell;
+    for (int c = 0; c < 2; ++c)
+    {
+      saddleEdgeMidpoints[2 * a + c] = 0.5 *
+        (field.Points[2 * mesh.EdgeVertices[edge][0] + c] + field.Points[2 * mesh.EdgeVertices[edge][1] + c]);
+    }
+  }
+  std::vector<Index> placeAroundExtremum(complex.Separatrices.size(), InvalidIndex);
+  this->Parallel(0, static_cast<Index>(cps.size()), [&](Index begin, Index end) {
+    for (Index x = begin; x < end; ++x)
+    {
+      SortAroundExtremum(complex, saddleEdgeMidpoints, x, arcsOfExtremum[x]);
+      for (size_t k = 0; k < arcsOfExtremum[x].size(); ++k)
+      {
+        placeAroundExtremum[arcsOfExtremum[x][k]] = static_cast<Index>(k);
+      }
+    }
+  });
+  // The 1-cell next to `arc` around its extremum: counter-clockwise (+1) or clockwise (-1).
+  auto neighbourAround = [&](Index arc, int direction) {
+    const Separatrix& sep = complex.Separatrices[arc];
+    const auto& around = arcsOfExtremum[sep.Type == Separatrix::Descending ? sep.Source : sep.Destination];
+    const Index n = static_cast<Index>(around.size());
+    return around[(placeAroundExtremum[arc] + n + direction) % n];
+  };
+
+  // Pair sectors into 2-cells by tracing the faces of the planar graph of 1-cells. A cell lies
+  // left of its first descending 1-cell (walked from the minimum), so counter-clockwise of it
+  // around the minimum up to the next descending 1-cell; and left of its first ascending
+  // 1-cell (walked to the maximum), so clockwise of it around the maximum up to the previous
+  // ascending 1-cell. Those two 1-cells must belong to one saddle, whose sector between them
+  // (right of both) closes the cell. The order is what makes this exact: a sliver between
+  // two 1-cells that run side by side has no region to identify it, and one region can touch
+  // the sectors of two cells on both sides of a thin loop (a saddle whose two ascending
+  // 1-cells reach the same maximum), which paired them into a pouch outside its own loop.
+  std::map<std::pair<Index, Index>, Index> sectorOfArcs;
+  for (Index i = 0; i < static_cast<Index>(sectors.size()); ++i)
+  {
+    sectorOfArcs[{ sectors[i].Descending, sectors[i].Ascending }] = i;
+  }
+  std::vector<std::array<Index, 2>> cellSectors;
+  std::vector<unsigned char> sectorPaired(sectors.size(), 0);
+  for (Index i = 0; i < static_cast<Index>(sectors.size()); ++i)
+  {
+    const Sector& left = sectors[i];
+    if (!left.LeftOfDescending || sectorPaired[i])
+    {
+      continue;
+    }
+    const auto right = sectorOfArcs.find({ neighbourAround(left.Descending, +1), neighbourAround(left.Ascending, -1) });
+    if (right == sectorOfArcs.end() || sectors[right->second].LeftOfDescending || sectorPaired[right->second])
+    {
+      continue;
+    }
+    cellSectors.push_back({ i, right->second });
+    sectorPaired[i] = sectorPaired[right->second] = 1;
+  }
+
+  // What the planar order leaves (it fails only where it ties): two sectors form a 2-cell when
+  // they share (minimum, maximum) and open into the same region. A cell thinner than the mesh
+  // may have no region (no vertex off its separatrices) or fall apart into two: within a
+  // (minimum, maximum) group, the sectors left over after pairing by region pair up when
+  // exactly two are left.
+  std::vector<Index> bySector;
+  for (Index i = 0; i < static_cast<Index>(sectors.size()); ++i)
+  {
+    if (!sectorPaired[i])
+    {
+      bySector.push_back(i);
+    }
+  }
   auto groupKey = [&](Index i) {
     return std::make_pair(complex.Separatrices[sectors[i].Descending].Source,
       complex.Separatrices[sectors[i].Ascending].Destination);
@@ -493,14 +571,6 @@ bool MorseSmaleComplexExtraction::Extract(
     }
     return sectors[a].Component < sectors[b].Component;
   });
-  // The 1-cells of each extremum: descending ones for minima, ascending ones for maxima.
-  std::vector<std::vector<Index>> arcsOfExtremum(cps.size());
-  for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
-  {
-    const Separatrix& arc = complex.Separatrices[a];
-    arcsOfExtremum[arc.Type == Separatrix::Descending ? arc.Source : arc.Destination].push_back(a);
-  }
-  std::vector<std::array<Index, 2>> cellSectors;
   std::vector<Index> unpairedSectors;
   for (size_t i = 0; i < bySector.size();)
   {
@@ -556,8 +626,7 @@ bool MorseSmaleComplexExtraction::Extract(
         std::vector<std::array<Index, 2>> tryPairs;
         std::vector<Index> tryRest;
         const Index extremum = end == 0 ? groupKey(group[0]).first : groupKey(group[0]).second;
-        std::vector<Index> around = arcsOfExtremum[extremum];
-        SortAroundExtremum(complex, extremum, around);
+        const std::vector<Index>& around = arcsOfExtremum[extremum];
         auto arcOf = [&](const Sector& sector) { return end == 0 ? sector.Descending : sector.Ascending; };
         std::vector<unsigned char> used(group.size(), 0);
         for (size_t a = 0; a < group.size(); ++a)

@@ -88,8 +88,10 @@ public:
   ProgressHooks Hooks;
 
   // Sorts `arcs`, 1-cells of `extremum` (descending ones for a minimum, ascending ones for a
-  // maximum), counter-clockwise around it.
-  static void SortAroundExtremum(const MorseSmaleComplex& complex, Index extremum, std::vector<Index>& arcs);
+  // maximum), counter-clockwise around it. `saddleEnds` holds, per 1-cell, the point (x, y)
+  // where it ends at its saddle beyond its stored path (the saddle edge's midpoint).
+  static void SortAroundExtremum(const MorseSmaleComplex& complex, const std::vector<double>& saddleEnds,
+    Index extremum, std::vector<Index>& arcs);
 
   // Intermediate structures, kept for tests and later stages.
   TriangleMeshTopology Mesh;
