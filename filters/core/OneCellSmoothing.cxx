@@ -337,8 +337,19 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
   // different pieces (and non-adjacent segments of one piece). Pieces meeting at a node may
   // touch there. Where pieces cross, raise their k and fit again.
   // Curves that end at one point (the same node, or two nodes on one vertex: a boundary
-  // saddle and a maximum share their vertex, and the 1-cell between them is a loop) may touch
-  // right next to it: within two samples of such a shared end, a contact is their meeting.
+  // saddle and a maximum share their vertex, and the 1-cell between them is a loop) meet
+  // there: within two samples of such a shared end, a contact through that point (to rounding)
+  // is their meeting. Any other contact is a crossing, however close to the node: two 1-cells
+  // that leave a saddle almost tangentially and cross there leave a 2-cell without a simple
+  // boundary.
+  const double meetingTolerance =
+    1e-9 * std::max(domainBounds[1] - domainBounds[0], domainBounds[3] - domainBounds[2]);
+  auto passesThrough = [meetingTolerance](const Segment2& s, const double* q) {
+    const double dx = s.B[0] - s.A[0], dy = s.B[1] - s.A[1];
+    const double length2 = dx * dx + dy * dy;
+    const double t = length2 > 0 ? std::clamp(((q[0] - s.A[0]) * dx + (q[1] - s.A[1]) * dy) / length2, 0.0, 1.0) : 0.0;
+    return std::hypot(s.A[0] + t * dx - q[0], s.A[1] + t * dy - q[1]) <= meetingTolerance;
+  };
   auto endPosition = [&](Index p, bool atEnd) {
     return nodes[atEnd ? result.Pieces[p].EndNode : result.Pieces[p].StartNode].Position;
   };
@@ -351,7 +362,7 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
         const bool nearT = et == 0 ? t.Index_ < 2 : t.Index_ >= t.Count - 2;
         const double* a = endPosition(s.Piece, es == 1);
         const double* b = endPosition(t.Piece, et == 1);
-        if (nearT && a[0] == b[0] && a[1] == b[1])
+        if (nearT && a[0] == b[0] && a[1] == b[1] && passesThrough(s, a) && passesThrough(t, a))
         {
           return true;
         }

@@ -508,10 +508,32 @@ bool TwoCellParameterization::Parameterize(
   // simple". (Repeated points were refused above unless they are on slits.)
   if (!CGAL::is_simple_2(loop.begin(), loop.end(), Kernel()))
   {
-    error = hasSlits ? "TwoCellParameterization: the outer loop of the boundary (without its slits) is not simple "
-                       "(self-touching, self-crossing or zero area)"
-                     : "TwoCellParameterization: the boundary polygon is not simple (self-touching, self-crossing "
-                       "or zero area)";
+    std::ostringstream message;
+    message << (hasSlits ? "TwoCellParameterization: the outer loop of the boundary (without its slits) is not "
+                           "simple (self-touching, self-crossing or zero area)"
+                         : "TwoCellParameterization: the boundary polygon is not simple (self-touching, "
+                           "self-crossing or zero area)");
+    // Where: the first two non-adjacent loop edges that meet (quadratic, on failure only).
+    const std::size_t m = loop.size();
+    bool located = false;
+    for (std::size_t a = 0; a < m && !located; ++a)
+    {
+      const Kernel::Segment_2 first(loop[a], loop[(a + 1) % m]);
+      for (std::size_t b = a + 2; b < m && !located; ++b)
+      {
+        if ((b + 1) % m == a)
+        {
+          continue;
+        }
+        if (CGAL::do_intersect(first, Kernel::Segment_2(loop[b], loop[(b + 1) % m])))
+        {
+          message << " at boundary samples " << graph.Loop[a] << " and " << graph.Loop[b] << " near ("
+                  << loop[a].x() << ", " << loop[a].y() << ")";
+          located = true;
+        }
+      }
+    }
+    error = message.str();
     return false;
   }
   const int polygonOrientation = CGAL::orientation_2(loop.begin(), loop.end(), Kernel()) == CGAL::LEFT_TURN ? 1 : -1;
