@@ -265,11 +265,12 @@ void BuildTopology(const topospline::PlanarScalarField& field, topospline::Trian
 // `vertexAt` (a vertex of the domain to one of the sampling), become the only extrema of the
 // sampled values (TopologicalSampling.h).
 topospline::TopologicalSamplingReport EnforceComplexTopology(const topospline::MorseSmaleComplex& complex,
-  const topospline::TriangleMeshTopology& domainMesh, const topospline::PlanarScalarField& sampling,
-  const topospline::TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, double spacing,
-  vtkDoubleArray* values, int& displacedSaddles)
+  const topospline::OneCellSmoothingResult& smoothed, const topospline::TriangleMeshTopology& domainMesh,
+  const topospline::PlanarScalarField& sampling, const topospline::TriangleMeshTopology& mesh,
+  const std::function<Index(Index)>& vertexAt, double spacing, vtkDoubleArray* values, int& displacedSaddles)
 {
-  const auto constraints = topospline::ComplexConstraints(complex, domainMesh, mesh, vertexAt);
+  auto constraints = topospline::ComplexConstraints(complex, domainMesh, mesh, vertexAt);
+  topospline::AddSaddleOneCells(complex, smoothed, vertexAt, 4 * spacing, constraints);
   const std::vector<double> before(values->GetPointer(0), values->GetPointer(0) + values->GetNumberOfTuples());
   std::vector<double> sampled = before;
   auto report = topospline::EnforceCriticalVertices(mesh, constraints, sampled);
@@ -503,7 +504,7 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
     rawValues->DeepCopy(values);
     rawValues->SetName(names::ExactReconstruction);
     output->GetPointData()->AddArray(rawValues);
-    sampling = EnforceComplexTopology(complex, domainMesh, domainField, domainMesh, [](Index v) { return v; },
+    sampling = EnforceComplexTopology(complex, smoothed, domainMesh, domainField, domainMesh, [](Index v) { return v; },
       gridSpacing, values, displacedSaddles);
     for (vtkIdType v = 0; v < n; ++v)
     {
@@ -639,7 +640,7 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
       const double* h = resampledOutput->GetSpacing();
       const int ni = dims[plane.U], nj = dims[plane.V];
       int fineDisplaced = 0;
-      const auto fineReport = EnforceComplexTopology(complex, domainMesh, fine, fineMesh,
+      const auto fineReport = EnforceComplexTopology(complex, smoothed, domainMesh, fine, fineMesh,
         [&](Index v) {
           const double* xy = &domainField.Points[2 * static_cast<std::size_t>(v)];
           const int i = std::clamp(static_cast<int>(std::lround((xy[0] - o[plane.U]) / h[plane.U])), 0, ni - 1);

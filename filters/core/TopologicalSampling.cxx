@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <queue>
+#include <unordered_map>
 
 namespace topospline
 {
@@ -49,9 +51,12 @@ bool IsExtremum(const Graph& g, const std::vector<double>& values, Index v, bool
 // first vertex that drains outside it (a neighbour before it, not in the region) or that is a
 // wanted extremum of the same kind, is then re-valued from that outlet inwards, every vertex
 // just past the neighbour it was reached from, so that each has a neighbour before it. Values
-// only move in the sweep direction. Returns the number of changed vertices.
+// only move in the sweep direction. A vertex marked in `fixed` (if given) ends the region like a
+// wanted one: the region drains into it and it keeps its value. Returns the number of changed
+// vertices.
 Index Fill(const Graph& g, std::vector<double>& values, Index v, bool ascending,
-  const std::vector<unsigned char>& wanted, unsigned char flag, std::vector<unsigned>& mark, unsigned& stamp)
+  const std::vector<unsigned char>& wanted, unsigned char flag, std::vector<unsigned>& mark, unsigned& stamp,
+  const std::vector<unsigned char>* fixed = nullptr)
 {
   auto before = [ascending](const Key& a, const Key& b) { return ascending ? a < b : b < a; };
   auto later = [&](const Key& a, const Key& b) { return before(b, a); };
@@ -66,7 +71,7 @@ Index Fill(const Graph& g, std::vector<double>& values, Index v, bool ascending,
     const Index u = queue.top().Vertex;
     queue.pop();
     const Key key{ values[u], u };
-    if (u != v && (wanted[u] & flag))
+    if (u != v && ((wanted[u] & flag) || (fixed && (*fixed)[u])))
     {
       outlet = u;
       break;
@@ -130,6 +135,81 @@ Index Fill(const Graph& g, std::vector<double>& values, Index v, bool ascending,
   }
   return changed;
 }
+
+// A wanted boundary saddle (a maximum of the boundary curve) whose whole link is lower is a
+// maximum of the sampling too. Cutting it, as Fill would, makes it a pit of the boundary curve
+// that the boundary pass fills again, round after round. It needs a way up into the domain
+// instead: the interior region below it is searched highest first for the nearest vertex with
+// a neighbour above the saddle, and the path to it is raised to rise evenly from the saddle to
+// that neighbour. Path vertices keep a lower and a higher neighbour, so no extremum appears,
+// and the boundary curve is not touched. Returns the number of changed vertices (0: no way up).
+Index RaiseWayUp(const Graph& g, const std::vector<unsigned char>& onBoundary, std::vector<double>& values, Index v,
+  std::vector<unsigned>& mark, unsigned& stamp)
+{
+  const Key top{ values[v], v };
+  auto lower = [](const Key& a, const Key& b) { return a < b; };
+  std::priority_queue<Key, std::vector<Key>, decltype(lower)> queue(lower); // highest first
+  std::unordered_map<Index, Index> parent;
+  const unsigned seen = ++stamp;
+  mark[v] = seen;
+  for (Index i = g.Start[v]; i < g.Start[v + 1]; ++i)
+  {
+    const Index w = g.Adjacent[i];
+    if (!onBoundary[w])
+    {
+      mark[w] = seen;
+      parent[w] = v;
+      queue.push({ values[w], w });
+    }
+  }
+  Index end = InvalidIndex, above = InvalidIndex;
+  while (!queue.empty() && end == InvalidIndex)
+  {
+    const Index u = queue.top().Vertex;
+    queue.pop();
+    for (Index i = g.Start[u]; i < g.Start[u + 1] && end == InvalidIndex; ++i)
+    {
+      const Index w = g.Adjacent[i];
+      if (top < Key{ values[w], w })
+      {
+        end = u;
+        above = w;
+      }
+    }
+    for (Index i = g.Start[u]; i < g.Start[u + 1] && end == InvalidIndex; ++i)
+    {
+      const Index w = g.Adjacent[i];
+      if (mark[w] != seen && !onBoundary[w])
+      {
+        mark[w] = seen;
+        parent[w] = u;
+        queue.push({ values[w], w });
+      }
+    }
+  }
+  if (end == InvalidIndex)
+  {
+    return 0;
+  }
+  std::vector<Index> path;
+  for (Index u = end; u != v; u = parent[u])
+  {
+    path.push_back(u);
+  }
+  std::reverse(path.begin(), path.end());
+  const double from = values[v], to = values[above];
+  const double steps = static_cast<double>(path.size() + 1);
+  double previous = from;
+  for (std::size_t k = 0; k < path.size(); ++k)
+  {
+    // Evenly between the saddle and the vertex above it, and strictly rising even where the
+    // two differ by a few ulps.
+    previous = std::max(from + (to - from) * static_cast<double>(k + 1) / steps,
+      std::nextafter(previous, std::numeric_limits<double>::infinity()));
+    values[path[k]] = previous;
+  }
+  return static_cast<Index>(path.size());
+}
 } // namespace
 
 TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
@@ -172,6 +252,11 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
       }
     }
   }
+  std::vector<unsigned char> onBoundary(n, 0);
+  for (Index v = 0; v < n; ++v)
+  {
+    onBoundary[v] = boundary.Start[v + 1] > boundary.Start[v];
+  }
   std::vector<unsigned char> wanted(n, 0);
   for (Index v : constraints.Minima)
   {
@@ -206,19 +291,38 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
     for (const Pass& pass : passes)
     {
       std::vector<Index> candidates;
+      // Boundary vertices belong to the boundary passes, which ran first: an extremum of the
+      // whole link on the boundary is one of the boundary curve too, so those passes already
+      // removed it unless it is wanted there. If the whole-link passes lowered or raised them
+      // as well, the two would undo each other by a few ulps per round, walking along the
+      // boundary. So here they are skipped and fixed (floods drain into them), except a wanted
+      // boundary saddle above its whole link, which gets a way up.
+      const bool wholeLink = pass.G == &all;
       for (Index v = 0; v < n; ++v)
       {
-        if (!(wanted[v] & pass.Flag) && IsExtremum(*pass.G, values, v, pass.Ascending))
+        if (!(wanted[v] & pass.Flag) && !(wholeLink && onBoundary[v] && !(pass.Flag == 2 && (wanted[v] & 8))) &&
+          IsExtremum(*pass.G, values, v, pass.Ascending))
         {
           candidates.push_back(v);
         }
       }
       for (Index v : candidates)
       {
-        if (IsExtremum(*pass.G, values, v, pass.Ascending))
+        if (!IsExtremum(*pass.G, values, v, pass.Ascending))
         {
-          changed += Fill(*pass.G, values, v, pass.Ascending, wanted, pass.Flag, mark, stamp);
+          continue;
         }
+        Index c = 0;
+        // A wanted boundary saddle above its whole link gets a way up, not a cut.
+        if (pass.Flag == 2 && (wanted[v] & 8))
+        {
+          c = RaiseWayUp(all, onBoundary, values, v, mark, stamp);
+        }
+        if (c == 0)
+        {
+          c = Fill(*pass.G, values, v, pass.Ascending, wanted, pass.Flag, mark, stamp, wholeLink ? &onBoundary : nullptr);
+        }
+        changed += c;
       }
       if (stamp > std::numeric_limits<unsigned>::max() / 2)
       {
@@ -278,6 +382,51 @@ SamplingConstraints ComplexConstraints(const MorseSmaleComplex& complex, const T
     }
   }
   return constraints;
+}
+
+void AddSaddleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
+  const std::function<Index(Index)>& vertexAt, double radius, SamplingConstraints& constraints)
+{
+  constexpr int samplesPerSegment = 16;
+  for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()) &&
+       a < static_cast<Index>(smoothed.PiecesOfSeparatrix.size());
+       ++a)
+  {
+    const Separatrix& arc = complex.Separatrices[a];
+    const bool ascending = arc.Type == Separatrix::Ascending;
+    SaddleOneCell cell;
+    cell.Saddle = vertexAt(complex.CriticalPoints[ascending ? arc.Source : arc.Destination].Vertex);
+    cell.Ascending = ascending;
+    if (cell.Saddle == InvalidIndex)
+    {
+      continue;
+    }
+    // Pieces run from the lower end to the higher one: away from the saddle along an ascending
+    // 1-cell, towards it along a descending one.
+    std::vector<Index> pieces = smoothed.PiecesOfSeparatrix[a];
+    if (!ascending)
+    {
+      std::reverse(pieces.begin(), pieces.end());
+    }
+    bool outside = false;
+    for (std::size_t k = 0; k < pieces.size() && !outside; ++k)
+    {
+      const SmoothedPiece& piece = smoothed.Pieces[pieces[k]];
+      const int count = std::max(1, piece.Segments) * samplesPerSegment;
+      for (int s = (k == 0 ? 0 : 1); s <= count && !outside; ++s)
+      {
+        const double t = ascending ? static_cast<double>(s) / count : 1 - static_cast<double>(s) / count;
+        double xy[2];
+        piece.Curve.Evaluate(t, xy);
+        cell.Points.insert(cell.Points.end(), { xy[0], xy[1], piece.Height.Value(t) });
+        outside = std::hypot(xy[0] - cell.Points[0], xy[1] - cell.Points[1]) > radius;
+      }
+    }
+    if (cell.Points.size() >= 6)
+    {
+      constraints.SaddleOneCells.push_back(std::move(cell));
+    }
+  }
 }
 
 void CountChanges(const std::vector<double>& before, const std::vector<double>& after,
@@ -353,6 +502,23 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
   };
   std::vector<Index> missing, spare;
   unmatched(values, missing, spare);
+  if (!missing.empty() && !constraints.SaddleOneCells.empty())
+  {
+    std::vector<double> trial = values;
+    for (Index w : missing)
+    {
+      CarveSaddleOneCells(field, mesh, constraints, w, reach, trial);
+    }
+    EnforceCriticalVertices(mesh, constraints, trial);
+    std::vector<Index> trialMissing, trialSpare;
+    unmatched(trial, trialMissing, trialSpare);
+    if (trialMissing.size() < missing.size())
+    {
+      values = std::move(trial);
+      missing = std::move(trialMissing);
+      spare = std::move(trialSpare);
+    }
+  }
   // Each round costs an extraction of the whole sampling: worth it for the few saddles of a
   // flat pass, not when many are missing (a failed 2-cell keeps the input's own saddles).
   if (static_cast<int>(missing.size()) > maximumMissing)
@@ -398,5 +564,212 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
     spare = std::move(trialSpare);
   }
   return static_cast<int>(missing.size());
+}
+
+Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, Index saddle, double radius, std::vector<double>& values)
+{
+  const auto& p = field.Points;
+  auto neighbours = [&mesh](Index u) {
+    std::vector<Index> list;
+    for (Index i = mesh.VertexTriangleBegin(u); i < mesh.VertexTriangleEnd(u); ++i)
+    {
+      for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
+      {
+        if (w != u && std::find(list.begin(), list.end(), w) == list.end())
+        {
+          list.push_back(w);
+        }
+      }
+    }
+    return list;
+  };
+  std::vector<const SaddleOneCell*> cells;
+  for (const SaddleOneCell& cell : constraints.SaddleOneCells)
+  {
+    if (cell.Saddle == saddle)
+    {
+      cells.push_back(&cell);
+    }
+  }
+  const std::vector<Index> link = neighbours(saddle);
+  if (cells.empty() || link.size() < cells.size())
+  {
+    return 0;
+  }
+  const double sx = p[2 * saddle], sy = p[2 * saddle + 1];
+  double shortestEdge = std::numeric_limits<double>::infinity();
+  for (Index w : link)
+  {
+    shortestEdge = std::min(shortestEdge, std::hypot(p[2 * w] - sx, p[2 * w + 1] - sy));
+  }
+  // Distance from (x, y) to a 1-cell, with the 1-cell's height and arc length there.
+  struct Nearest
+  {
+    double Distance = std::numeric_limits<double>::infinity();
+    double Height = 0;
+    double Along = 0;
+  };
+  auto nearestOn = [](const SaddleOneCell& cell, double x, double y) {
+    Nearest best;
+    const std::vector<double>& q = cell.Points;
+    double along = 0;
+    for (std::size_t i = 0; i + 5 < q.size(); i += 3)
+    {
+      const double dx = q[i + 3] - q[i], dy = q[i + 4] - q[i + 1];
+      const double length2 = dx * dx + dy * dy;
+      const double t = length2 > 0 ? std::clamp(((x - q[i]) * dx + (y - q[i + 1]) * dy) / length2, 0.0, 1.0) : 0.0;
+      const double d = std::hypot(q[i] + t * dx - x, q[i + 1] + t * dy - y);
+      if (d < best.Distance)
+      {
+        best.Distance = d;
+        best.Height = q[i + 2] + t * (q[i + 5] - q[i + 2]);
+        best.Along = along + t * std::sqrt(length2);
+      }
+      along += std::sqrt(length2);
+    }
+    return best;
+  };
+  // The direction in which each 1-cell leaves the saddle, seen at the scale of the link.
+  auto angleOf = [&](double x, double y) { return std::atan2(y - sy, x - sx); };
+  std::vector<double> cellAngle;
+  for (const SaddleOneCell* cell : cells)
+  {
+    const std::vector<double>& q = cell->Points;
+    std::size_t i = 3;
+    while (i + 3 < q.size() && std::hypot(q[i] - sx, q[i + 1] - sy) < shortestEdge)
+    {
+      i += 3;
+    }
+    cellAngle.push_back(angleOf(q[i], q[i + 1]));
+  }
+  std::vector<double> linkAngle;
+  for (Index w : link)
+  {
+    linkAngle.push_back(angleOf(p[2 * w], p[2 * w + 1]));
+  }
+  // Each 1-cell takes its own link vertex, in the same turning order as the 1-cells leave (a
+  // saddle's link alternates above and below it as its 1-cells do), with the least total
+  // angle between the 1-cells and their vertices: all order-preserving choices are tried
+  // (a link has a handful of vertices).
+  std::vector<std::size_t> cellOrder(cells.size()), linkOrder(link.size());
+  std::iota(cellOrder.begin(), cellOrder.end(), 0);
+  std::iota(linkOrder.begin(), linkOrder.end(), 0);
+  std::sort(cellOrder.begin(), cellOrder.end(), [&](std::size_t a, std::size_t b) { return cellAngle[a] < cellAngle[b]; });
+  std::sort(linkOrder.begin(), linkOrder.end(), [&](std::size_t a, std::size_t b) { return linkAngle[a] < linkAngle[b]; });
+  auto gap = [](double a, double b) {
+    const double d = std::fmod(std::abs(a - b), 2 * M_PI);
+    return std::min(d, 2 * M_PI - d);
+  };
+  const std::size_t m = cells.size(), l = link.size();
+  std::vector<Index> vertexOfCell(m, InvalidIndex);
+  double bestCost = std::numeric_limits<double>::infinity();
+  std::vector<std::size_t> chosen(m);
+  // Subsets of m link positions in increasing order, by a bit mask over the l positions.
+  for (unsigned mask = 0; mask < (1u << l); ++mask)
+  {
+    if (static_cast<std::size_t>(__builtin_popcount(mask)) != m)
+    {
+      continue;
+    }
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < l; ++i)
+    {
+      if (mask & (1u << i))
+      {
+        chosen[k++] = i;
+      }
+    }
+    for (std::size_t shift = 0; shift < m; ++shift)
+    {
+      double cost = 0;
+      for (std::size_t j = 0; j < m; ++j)
+      {
+        cost += gap(cellAngle[cellOrder[(j + shift) % m]], linkAngle[linkOrder[chosen[j]]]);
+      }
+      if (cost < bestCost)
+      {
+        bestCost = cost;
+        for (std::size_t j = 0; j < m; ++j)
+        {
+          vertexOfCell[cellOrder[(j + shift) % m]] = link[linkOrder[chosen[j]]];
+        }
+      }
+    }
+  }
+  // From each of those vertices, a chain of vertices along the 1-cell that rises (falls) from
+  // the saddle: each next vertex the neighbour nearest to the 1-cell further along it, among
+  // those no 1-cell of the other kind passes nearer; the chain ends where the values already
+  // rise (fall) on their own, or at `radius`.
+  const double level = values[saddle];
+  const double infinity = std::numeric_limits<double>::infinity();
+  std::vector<Index> taken = { saddle };
+  for (Index v : vertexOfCell)
+  {
+    taken.push_back(v);
+  }
+  Index changed = 0;
+  auto set = [&](Index v, double value) {
+    if (values[v] != value)
+    {
+      values[v] = value;
+      ++changed;
+    }
+  };
+  for (std::size_t c = 0; c < m; ++c)
+  {
+    const SaddleOneCell& cell = *cells[c];
+    const bool up = cell.Ascending;
+    Index current = vertexOfCell[c];
+    Nearest at = nearestOn(cell, p[2 * current], p[2 * current + 1]);
+    double previous = level;
+    for (int step = 0; current != InvalidIndex; ++step)
+    {
+      const double wanted = up ? std::max(at.Height, std::nextafter(previous, infinity))
+                               : std::min(at.Height, std::nextafter(previous, -infinity));
+      if (step > 0 && (up ? values[current] > previous : values[current] < previous))
+      {
+        break; // the field goes on by itself from here
+      }
+      if (up ? values[current] < wanted : values[current] > wanted)
+      {
+        set(current, wanted);
+      }
+      previous = values[current];
+      Index next = InvalidIndex;
+      Nearest nextAt;
+      for (Index w : neighbours(current))
+      {
+        if (std::find(taken.begin(), taken.end(), w) != taken.end() ||
+          std::hypot(p[2 * w] - sx, p[2 * w + 1] - sy) > radius)
+        {
+          continue;
+        }
+        const Nearest candidate = nearestOn(cell, p[2 * w], p[2 * w + 1]);
+        if (candidate.Along <= at.Along || candidate.Distance >= nextAt.Distance)
+        {
+          continue;
+        }
+        bool otherKindNearer = false;
+        for (const SaddleOneCell* other : cells)
+        {
+          otherKindNearer = otherKindNearer ||
+            (other->Ascending != up && nearestOn(*other, p[2 * w], p[2 * w + 1]).Distance < candidate.Distance);
+        }
+        if (!otherKindNearer)
+        {
+          next = w;
+          nextAt = candidate;
+        }
+      }
+      if (next != InvalidIndex)
+      {
+        taken.push_back(next);
+      }
+      current = next;
+      at = nextAt;
+    }
+  }
+  return changed;
 }
 } // namespace topospline

@@ -16,6 +16,7 @@
 
 #include "CoreTypes.h"
 #include "MorseSmaleComplexExtraction.h"
+#include "OneCellSmoothing.h"
 #include "TriangleMeshTopology.h"
 
 #include <functional>
@@ -31,6 +32,15 @@ struct TopologicalSamplingReport
   double MaximumChange = 0;
 };
 
+// One smoothed 1-cell of a wanted saddle, sampled from the saddle outwards: x, y and height per
+// point (heights rise along an ascending 1-cell, fall along a descending one).
+struct SaddleOneCell
+{
+  Index Saddle = InvalidIndex; // the saddle's vertex in the sampling
+  bool Ascending = false;
+  std::vector<double> Points;
+};
+
 struct SamplingConstraints
 {
   std::vector<Index> Minima;         // vertices of the wanted minima
@@ -39,13 +49,21 @@ struct SamplingConstraints
   std::vector<Index> BoundaryMaxima; // wanted maxima along the boundary curve (higher vertex of a
                                      // critical boundary edge: a boundary saddle)
   std::vector<Index> Saddles;        // vertices of the wanted saddles (RelocateSaddles)
+  // Optional, for RelocateSaddles: the smoothed 1-cells of the wanted saddles.
+  std::vector<SaddleOneCell> SaddleOneCells;
 };
+
 
 // The critical points of `complex`, extracted on `complexMesh`, as constraints on a sampling
 // with mesh `mesh`: `vertexAt` gives the sampling's vertex for a vertex of `complexMesh`
 // (InvalidIndex: none). A saddle of a boundary edge is a wanted maximum along the boundary.
 SamplingConstraints ComplexConstraints(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
   const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt);
+
+// Adds to `constraints` the smoothed 1-cells of the complex's saddles, sampled from each saddle
+// out to `radius` (`vertexAt` as for ComplexConstraints).
+void AddSaddleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
+  const std::function<Index(Index)>& vertexAt, double radius, SamplingConstraints& constraints);
 
 // Adds to `report` how many of `after` differ from `before`, and by how much at most.
 void CountChanges(const std::vector<double>& before, const std::vector<double>& after,
@@ -65,7 +83,21 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
 // enforced again. A round is kept only if it leaves fewer unmatched saddles. Nothing is tried
 // when more than `maximumMissing` are unmatched. Returns the number of unmatched wanted saddles
 // left.
+// With constraints.SaddleOneCells, the unmatched saddles' 1-cells are first carved into the
+// sampling (CarveSaddleOneCells, within `reach`; one extraction, whatever the number
+// unmatched): where a 1-cell runs between two rows of vertices, as next to the domain
+// boundary, the ridge or valley it follows is seen by no vertex and the saddle slides along
+// it; carving gives it vertices.
 int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, double tolerance, double reach, std::vector<double>& values,
   int maximumRounds = 3, int maximumMissing = 10);
+
+// Makes the wanted saddle `saddle` a saddle of the sampling with its own 1-cells
+// (constraints.SaddleOneCells): each 1-cell gets a vertex of the saddle's link, in the order
+// in which they leave it, raised above the saddle's value for an ascending 1-cell and lowered
+// below it for a descending one; from there a chain of vertices along the 1-cell, within
+// `radius`, rises (falls) with the 1-cell's heights until the values go on that way by
+// themselves. Returns the number of changed vertices.
+Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, Index saddle, double radius, std::vector<double>& values);
 } // namespace topospline
