@@ -270,13 +270,13 @@ topospline::TopologicalSamplingReport EnforceComplexTopology(const topospline::M
   const std::function<Index(Index)>& vertexAt, double spacing, vtkDoubleArray* values, int& displacedSaddles)
 {
   auto constraints = topospline::ComplexConstraints(complex, domainMesh, mesh, vertexAt);
-  topospline::AddSaddleOneCells(complex, smoothed, vertexAt, 4 * spacing, constraints);
+  topospline::AddSaddleOneCells(complex, smoothed, vertexAt, 8 * spacing, constraints);
   const std::vector<double> before(values->GetPointer(0), values->GetPointer(0) + values->GetNumberOfTuples());
   std::vector<double> sampled = before;
   auto report = topospline::EnforceCriticalVertices(mesh, constraints, sampled);
   // Saddles left a few vertices from their nodes in flat passes are moved onto them.
   displacedSaddles =
-    topospline::RelocateSaddles(sampling, mesh, constraints, spacing * (1 + 1e-9), 4 * spacing, sampled);
+    topospline::RelocateSaddles(sampling, mesh, constraints, spacing * (1 + 1e-9), 8 * spacing, sampled);
   report.ChangedVertices = 0;
   report.MaximumChange = 0;
   topospline::CountChanges(before, sampled, report);

@@ -502,6 +502,12 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
   };
   std::vector<Index> missing, spare;
   unmatched(values, missing, spare);
+  // A trial is kept if it matches more wanted saddles without adding saddles: found saddles
+  // beyond the wanted ones would come with an extremum the enforcement could not remove.
+  auto better = [&](const std::vector<Index>& trialMissing, const std::vector<Index>& trialSpare) {
+    return trialMissing.size() < missing.size() &&
+      trialSpare.size() + missing.size() <= spare.size() + trialMissing.size();
+  };
   if (!missing.empty() && !constraints.SaddleOneCells.empty())
   {
     std::vector<double> trial = values;
@@ -512,7 +518,7 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
     EnforceCriticalVertices(mesh, constraints, trial);
     std::vector<Index> trialMissing, trialSpare;
     unmatched(trial, trialMissing, trialSpare);
-    if (trialMissing.size() < missing.size())
+    if (better(trialMissing, trialSpare))
     {
       values = std::move(trial);
       missing = std::move(trialMissing);
@@ -555,7 +561,7 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
     EnforceCriticalVertices(mesh, constraints, trial);
     std::vector<Index> trialMissing, trialSpare;
     unmatched(trial, trialMissing, trialSpare);
-    if (trialMissing.size() >= missing.size())
+    if (!better(trialMissing, trialSpare))
     {
       break;
     }
