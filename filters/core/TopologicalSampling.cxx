@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <queue>
@@ -136,13 +137,45 @@ Index Fill(const Graph& g, std::vector<double>& values, Index v, bool ascending,
   return changed;
 }
 
+// The distance from (x, y) to a smoothed 1-cell, with its height and arc length there.
+struct NearestPoint
+{
+  double Distance = std::numeric_limits<double>::infinity();
+  double Height = 0;
+  double Along = 0;
+};
+
+NearestPoint NearestOnOneCell(const SaddleOneCell& cell, double x, double y)
+{
+  NearestPoint best;
+  const std::vector<double>& q = cell.Points;
+  double along = 0;
+  for (std::size_t i = 0; i + 5 < q.size(); i += 3)
+  {
+    const double dx = q[i + 3] - q[i], dy = q[i + 4] - q[i + 1];
+    const double length2 = dx * dx + dy * dy;
+    const double t = length2 > 0 ? std::clamp(((x - q[i]) * dx + (y - q[i + 1]) * dy) / length2, 0.0, 1.0) : 0.0;
+    const double d = std::hypot(q[i] + t * dx - x, q[i + 1] + t * dy - y);
+    if (d < best.Distance)
+    {
+      best.Distance = d;
+      best.Height = q[i + 2] + t * (q[i + 5] - q[i + 2]);
+      best.Along = along + t * std::sqrt(length2);
+    }
+    along += std::sqrt(length2);
+  }
+  return best;
+}
+
 // A wanted boundary saddle (a maximum of the boundary curve) whose whole link is lower is a
 // maximum of the sampling too. Cutting it, as Fill would, makes it a pit of the boundary curve
 // that the boundary pass fills again, round after round. It needs a way up into the domain
-// instead: the interior region below it is searched highest first for the nearest vertex with
-// a neighbour above the saddle, and the path to it is raised to rise evenly from the saddle to
+// instead: the interior is searched, highest vertices first, for the nearest vertex with a
+// neighbour above the saddle, and the path to it is raised to rise evenly from the saddle to
 // that neighbour. Path vertices keep a lower and a higher neighbour, so no extremum appears,
 // and the boundary curve is not touched. Returns the number of changed vertices (0: no way up).
+// (Tried and dropped: following the saddle's smoothed ascending 1-cell instead, and keeping
+// the path off wanted vertices; both left more saddles off their nodes on the climate field.)
 Index RaiseWayUp(const Graph& g, const std::vector<unsigned char>& onBoundary, std::vector<double>& values, Index v,
   std::vector<unsigned>& mark, unsigned& stamp)
 {
@@ -152,15 +185,17 @@ Index RaiseWayUp(const Graph& g, const std::vector<unsigned char>& onBoundary, s
   std::unordered_map<Index, Index> parent;
   const unsigned seen = ++stamp;
   mark[v] = seen;
-  for (Index i = g.Start[v]; i < g.Start[v + 1]; ++i)
-  {
-    const Index w = g.Adjacent[i];
-    if (!onBoundary[w])
+  auto visit = [&](Index w, Index from) {
+    if (mark[w] != seen && !onBoundary[w])
     {
       mark[w] = seen;
-      parent[w] = v;
+      parent[w] = from;
       queue.push({ values[w], w });
     }
+  };
+  for (Index i = g.Start[v]; i < g.Start[v + 1]; ++i)
+  {
+    visit(g.Adjacent[i], v);
   }
   Index end = InvalidIndex, above = InvalidIndex;
   while (!queue.empty() && end == InvalidIndex)
@@ -178,13 +213,7 @@ Index RaiseWayUp(const Graph& g, const std::vector<unsigned char>& onBoundary, s
     }
     for (Index i = g.Start[u]; i < g.Start[u + 1] && end == InvalidIndex; ++i)
     {
-      const Index w = g.Adjacent[i];
-      if (mark[w] != seen && !onBoundary[w])
-      {
-        mark[w] = seen;
-        parent[w] = u;
-        queue.push({ values[w], w });
-      }
+      visit(g.Adjacent[i], u);
     }
   }
   if (end == InvalidIndex)
@@ -609,33 +638,8 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
   {
     shortestEdge = std::min(shortestEdge, std::hypot(p[2 * w] - sx, p[2 * w + 1] - sy));
   }
-  // Distance from (x, y) to a 1-cell, with the 1-cell's height and arc length there.
-  struct Nearest
-  {
-    double Distance = std::numeric_limits<double>::infinity();
-    double Height = 0;
-    double Along = 0;
-  };
-  auto nearestOn = [](const SaddleOneCell& cell, double x, double y) {
-    Nearest best;
-    const std::vector<double>& q = cell.Points;
-    double along = 0;
-    for (std::size_t i = 0; i + 5 < q.size(); i += 3)
-    {
-      const double dx = q[i + 3] - q[i], dy = q[i + 4] - q[i + 1];
-      const double length2 = dx * dx + dy * dy;
-      const double t = length2 > 0 ? std::clamp(((x - q[i]) * dx + (y - q[i + 1]) * dy) / length2, 0.0, 1.0) : 0.0;
-      const double d = std::hypot(q[i] + t * dx - x, q[i + 1] + t * dy - y);
-      if (d < best.Distance)
-      {
-        best.Distance = d;
-        best.Height = q[i + 2] + t * (q[i + 5] - q[i + 2]);
-        best.Along = along + t * std::sqrt(length2);
-      }
-      along += std::sqrt(length2);
-    }
-    return best;
-  };
+  auto nearestOn = [](const SaddleOneCell& cell, double x, double y) { return NearestOnOneCell(cell, x, y); };
+  using Nearest = NearestPoint;
   // The direction in which each 1-cell leaves the saddle, seen at the scale of the link.
   auto angleOf = [&](double x, double y) { return std::atan2(y - sy, x - sx); };
   std::vector<double> cellAngle;
@@ -668,8 +672,17 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
     return std::min(d, 2 * M_PI - d);
   };
   const std::size_t m = cells.size(), l = link.size();
+  // A vertex of the domain boundary should serve only a 1-cell that runs along the boundary
+  // through it: raising or lowering it for a 1-cell that merely passes nearby changes the
+  // boundary curve's own extrema, which the boundary passes then fight. In the link it is
+  // only avoided (a boundary saddle's link may have no other vertex for a 1-cell); chains
+  // never take one.
+  const double infinity = std::numeric_limits<double>::infinity();
+  auto onTheirWay = [&](const SaddleOneCell& cell, Index w) {
+    return !mesh.IsBoundaryVertex(w) || nearestOn(cell, p[2 * w], p[2 * w + 1]).Distance <= 0.25 * shortestEdge;
+  };
   std::vector<Index> vertexOfCell(m, InvalidIndex);
-  double bestCost = std::numeric_limits<double>::infinity();
+  double bestCost = infinity;
   std::vector<std::size_t> chosen(m);
   // Subsets of m link positions in increasing order, by a bit mask over the l positions.
   for (unsigned mask = 0; mask < (1u << l); ++mask)
@@ -691,7 +704,9 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
       double cost = 0;
       for (std::size_t j = 0; j < m; ++j)
       {
-        cost += gap(cellAngle[cellOrder[(j + shift) % m]], linkAngle[linkOrder[chosen[j]]]);
+        const std::size_t c = cellOrder[(j + shift) % m];
+        const Index w = link[linkOrder[chosen[j]]];
+        cost += gap(cellAngle[c], linkAngle[linkOrder[chosen[j]]]) + (onTheirWay(*cells[c], w) ? 0 : M_PI / 4);
       }
       if (cost < bestCost)
       {
@@ -707,8 +722,11 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
   // the saddle: each next vertex the neighbour nearest to the 1-cell further along it, among
   // those no 1-cell of the other kind passes nearer; the chain ends where the values already
   // rise (fall) on their own, or at `radius`.
+  if (!std::isfinite(bestCost))
+  {
+    return 0;
+  }
   const double level = values[saddle];
-  const double infinity = std::numeric_limits<double>::infinity();
   std::vector<Index> taken = { saddle };
   for (Index v : vertexOfCell)
   {
@@ -747,7 +765,7 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
       for (Index w : neighbours(current))
       {
         if (std::find(taken.begin(), taken.end(), w) != taken.end() ||
-          std::hypot(p[2 * w] - sx, p[2 * w + 1] - sy) > radius)
+          std::hypot(p[2 * w] - sx, p[2 * w + 1] - sy) > radius || !onTheirWay(cell, w))
         {
           continue;
         }

@@ -49,7 +49,8 @@ struct SamplingConstraints
   std::vector<Index> BoundaryMaxima; // wanted maxima along the boundary curve (higher vertex of a
                                      // critical boundary edge: a boundary saddle)
   std::vector<Index> Saddles;        // vertices of the wanted saddles (RelocateSaddles)
-  // Optional, for RelocateSaddles: the smoothed 1-cells of the wanted saddles.
+  // Optional, for RelocateSaddles: the smoothed 1-cells of the wanted saddles
+  // (AddSaddleOneCells).
   std::vector<SaddleOneCell> SaddleOneCells;
 };
 
@@ -97,7 +98,9 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
 // in which they leave it, raised above the saddle's value for an ascending 1-cell and lowered
 // below it for a descending one; from there a chain of vertices along the 1-cell, within
 // `radius`, rises (falls) with the 1-cell's heights until the values go on that way by
-// themselves. Returns the number of changed vertices.
+// themselves. Vertices of the domain boundary serve only 1-cells that run through them (in the
+// link, unless there is no other choice).
+// Returns the number of changed vertices.
 Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, Index saddle, double radius, std::vector<double>& values);
 } // namespace topospline

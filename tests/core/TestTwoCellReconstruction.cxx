@@ -249,11 +249,11 @@ void CheckReconstruction(const char* name, const GridField& grid, double percent
     const int nx = grid.Dimensions[0], fineX = sampled.GridDimensions[0];
     const auto vertexAt = [&](Index v) { return (v / nx) * factor * fineX + (v % nx) * factor; };
     SamplingConstraints constraints = ComplexConstraints(p.Simplified.Complex, inputMesh, mesh, vertexAt);
+    // The smoothed 1-cells guide the way up from boundary saddles and carve back saddles that
+    // slid a few vertices along a flat pass or the domain boundary.
+    AddSaddleOneCells(p.Simplified.Complex, p.Smoothed, vertexAt, 8 * spacing, constraints);
     const auto repair = EnforceCriticalVertices(mesh, constraints, sampled.Values);
-    // Saddles that slid a few vertices along a flat pass or the domain boundary are carved
-    // back onto their nodes along their smoothed 1-cells.
-    AddSaddleOneCells(p.Simplified.Complex, p.Smoothed, vertexAt, 4 * spacing, constraints);
-    const int unmatched = RelocateSaddles(sampled, mesh, constraints, spacing, 4 * spacing, sampled.Values);
+    const int unmatched = RelocateSaddles(sampled, mesh, constraints, spacing, 8 * spacing, sampled.Values);
     MorseSmaleComplex repaired;
     CHECK(extraction.Extract(sampled, repaired, error));
     const auto after = CompareCriticalPoints(expected, CriticalPointLocations(repaired, sampled.Points), spacing);

@@ -1,12 +1,13 @@
 """Stage 4 through ParaView on the synthetic fields and every catalog data set at 2, 5 and
 25 % with k = 4 and 7 (files above 300k vertices only with TOPOSPLINE_LARGE_TESTS=1).
-Asserted: no Sibson cell violates the monotonicity conditions; critical values are
-interpolated; the Bezier patches (VTK_BEZIER_TRIANGLE) and the finer resampling (4x, 2x
-above 100k vertices) are output; the outputs' samplings (after topological sampling) have
-exactly the simplified complex's number of minima, saddles and maxima, at the input
-resolution and finer. Printed for the record: failed 2-cells, the counts before topological
-sampling, how far it moved values, the topology verdict (which also requires every critical
-point within one grid spacing of its node), and the L-infinity and RMS errors."""
+Asserted: every 2-cell is reconstructed; no Sibson cell violates the monotonicity conditions;
+critical values are interpolated; the Bezier patches (VTK_BEZIER_TRIANGLE) and the finer
+resampling (4x, 2x above 100k vertices) are output; the outputs' samplings (after topological
+sampling) have exactly the simplified complex's number of minima, saddles and maxima, at the
+input resolution and finer; and the topology verdict, which also requires every critical point
+within one grid spacing of its node, holds except on the listed known misses. Printed for the
+record: the counts before topological sampling, how far it moved values, and the L-infinity and
+RMS errors."""
 import os
 
 import numpy as np
@@ -32,6 +33,15 @@ for entry in tt.catalog():
         checks.skip("%s absent (large data sets live in ../shared/data)" % entry["file"])
 
 
+# Runs whose sampled saddles are not all within one grid spacing of their nodes (docs/Reconstruction.md,
+# "Saddle positions"): saddles next to the bottom boundary row of the climate grid, where two
+# ascending 1-cells run half a row above the boundary.
+KNOWN_POSITION_MISSES = {
+    "ttk_happi_tas_anomaly.vti 2% k=4": "saddle (116, 1) at 4x",
+    "ttk_happi_tas_anomaly.vti 5% k=7": "saddle (85, 6)",
+}
+
+
 def number(fd, name, index=0):
     array = fd.GetArray(name)
     return array.GetValue(index) if array is not None else None
@@ -50,15 +60,18 @@ def check_reconstruction(label, reconstruct, c, resolution):
     checks.equal(sum(expected), len(c["cp_VertexId"]), "%s: the topology check counted every node" % label)
     found = [int(number(fd, "InputCriticalPoints", i)) for i in range(3)]
     fine = [int(number(fd, "ResampledCriticalPoints", i)) for i in range(3)] if resolution > 1 else None
-    # Asserted where every 2-cell was reconstructed (a failed cell keeps the input values, with
-    # their critical points); printed otherwise.
-    if number(fd, "FailedTwoCells") == 0:
-        checks.equal(found, expected, "%s: critical points of the sampling at the input resolution" % label)
-        if fine is not None:
-            checks.equal(fine, expected, "%s: critical points of the %dx finer sampling" % (label, resolution))
+    checks.equal(number(fd, "FailedTwoCells"), 0, "%s: every 2-cell reconstructed" % label)
+    checks.equal(found, expected, "%s: critical points of the sampling at the input resolution" % label)
+    if fine is not None:
+        checks.equal(fine, expected, "%s: critical points of the %dx finer sampling" % (label, resolution))
+    # The full verdict: also every critical point within one grid spacing of its node, at both
+    # resolutions. Known misses are listed (and must stay misses, so the list stays true).
+    verdict = bool(number(fd, "TopologyVerified"))
+    if label in KNOWN_POSITION_MISSES:
+        checks.check(not verdict, "%s: still a known position miss (%s); if it now holds, take it off the list"
+                     % (label, KNOWN_POSITION_MISSES[label]))
     else:
-        print("%s: %d failed 2-cells; critical points at the input resolution %s, finer %s" % (
-            label, number(fd, "FailedTwoCells"), found, fine))
+        checks.check(verdict, "%s: topology verified (counts and positions within one spacing)" % label)
     raw = [int(number(fd, "RawInputCriticalPoints", i)) for i in range(3)]
     print("%s: failed 2-cells %d; critical points expected %s, before topological sampling %s (it moved %d "
           "vertices, at most %.3g = %.2f%% of the range); verdict %d (%d spurious, %d missing within one grid spacing)"
@@ -78,12 +91,9 @@ def check_reconstruction(label, reconstruct, c, resolution):
     at_nodes = exact[vertices][located]
     moved = float(np.max(np.abs(values[vertices] - exact[vertices]))) if len(vertices) else 0.0
     worst = float(np.max(np.abs(at_nodes - c["cp_CriticalValue"][located]))) if len(at_nodes) else 0.0
-    if number(fd, "FailedTwoCells") == 0:
-        checks.check(worst <= 1e-9 * field_range, "%s: critical values interpolated (worst %.3g)" % (label, worst))
-        print("%s: topological sampling moved node values by up to %.3g (%.2f%% of the range)"
-              % (label, moved, 100 * moved / field_range))
-    else:  # a node next to a failed cell may be snapped to a neighbour's boundary
-        print("%s: critical values off by up to %.3g next to failed cells" % (label, worst))
+    checks.check(worst <= 1e-9 * field_range, "%s: critical values interpolated (worst %.3g)" % (label, worst))
+    print("%s: topological sampling moved node values by up to %.3g (%.2f%% of the range)"
+          % (label, moved, 100 * moved / field_range))
     return number(fd, "MaximumError"), number(fd, "RMSError"), field_range, number(fd, "BezierTriangles")
 
 
