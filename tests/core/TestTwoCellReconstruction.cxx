@@ -495,19 +495,46 @@ TEST_CASE(PlanarBezierTrianglesEvaluateToTheSurface)
   CHECK(worst < 1e-9);
 }
 
+namespace
+{
+// A smooth trigonometric field on an 80 x 80 grid, its complex (the wanted one) and the
+// sampling constraints it gives.
+struct SamplingCase
+{
+  PlanarScalarField Field;
+  MorseSmaleComplex Wanted;
+  TriangleMeshTopology Mesh;
+  SamplingConstraints Constraints;
+};
+
+SamplingCase TrigonometricSamplingCase()
+{
+  SamplingCase c;
+  const GridField smooth = TrigonometricField(10, 80, -40);
+  c.Field = GridToField(smooth);
+  MorseSmaleComplexExtraction extraction;
+  std::string error;
+  CHECK(extraction.Extract(c.Field, c.Wanted, error));
+  c.Mesh.BuildGrid(smooth.Dimensions[0], smooth.Dimensions[1], SequentialFor);
+  c.Constraints = ComplexConstraints(c.Wanted, c.Mesh, c.Mesh, [](Index v) { return v; });
+  return c;
+}
+} // namespace
+
 TEST_CASE(TopologicalSamplingRemovesNoiseExtrema)
 {
   // A smooth field's complex is the wanted one; noise adds hundreds of small extrema, which
   // the flooding must remove, leaving exactly the smooth field's critical points, with values
   // moved by less than the noise amplitude.
+  const SamplingCase smooth = TrigonometricSamplingCase();
+  const PlanarScalarField& field = smooth.Field;
+  const MorseSmaleComplex& wanted = smooth.Wanted;
+  const TriangleMeshTopology& mesh = smooth.Mesh;
+  const SamplingConstraints& constraints = smooth.Constraints;
+  MorseSmaleComplexExtraction extraction;
+  std::string error;
   for (int seed : { 1, 2, 3 })
   {
-    GridField smooth = TrigonometricField(10, 80, -40);
-    PlanarScalarField field = GridToField(smooth);
-    MorseSmaleComplexExtraction extraction;
-    MorseSmaleComplex wanted;
-    std::string error;
-    CHECK(extraction.Extract(field, wanted, error));
     std::mt19937_64 random(seed);
     std::uniform_real_distribution<double> noise(-0.5, 0.5);
     PlanarScalarField noisy = field;
@@ -517,9 +544,6 @@ TEST_CASE(TopologicalSamplingRemovesNoiseExtrema)
     }
     MorseSmaleComplex before;
     CHECK(extraction.Extract(noisy, before, error));
-    TriangleMeshTopology mesh;
-    mesh.BuildGrid(smooth.Dimensions[0], smooth.Dimensions[1], SequentialFor);
-    const SamplingConstraints constraints = ComplexConstraints(wanted, mesh, mesh, [](Index v) { return v; });
     const auto report = EnforceCriticalVertices(mesh, constraints, noisy.Values);
     MorseSmaleComplex after;
     CHECK(extraction.Extract(noisy, after, error));
@@ -542,15 +566,12 @@ TEST_CASE(BoundarySaddleAboveItsLinkGetsAWayUp)
   // lie below it is a maximum of the sampling. Cutting it made it a pit of the boundary curve,
   // which the boundary pass filled again: the passes undid each other and never converged.
   // It must keep its value and get a rising path into the domain instead.
-  GridField smooth = TrigonometricField(10, 80, -40);
-  PlanarScalarField field = GridToField(smooth);
+  const SamplingCase smooth = TrigonometricSamplingCase();
+  const PlanarScalarField& field = smooth.Field;
+  const TriangleMeshTopology& mesh = smooth.Mesh;
+  const SamplingConstraints& constraints = smooth.Constraints;
   MorseSmaleComplexExtraction extraction;
-  MorseSmaleComplex wanted;
   std::string error;
-  CHECK(extraction.Extract(field, wanted, error));
-  TriangleMeshTopology mesh;
-  mesh.BuildGrid(smooth.Dimensions[0], smooth.Dimensions[1], SequentialFor);
-  const SamplingConstraints constraints = ComplexConstraints(wanted, mesh, mesh, [](Index v) { return v; });
   CHECK(!constraints.BoundaryMaxima.empty());
   int tried = 0;
   for (Index saddle : constraints.BoundaryMaxima)
@@ -570,7 +591,7 @@ TEST_CASE(BoundarySaddleAboveItsLinkGetsAWayUp)
     MorseSmaleComplex after;
     CHECK(extraction.Extract(dented, after, error));
     CHECK(report.Converged);
-    CHECK(after.CountByIndex() == wanted.CountByIndex());
+    CHECK(after.CountByIndex() == smooth.Wanted.CountByIndex());
     CHECK_EQ(dented.Values[saddle], field.Values[saddle]);
     ++tried;
   }
