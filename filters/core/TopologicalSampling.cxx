@@ -171,8 +171,8 @@ NearestPoint NearestOnOneCell(const SaddleOneCell& cell, double x, double y)
 // maximum of the sampling too. Cutting it, as Fill would, makes it a pit of the boundary curve
 // that the boundary pass fills again, round after round. It needs a way up into the domain
 // instead: the interior is searched, highest vertices first, for the nearest vertex with a
-// neighbour above the saddle, and the path to it is raised to rise evenly from the saddle to
-// that neighbour. Path vertices keep a lower and a higher neighbour, so no extremum appears,
+// neighbour above the saddle, and the path to it is raised to rise from just above the saddle
+// towards that neighbour. Path vertices keep a lower and a higher neighbour, so no extremum appears,
 // and the boundary curve is not touched. Returns the number of changed vertices (0: no way up).
 // (Tried and dropped: following the saddle's smoothed ascending 1-cell instead, and keeping
 // the path off wanted vertices; both left more saddles off their nodes on the climate field.)
@@ -231,9 +231,10 @@ Index RaiseWayUp(const Graph& g, const std::vector<unsigned char>& onBoundary, s
   double previous = from;
   for (std::size_t k = 0; k < path.size(); ++k)
   {
-    // Evenly between the saddle and the vertex above it, and strictly rising even where the
-    // two differ by a few ulps.
-    previous = std::max(from + (to - from) * static_cast<double>(k + 1) / steps,
+    // Just above the saddle, rising by a thousandth of the way to the vertex above per step
+    // (strictly, even where the two differ by a few ulps): the path only has to rise, and
+    // ramping it all the way up distorted long paths by most of that difference.
+    previous = std::max(from + 1e-3 * (to - from) * static_cast<double>(k + 1) / steps,
       std::nextafter(previous, std::numeric_limits<double>::infinity()));
     values[path[k]] = previous;
   }
