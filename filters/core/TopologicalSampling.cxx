@@ -172,10 +172,11 @@ NearestPoint NearestOnOneCell(const SaddleOneCell& cell, double x, double y)
 // that the boundary pass fills again, round after round. It needs a way up into the domain
 // instead: the interior is searched, highest vertices first, for the nearest vertex with a
 // neighbour above the saddle, and the path to it is raised to rise from just above the saddle
-// towards that neighbour. Path vertices keep a lower and a higher neighbour, so no extremum appears,
-// and the boundary curve is not touched. Returns the number of changed vertices (0: no way up).
-// (Tried and dropped: following the saddle's smoothed ascending 1-cell instead, and keeping
-// the path off wanted vertices; both left more saddles off their nodes on the climate field.)
+// towards that neighbour. Path vertices keep a lower and a higher neighbour, so no extremum
+// appears, and the boundary curve is not touched. Returns the number of changed vertices (0: no
+// way up). (Tried and dropped: following the saddle's smoothed ascending 1-cell instead, and
+// keeping the path off wanted saddles or their lower neighbours; the first two left more
+// saddles off their nodes on the climate field, the last broke convergence.)
 Index RaiseWayUp(const Graph& g, const std::vector<unsigned char>& onBoundary, std::vector<double>& values, Index v,
   std::vector<unsigned>& mark, unsigned& stamp)
 {
