@@ -269,14 +269,16 @@ topospline::TopologicalSamplingReport EnforceComplexTopology(const topospline::M
   const topospline::PlanarScalarField& sampling, const topospline::TriangleMeshTopology& mesh,
   const std::function<Index(Index)>& vertexAt, double spacing, vtkDoubleArray* values, int& displacedSaddles)
 {
+  // How far from its node a saddle is looked for and carved back.
+  const double reach = 8 * spacing;
   auto constraints = topospline::ComplexConstraints(complex, domainMesh, mesh, vertexAt);
-  topospline::AddSaddleOneCells(complex, smoothed, vertexAt, 8 * spacing, constraints);
+  topospline::AddSaddleOneCells(complex, smoothed, vertexAt, reach, constraints);
   const std::vector<double> before(values->GetPointer(0), values->GetPointer(0) + values->GetNumberOfTuples());
   std::vector<double> sampled = before;
   auto report = topospline::EnforceCriticalVertices(mesh, constraints, sampled);
   // Saddles left a few vertices from their nodes in flat passes are moved onto them.
   displacedSaddles =
-    topospline::RelocateSaddles(sampling, mesh, constraints, spacing * (1 + 1e-9), 8 * spacing, sampled);
+    topospline::RelocateSaddles(sampling, mesh, constraints, spacing * (1 + 1e-9), reach, sampled);
   report.ChangedVertices = 0;
   report.MaximumChange = 0;
   topospline::CountChanges(before, sampled, report);
@@ -331,8 +333,15 @@ int vtkTopoSplineReconstructTwoCells::RequestInformation(
   vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
   vtkInformation* resampledInfo = outputVector->GetInformationObject(2);
   const int f = this->OutputResolution;
+  const bool image = inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()) != 0;
+  if (f > 1 && !image)
+  {
+    // Not an image: the extent is known only once the domain's bounds are.
+    resampledInfo->Remove(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT());
+    return 1;
+  }
   int extent[6] = { 0, -1, 0, -1, 0, -1 };
-  if (f > 1 && inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+  if (f > 1)
   {
     int input[6];
     inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), input);
@@ -342,15 +351,7 @@ int vtkTopoSplineReconstructTwoCells::RequestInformation(
       extent[2 * axis + 1] = std::max(0, input[2 * axis + 1] - input[2 * axis]) * f;
     }
   }
-  if (f > 1 && !inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
-  {
-    // Not an image: the extent is known only once the domain's bounds are.
-    resampledInfo->Remove(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT());
-  }
-  else
-  {
-    resampledInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
-  }
+  resampledInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
   return 1;
 }
 
@@ -773,5 +774,6 @@ void vtkTopoSplineReconstructTwoCells::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "BoundarySamples: " << this->BoundarySamples << "\n"
      << indent << "OutputResolution: " << this->OutputResolution << "\n"
+     << indent << "TopologicalSampling: " << this->TopologicalSampling << "\n"
      << indent << "VerifyTopology: " << this->VerifyTopology << "\n";
 }

@@ -625,20 +625,16 @@ bool MorseSmaleComplexExtraction::Extract(
       {
         std::vector<std::array<Index, 2>> tryPairs;
         std::vector<Index> tryRest;
-        const Index extremum = end == 0 ? groupKey(group[0]).first : groupKey(group[0]).second;
-        const std::vector<Index>& around = arcsOfExtremum[extremum];
         auto arcOf = [&](const Sector& sector) { return end == 0 ? sector.Descending : sector.Ascending; };
         std::vector<unsigned char> used(group.size(), 0);
         for (size_t a = 0; a < group.size(); ++a)
         {
           const Sector& left = sectors[group[a]];
-          const auto at = std::find(around.begin(), around.end(), arcOf(left));
-          if (used[a] || !left.LeftOfDescending || at == around.end())
+          if (used[a] || !left.LeftOfDescending)
           {
             continue;
           }
-          const Index neighbour = end == 0 ? (std::next(at) == around.end() ? around.front() : *std::next(at))
-                                           : (at == around.begin() ? around.back() : *std::prev(at));
+          const Index neighbour = neighbourAround(arcOf(left), end == 0 ? +1 : -1);
           for (size_t b = 0; b < group.size(); ++b)
           {
             const Sector& right = sectors[group[b]];

@@ -1,6 +1,7 @@
 #include "OneCellSmoothing.h"
 
 #include "JunctionValueProgram.h"
+#include "PlanarGeometry.h"
 
 #include <algorithm>
 #include <cmath>
@@ -345,10 +346,8 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
   const double meetingTolerance =
     1e-9 * std::max(domainBounds[1] - domainBounds[0], domainBounds[3] - domainBounds[2]);
   auto passesThrough = [meetingTolerance](const Segment2& s, const double* q) {
-    const double dx = s.B[0] - s.A[0], dy = s.B[1] - s.A[1];
-    const double length2 = dx * dx + dy * dy;
-    const double t = length2 > 0 ? std::clamp(((q[0] - s.A[0]) * dx + (q[1] - s.A[1]) * dy) / length2, 0.0, 1.0) : 0.0;
-    return std::hypot(s.A[0] + t * dx - q[0], s.A[1] + t * dy - q[1]) <= meetingTolerance;
+    double fraction;
+    return std::sqrt(SegmentDistance2(s.A, s.B, q[0], q[1], fraction)) <= meetingTolerance;
   };
   auto endPosition = [&](Index p, bool atEnd) {
     return nodes[atEnd ? result.Pieces[p].EndNode : result.Pieces[p].StartNode].Position;

@@ -1,5 +1,7 @@
 #include "TopologicalSampling.h"
 
+#include "PlanarGeometry.h"
+
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -52,12 +54,12 @@ bool IsExtremum(const Graph& g, const std::vector<double>& values, Index v, bool
 // first vertex that drains outside it (a neighbour before it, not in the region) or that is a
 // wanted extremum of the same kind, is then re-valued from that outlet inwards, every vertex
 // just past the neighbour it was reached from, so that each has a neighbour before it. Values
-// only move in the sweep direction. A vertex marked in `fixed` (if given) ends the region like a
-// wanted one: the region drains into it and it keeps its value. Returns the number of changed
-// vertices.
+// only move in the sweep direction. A boundary vertex of `drainsToBoundary` (if given) ends the
+// region like a wanted one: the region drains into it and it keeps its value. Returns the
+// number of changed vertices.
 Index Fill(const Graph& g, std::vector<double>& values, Index v, bool ascending,
   const std::vector<unsigned char>& wanted, unsigned char flag, std::vector<unsigned>& mark, unsigned& stamp,
-  const std::vector<unsigned char>* fixed = nullptr)
+  const TriangleMeshTopology* drainsToBoundary = nullptr)
 {
   auto before = [ascending](const Key& a, const Key& b) { return ascending ? a < b : b < a; };
   auto later = [&](const Key& a, const Key& b) { return before(b, a); };
@@ -72,7 +74,7 @@ Index Fill(const Graph& g, std::vector<double>& values, Index v, bool ascending,
     const Index u = queue.top().Vertex;
     queue.pop();
     const Key key{ values[u], u };
-    if (u != v && ((wanted[u] & flag) || (fixed && (*fixed)[u])))
+    if (u != v && ((wanted[u] & flag) || (drainsToBoundary && drainsToBoundary->IsBoundaryVertex(u))))
     {
       outlet = u;
       break;
@@ -152,17 +154,16 @@ NearestPoint NearestOnOneCell(const SaddleOneCell& cell, double x, double y)
   double along = 0;
   for (std::size_t i = 0; i + 5 < q.size(); i += 3)
   {
-    const double dx = q[i + 3] - q[i], dy = q[i + 4] - q[i + 1];
-    const double length2 = dx * dx + dy * dy;
-    const double t = length2 > 0 ? std::clamp(((x - q[i]) * dx + (y - q[i + 1]) * dy) / length2, 0.0, 1.0) : 0.0;
-    const double d = std::hypot(q[i] + t * dx - x, q[i + 1] + t * dy - y);
+    double t;
+    const double d = std::sqrt(SegmentDistance2(&q[i], &q[i + 3], x, y, t));
+    const double length = std::hypot(q[i + 3] - q[i], q[i + 4] - q[i + 1]);
     if (d < best.Distance)
     {
       best.Distance = d;
       best.Height = q[i + 2] + t * (q[i + 5] - q[i + 2]);
-      best.Along = along + t * std::sqrt(length2);
+      best.Along = along + t * length;
     }
-    along += std::sqrt(length2);
+    along += length;
   }
   return best;
 }
@@ -177,7 +178,7 @@ NearestPoint NearestOnOneCell(const SaddleOneCell& cell, double x, double y)
 // way up). (Tried and dropped: following the saddle's smoothed ascending 1-cell instead, and
 // keeping the path off wanted saddles or their lower neighbours; the first two left more
 // saddles off their nodes on the climate field, the last broke convergence.)
-Index RaiseWayUp(const Graph& g, const std::vector<unsigned char>& onBoundary, std::vector<double>& values, Index v,
+Index RaiseWayUp(const Graph& g, const TriangleMeshTopology& mesh, std::vector<double>& values, Index v,
   std::vector<unsigned>& mark, unsigned& stamp)
 {
   const Key top{ values[v], v };
@@ -187,7 +188,7 @@ Index RaiseWayUp(const Graph& g, const std::vector<unsigned char>& onBoundary, s
   const unsigned seen = ++stamp;
   mark[v] = seen;
   auto visit = [&](Index w, Index from) {
-    if (mark[w] != seen && !onBoundary[w])
+    if (mark[w] != seen && !mesh.IsBoundaryVertex(w))
     {
       mark[w] = seen;
       parent[w] = from;
@@ -283,11 +284,6 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
       }
     }
   }
-  std::vector<unsigned char> onBoundary(n, 0);
-  for (Index v = 0; v < n; ++v)
-  {
-    onBoundary[v] = boundary.Start[v + 1] > boundary.Start[v];
-  }
   std::vector<unsigned char> wanted(n, 0);
   for (Index v : constraints.Minima)
   {
@@ -329,9 +325,10 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
       // boundary. So here they are skipped and fixed (floods drain into them), except a wanted
       // boundary saddle above its whole link, which gets a way up.
       const bool wholeLink = pass.G == &all;
+      auto getsWayUp = [&](Index v) { return pass.Flag == 2 && (wanted[v] & 8); };
       for (Index v = 0; v < n; ++v)
       {
-        if (!(wanted[v] & pass.Flag) && !(wholeLink && onBoundary[v] && !(pass.Flag == 2 && (wanted[v] & 8))) &&
+        if (!(wanted[v] & pass.Flag) && !(wholeLink && mesh.IsBoundaryVertex(v) && !getsWayUp(v)) &&
           IsExtremum(*pass.G, values, v, pass.Ascending))
         {
           candidates.push_back(v);
@@ -343,17 +340,10 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
         {
           continue;
         }
-        Index c = 0;
-        // A wanted boundary saddle above its whole link gets a way up, not a cut.
-        if (pass.Flag == 2 && (wanted[v] & 8))
-        {
-          c = RaiseWayUp(all, onBoundary, values, v, mark, stamp);
-        }
-        if (c == 0)
-        {
-          c = Fill(*pass.G, values, v, pass.Ascending, wanted, pass.Flag, mark, stamp, wholeLink ? &onBoundary : nullptr);
-        }
-        changed += c;
+        const Index raised = getsWayUp(v) ? RaiseWayUp(all, mesh, values, v, mark, stamp) : 0;
+        changed += raised > 0
+          ? raised
+          : Fill(*pass.G, values, v, pass.Ascending, wanted, pass.Flag, mark, stamp, wholeLink ? &mesh : nullptr);
       }
       if (stamp > std::numeric_limits<unsigned>::max() / 2)
       {
@@ -366,8 +356,8 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
       report.Converged = true;
       break;
     }
-    // The same handful of changes again: a boundary and a whole-link constraint keep undoing
-    // each other by a few ulps; more rounds would only repeat it.
+    // The same number of changes again: pit fills and peak cuts keep undoing each other by a
+    // few ulps (on a plateau); more rounds would only repeat it.
     if (changed == previousChanged)
     {
       break;
@@ -539,6 +529,20 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
     return trialMissing.size() < missing.size() &&
       trialSpare.size() + missing.size() <= spare.size() + trialMissing.size();
   };
+  // Floods `trial` again and keeps it if it is better.
+  auto keepIfBetter = [&](std::vector<double>& trial) {
+    EnforceCriticalVertices(mesh, constraints, trial);
+    std::vector<Index> trialMissing, trialSpare;
+    unmatched(trial, trialMissing, trialSpare);
+    if (!better(trialMissing, trialSpare))
+    {
+      return false;
+    }
+    values = std::move(trial);
+    missing = std::move(trialMissing);
+    spare = std::move(trialSpare);
+    return true;
+  };
   if (!missing.empty() && !constraints.SaddleOneCells.empty())
   {
     std::vector<double> trial = values;
@@ -546,15 +550,7 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
     {
       CarveSaddleOneCells(field, mesh, constraints, w, reach, trial);
     }
-    EnforceCriticalVertices(mesh, constraints, trial);
-    std::vector<Index> trialMissing, trialSpare;
-    unmatched(trial, trialMissing, trialSpare);
-    if (better(trialMissing, trialSpare))
-    {
-      values = std::move(trial);
-      missing = std::move(trialMissing);
-      spare = std::move(trialSpare);
-    }
+    keepIfBetter(trial);
   }
   // Each round costs an extraction of the whole sampling: worth it for the few saddles of a
   // flat pass, not when many are missing (a failed 2-cell keeps the input's own saddles).
@@ -585,20 +581,10 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
                                                       : -std::numeric_limits<double>::infinity());
       moved = true;
     }
-    if (!moved)
+    if (!moved || !keepIfBetter(trial))
     {
       break;
     }
-    EnforceCriticalVertices(mesh, constraints, trial);
-    std::vector<Index> trialMissing, trialSpare;
-    unmatched(trial, trialMissing, trialSpare);
-    if (!better(trialMissing, trialSpare))
-    {
-      break;
-    }
-    values = std::move(trial);
-    missing = std::move(trialMissing);
-    spare = std::move(trialSpare);
   }
   return static_cast<int>(missing.size());
 }
@@ -640,8 +626,6 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
   {
     shortestEdge = std::min(shortestEdge, std::hypot(p[2 * w] - sx, p[2 * w + 1] - sy));
   }
-  auto nearestOn = [](const SaddleOneCell& cell, double x, double y) { return NearestOnOneCell(cell, x, y); };
-  using Nearest = NearestPoint;
   // The direction in which each 1-cell leaves the saddle, seen at the scale of the link.
   auto angleOf = [&](double x, double y) { return std::atan2(y - sy, x - sx); };
   std::vector<double> cellAngle;
@@ -681,7 +665,7 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
   // never take one.
   const double infinity = std::numeric_limits<double>::infinity();
   auto onTheirWay = [&](const SaddleOneCell& cell, Index w) {
-    return !mesh.IsBoundaryVertex(w) || nearestOn(cell, p[2 * w], p[2 * w + 1]).Distance <= 0.25 * shortestEdge;
+    return !mesh.IsBoundaryVertex(w) || NearestOnOneCell(cell, p[2 * w], p[2 * w + 1]).Distance <= 0.25 * shortestEdge;
   };
   std::vector<Index> vertexOfCell(m, InvalidIndex);
   double bestCost = infinity;
@@ -724,10 +708,6 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
   // the saddle: each next vertex the neighbour nearest to the 1-cell further along it, among
   // those no 1-cell of the other kind passes nearer; the chain ends where the values already
   // rise (fall) on their own, or at `radius`.
-  if (!std::isfinite(bestCost))
-  {
-    return 0;
-  }
   const double level = values[saddle];
   std::vector<Index> taken = { saddle };
   for (Index v : vertexOfCell)
@@ -735,19 +715,12 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
     taken.push_back(v);
   }
   Index changed = 0;
-  auto set = [&](Index v, double value) {
-    if (values[v] != value)
-    {
-      values[v] = value;
-      ++changed;
-    }
-  };
   for (std::size_t c = 0; c < m; ++c)
   {
     const SaddleOneCell& cell = *cells[c];
     const bool up = cell.Ascending;
     Index current = vertexOfCell[c];
-    Nearest at = nearestOn(cell, p[2 * current], p[2 * current + 1]);
+    NearestPoint at = NearestOnOneCell(cell, p[2 * current], p[2 * current + 1]);
     double previous = level;
     for (int step = 0; current != InvalidIndex; ++step)
     {
@@ -759,11 +732,12 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
       }
       if (up ? values[current] < wanted : values[current] > wanted)
       {
-        set(current, wanted);
+        values[current] = wanted;
+        ++changed;
       }
       previous = values[current];
       Index next = InvalidIndex;
-      Nearest nextAt;
+      NearestPoint nextAt;
       for (Index w : neighbours(current))
       {
         if (std::find(taken.begin(), taken.end(), w) != taken.end() ||
@@ -771,7 +745,7 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
         {
           continue;
         }
-        const Nearest candidate = nearestOn(cell, p[2 * w], p[2 * w + 1]);
+        const NearestPoint candidate = NearestOnOneCell(cell, p[2 * w], p[2 * w + 1]);
         if (candidate.Along <= at.Along || candidate.Distance >= nextAt.Distance)
         {
           continue;
@@ -780,7 +754,7 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
         for (const SaddleOneCell* other : cells)
         {
           otherKindNearer = otherKindNearer ||
-            (other->Ascending != up && nearestOn(*other, p[2 * w], p[2 * w + 1]).Distance < candidate.Distance);
+            (other->Ascending != up && NearestOnOneCell(*other, p[2 * w], p[2 * w + 1]).Distance < candidate.Distance);
         }
         if (!otherKindNearer)
         {

@@ -70,10 +70,10 @@ void AddSaddleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingR
 void CountChanges(const std::vector<double>& before, const std::vector<double>& after,
   TopologicalSamplingReport& report);
 
-// Modifies `values` (one per mesh vertex) in place. The alternation usually settles in one or
-// two rounds; where a boundary constraint and the whole-link ones disagree about a vertex it
-// can go on moving values by a few ulps per round, so it stops after `maximumRounds`
-// (Converged is then false, and a few spurious pairs may remain).
+// Modifies `values` (one per mesh vertex) in place. The alternation usually settles in a few
+// rounds; on a plateau pit fills and peak cuts can go on moving values by a few ulps per
+// round, so it stops after `maximumRounds` or when a round changes as many vertices as the one
+// before (Converged is then false, and a few spurious pairs may remain).
 TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds = 6);
 // After EnforceCriticalVertices the extrema are the wanted ones, but a saddle can sit a few

@@ -1,5 +1,7 @@
 #include "TwoCellParameterization.h"
 
+#include "PlanarGeometry.h"
+
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Delaunay_mesh_face_base_2.h>
 #include <CGAL/Delaunay_mesh_size_criteria_2.h>
@@ -922,9 +924,8 @@ namespace
 {
 double DistanceToSegment(double x, double y, const double* a, const double* b)
 {
-  const double dx = b[0] - a[0], dy = b[1] - a[1];
-  const double t = std::max(0.0, std::min(1.0, ((x - a[0]) * dx + (y - a[1]) * dy) / (dx * dx + dy * dy)));
-  return std::hypot(x - a[0] - t * dx, y - a[1] - t * dy);
+  double fraction;
+  return std::sqrt(SegmentDistance2(a, b, x, y, fraction));
 }
 
 // For a point outside the triangle.

@@ -1,5 +1,7 @@
 #include "TwoCellReconstruction.h"
 
+#include "PlanarGeometry.h"
+
 #include <Eigen/Dense>
 
 #include <algorithm>
@@ -167,15 +169,6 @@ const Eigen::Matrix<double, 10, 10>& LatticeToControl()
   return inverse;
 }
 
-// Closest point of segment ab to p: returns the squared distance and the fraction along ab.
-double SegmentDistance2(const double* a, const double* b, double x, double y, double& fraction)
-{
-  const double dx = b[0] - a[0], dy = b[1] - a[1];
-  const double length2 = dx * dx + dy * dy;
-  fraction = length2 > 0 ? std::clamp(((x - a[0]) * dx + (y - a[1]) * dy) / length2, 0.0, 1.0) : 0.0;
-  const double ex = a[0] + fraction * dx - x, ey = a[1] + fraction * dy - y;
-  return ex * ex + ey * ey;
-}
 } // namespace
 
 bool AssembleTwoCellSides(const TwoCell& cell, const OneCellSmoothingResult& smoothed, TwoCellSides& sides,

@@ -251,9 +251,10 @@ void CheckReconstruction(const char* name, const GridField& grid, double percent
     SamplingConstraints constraints = ComplexConstraints(p.Simplified.Complex, inputMesh, mesh, vertexAt);
     // The smoothed 1-cells guide the way up from boundary saddles and carve back saddles that
     // slid a few vertices along a flat pass or the domain boundary.
-    AddSaddleOneCells(p.Simplified.Complex, p.Smoothed, vertexAt, 8 * spacing, constraints);
+    const double reach = 8 * spacing;
+    AddSaddleOneCells(p.Simplified.Complex, p.Smoothed, vertexAt, reach, constraints);
     const auto repair = EnforceCriticalVertices(mesh, constraints, sampled.Values);
-    const int unmatched = RelocateSaddles(sampled, mesh, constraints, spacing, 8 * spacing, sampled.Values);
+    const int unmatched = RelocateSaddles(sampled, mesh, constraints, spacing, reach, sampled.Values);
     MorseSmaleComplex repaired;
     CHECK(extraction.Extract(sampled, repaired, error));
     const auto after = CompareCriticalPoints(expected, CriticalPointLocations(repaired, sampled.Points), spacing);
