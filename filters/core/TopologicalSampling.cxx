@@ -616,7 +616,10 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
     }
   }
   const std::vector<Index> link = neighbours(saddle);
-  if (cells.empty() || link.size() < cells.size())
+  // The assignment below tries every subset of the link: a handful of vertices on grids, but
+  // an unstructured mesh can have vertices of very high valence; those are left as they are.
+  constexpr std::size_t maximumLinkSize = 16;
+  if (cells.empty() || link.size() < cells.size() || link.size() > maximumLinkSize)
   {
     return 0;
   }
