@@ -236,6 +236,7 @@ TopologyCheck CheckTopology(vtkDataSet* sampling, vtkDataArray* values,
   topospline::PlanarScalarField field;
   topospline::MorseSmaleComplexExtraction extraction;
   extraction.Parallel = conversion::SMPParallelFor();
+  extraction.CriticalPointsOnly = true;
   topospline::MorseSmaleComplex found;
   if (!conversion::ToPlanarScalarField(sampling, values, field, check.Error) ||
     !extraction.Extract(field, found, check.Error))
@@ -269,19 +270,9 @@ topospline::TopologicalSamplingReport EnforceComplexTopology(const topospline::M
   const topospline::PlanarScalarField& sampling, const topospline::TriangleMeshTopology& mesh,
   const std::function<Index(Index)>& vertexAt, double spacing, vtkDoubleArray* values, int& displacedSaddles)
 {
-  // How far from its node a saddle is looked for and carved back.
-  const double reach = 8 * spacing;
-  auto constraints = topospline::ComplexConstraints(complex, domainMesh, mesh, vertexAt);
-  topospline::AddSaddleOneCells(complex, smoothed, vertexAt, reach, constraints);
-  const std::vector<double> before(values->GetPointer(0), values->GetPointer(0) + values->GetNumberOfTuples());
-  std::vector<double> sampled = before;
-  auto report = topospline::EnforceCriticalVertices(mesh, constraints, sampled);
-  // Saddles left a few vertices from their nodes in flat passes are moved onto them.
-  displacedSaddles =
-    topospline::RelocateSaddles(sampling, mesh, constraints, spacing * (1 + 1e-9), reach, sampled);
-  report.ChangedVertices = 0;
-  report.MaximumChange = 0;
-  topospline::CountChanges(before, sampled, report);
+  std::vector<double> sampled(values->GetPointer(0), values->GetPointer(0) + values->GetNumberOfTuples());
+  const auto report = topospline::SampleTopologically(
+    complex, domainMesh, smoothed, sampling, mesh, vertexAt, spacing, sampled, displacedSaddles);
   std::copy(sampled.begin(), sampled.end(), values->GetPointer(0));
   return report;
 }

@@ -138,7 +138,7 @@ bool MorseSmaleComplexExtraction::Extract(
 {
   complex = MorseSmaleComplex();
   const Index nV = static_cast<Index>(field.Values.size());
-  if (nV == 0 || (field.Triangles.empty() && !field.IsGrid()))
+  if (nV == 0 || (field.Triangles.empty() && !field.IsGrid() && !this->GivenMesh))
   {
     error = "the input has no triangles";
     return false;
@@ -148,7 +148,7 @@ bool MorseSmaleComplexExtraction::Extract(
     error = "the grid dimensions do not match the number of values";
     return false;
   }
-  if (field.Points.size() != 2 * field.Values.size())
+  if (field.Points.size() != 2 * field.Values.size() && !(this->CriticalPointsOnly && field.Points.empty()))
   {
     error = "expected one scalar value per point";
     return false;
@@ -161,7 +161,15 @@ bool MorseSmaleComplexExtraction::Extract(
       return false;
     }
   }
-  if (field.IsGrid())
+  if (this->GivenMesh)
+  {
+    if (this->GivenMesh->NumberOfVertices() != nV)
+    {
+      error = "the given mesh does not match the field";
+      return false;
+    }
+  }
+  else if (field.IsGrid())
   {
     this->Mesh.BuildGrid(field.GridDimensions[0], field.GridDimensions[1], this->Parallel);
   }
@@ -169,15 +177,15 @@ bool MorseSmaleComplexExtraction::Extract(
   {
     return false;
   }
+  const TriangleMeshTopology& mesh = this->GivenMesh ? *this->GivenMesh : this->Mesh;
   for (Index v = 0; v < nV; ++v)
   {
-    if (this->Mesh.VertexTriangleBegin(v) == this->Mesh.VertexTriangleEnd(v))
+    if (mesh.VertexTriangleBegin(v) == mesh.VertexTriangleEnd(v))
     {
       error = "point " + std::to_string(v) + " is not used by any triangle";
       return false;
     }
   }
-  const TriangleMeshTopology& mesh = this->Mesh;
   this->Hooks.Report(0.2);
   if (this->Hooks.Aborted())
   {
@@ -228,6 +236,15 @@ bool MorseSmaleComplexExtraction::Extract(
     }
     return a.Vertex != b.Vertex ? a.Vertex < b.Vertex : a.Cell < b.Cell;
   });
+  if (this->CriticalPointsOnly)
+  {
+    for (Index id = 0; id < static_cast<Index>(cps.size()); ++id)
+    {
+      cps[id].Id = id;
+    }
+    this->Hooks.Report(1.0);
+    return true;
+  }
   std::vector<Index> minimumOfVertex(nV, InvalidIndex);
   std::vector<Index> maximumOfTriangle(mesh.NumberOfTriangles(), InvalidIndex);
   std::vector<Index> saddles;

@@ -86,6 +86,14 @@ public:
 
   ParallelFor Parallel = SequentialFor;
   ProgressHooks Hooks;
+  // Only the critical points (no 1-cells, 2-cells or manifolds): what a topology check needs,
+  // in a fraction of the memory (samplings of tens of millions of vertices). field.Points may
+  // then be empty.
+  bool CriticalPointsOnly = false;
+  // The field's mesh, if the caller has it already (it must be the mesh of field.Triangles or
+  // of the grid, which may then be left empty); otherwise Mesh is built. Saves a second copy
+  // of the largest structure.
+  const TriangleMeshTopology* GivenMesh = nullptr;
 
   // Sorts `arcs`, 1-cells of `extremum` (descending ones for a minimum, ascending ones for a
   // maximum), counter-clockwise around it. `saddleEnds` holds, per 1-cell, the point (x, y)

@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <numeric>
 #include <queue>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace topospline
 {
@@ -56,10 +58,10 @@ bool IsExtremum(const Graph& g, const std::vector<double>& values, Index v, bool
 // just past the neighbour it was reached from, so that each has a neighbour before it. Values
 // only move in the sweep direction. A boundary vertex of `drainsToBoundary` (if given) ends the
 // region like a wanted one: the region drains into it and it keeps its value. Returns the
-// number of changed vertices.
+// number of changed vertices (and appends them to `revalued`, if given).
 Index Fill(const Graph& g, std::vector<double>& values, Index v, bool ascending,
   const std::vector<unsigned char>& wanted, unsigned char flag, std::vector<unsigned>& mark, unsigned& stamp,
-  const TriangleMeshTopology* drainsToBoundary = nullptr)
+  const TriangleMeshTopology* drainsToBoundary = nullptr, std::vector<Index>* revalued = nullptr)
 {
   auto before = [ascending](const Key& a, const Key& b) { return ascending ? a < b : b < a; };
   auto later = [&](const Key& a, const Key& b) { return before(b, a); };
@@ -107,36 +109,76 @@ Index Fill(const Graph& g, std::vector<double>& values, Index v, bool ascending,
   {
     return 0; // the whole component: nothing to drain into
   }
-  // From the outlet inwards (breadth first over the region).
+  // From the outlet inwards, each region vertex gets the first key after the region neighbour
+  // it is reached from, in the sweep order: that neighbour's value if the vertex id already
+  // orders it after (ties go by id), else one ulp past it. Taking vertices nearest the outlet
+  // first in that order (Dijkstra) gives every vertex the least such key. Stepping an ulp at
+  // every vertex instead lifted a filled pit above a plateau it lies in (every region vertex
+  // past all the plateau vertices around it): a peak, which the cut made a pit again, round
+  // after round.
   const unsigned inRegion = ++stamp;
   for (Index r : region)
   {
     mark[r] = inRegion;
   }
   const double direction = ascending ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
-  std::vector<Index> front = { outlet };
+  auto firstAfter = [&](Index p, Index r) {
+    const double value = values[p];
+    return before({ value, p }, { value, r }) ? Key{ value, r } : Key{ std::nextafter(value, direction), r };
+  };
+  std::priority_queue<Key, std::vector<Key>, decltype(later)> front(later);
+  front.push({ values[outlet], outlet });
+  const unsigned done = ++stamp;
   Index changed = 0;
-  for (std::size_t k = 0; k < front.size(); ++k)
+  while (!front.empty())
   {
-    const Index p = front[k];
+    const Key k = front.top();
+    front.pop();
+    const Index p = k.Vertex;
+    if (p != outlet)
+    {
+      if (mark[p] != inRegion)
+      {
+        continue; // already placed from a nearer neighbour
+      }
+      mark[p] = done;
+      if (values[p] != k.Value)
+      {
+        values[p] = k.Value;
+        ++changed;
+        if (revalued)
+        {
+          revalued->push_back(p);
+        }
+      }
+    }
     for (Index i = g.Start[p]; i < g.Start[p + 1]; ++i)
     {
       const Index r = g.Adjacent[i];
-      if (mark[r] != inRegion)
+      if (mark[r] == inRegion)
       {
-        continue;
+        front.push(firstAfter(p, r));
       }
-      mark[r] = 0;
-      const double past = std::nextafter(values[p], direction);
-      if (ascending ? values[r] < past : values[r] > past)
-      {
-        values[r] = past;
-        ++changed;
-      }
-      front.push_back(r);
     }
   }
   return changed;
+}
+
+// The vertices sharing a triangle with u.
+std::vector<Index> LinkOf(const TriangleMeshTopology& mesh, Index u)
+{
+  std::vector<Index> list;
+  for (Index i = mesh.VertexTriangleBegin(u); i < mesh.VertexTriangleEnd(u); ++i)
+  {
+    for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
+    {
+      if (w != u && std::find(list.begin(), list.end(), w) == list.end())
+      {
+        list.push_back(w);
+      }
+    }
+  }
+  return list;
 }
 
 // The distance from (x, y) to a smoothed 1-cell, with its height and arc length there.
@@ -184,17 +226,23 @@ Index RaiseWayUp(const Graph& g, const TriangleMeshTopology& mesh, std::vector<d
   const Key top{ values[v], v };
   auto lower = [](const Key& a, const Key& b) { return a < b; };
   std::priority_queue<Key, std::vector<Key>, decltype(lower)> queue(lower); // highest first
-  std::unordered_map<Index, Index> parent;
+  std::unordered_map<Index, Index> parent, depth;
   const unsigned seen = ++stamp;
   mark[v] = seen;
+  depth[v] = 0;
   auto visit = [&](Index w, Index from) {
     if (mark[w] != seen && !mesh.IsBoundaryVertex(w))
     {
       mark[w] = seen;
       parent[w] = from;
+      depth[w] = depth[from] + 1;
       queue.push({ values[w], w });
     }
   };
+  // The path rises by at least an ulp per vertex and must stay below the vertex above its end
+  // (else its end is a peak, which the cut lowers, and the way up is raised again, without
+  // end): that vertex must lie above the saddle by more than the path's length in ulps.
+  const double ulp = std::nextafter(values[v], std::numeric_limits<double>::infinity()) - values[v];
   for (Index i = g.Start[v]; i < g.Start[v + 1]; ++i)
   {
     visit(g.Adjacent[i], v);
@@ -207,7 +255,7 @@ Index RaiseWayUp(const Graph& g, const TriangleMeshTopology& mesh, std::vector<d
     for (Index i = g.Start[u]; i < g.Start[u + 1] && end == InvalidIndex; ++i)
     {
       const Index w = g.Adjacent[i];
-      if (top < Key{ values[w], w })
+      if (top < Key{ values[w], w } && values[w] - values[v] > 2 * static_cast<double>(depth[u] + 1) * ulp)
       {
         end = u;
         above = w;
@@ -326,24 +374,50 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
       // boundary saddle above its whole link, which gets a way up.
       const bool wholeLink = pass.G == &all;
       auto getsWayUp = [&](Index v) { return pass.Flag == 2 && (wanted[v] & 8); };
-      for (Index v = 0; v < n; ++v)
+      auto isCandidate = [&](Index v) {
+        return !(wanted[v] & pass.Flag) && !(wholeLink && mesh.IsBoundaryVertex(v) && !getsWayUp(v)) &&
+          IsExtremum(*pass.G, values, v, pass.Ascending);
+      };
+      for (Index v = n - 1; v >= 0; --v) // taken from the back: in vertex order
       {
-        if (!(wanted[v] & pass.Flag) && !(wholeLink && mesh.IsBoundaryVertex(v) && !getsWayUp(v)) &&
-          IsExtremum(*pass.G, values, v, pass.Ascending))
+        if (isCandidate(v))
         {
           candidates.push_back(v);
         }
       }
-      for (Index v : candidates)
+      // A fill can leave a vertex next to its region with no lower neighbour (a cut, no
+      // higher one) where values differ by a few ulps (a nearly flat patch): such vertices are
+      // taken in the same pass, not a round later, so that a pit chain along an ulp-level
+      // valley drains in one pass instead of creeping up by a few ulps per round.
+      // Bounded, in case a fill and a way up undo each other vertex by vertex.
+      std::vector<Index> revalued;
+      std::size_t fills = 0;
+      const std::size_t maximumFills = 4 * candidates.size() + 4096;
+      while (!candidates.empty() && fills < maximumFills)
       {
+        const Index v = candidates.back();
+        candidates.pop_back();
         if (!IsExtremum(*pass.G, values, v, pass.Ascending))
         {
           continue;
         }
+        ++fills;
         const Index raised = getsWayUp(v) ? RaiseWayUp(all, mesh, values, v, mark, stamp) : 0;
-        changed += raised > 0
-          ? raised
-          : Fill(*pass.G, values, v, pass.Ascending, wanted, pass.Flag, mark, stamp, wholeLink ? &mesh : nullptr);
+        revalued.clear();
+        changed += raised > 0 ? raised
+                              : Fill(*pass.G, values, v, pass.Ascending, wanted, pass.Flag, mark, stamp,
+                                  wholeLink ? &mesh : nullptr, &revalued);
+        for (Index r : revalued)
+        {
+          for (Index i = pass.G->Start[r]; i < pass.G->Start[r + 1]; ++i)
+          {
+            const Index w = pass.G->Adjacent[i];
+            if (isCandidate(w))
+            {
+              candidates.push_back(w);
+            }
+          }
+        }
       }
       if (stamp > std::numeric_limits<unsigned>::max() / 2)
       {
@@ -405,9 +479,14 @@ SamplingConstraints ComplexConstraints(const MorseSmaleComplex& complex, const T
   return constraints;
 }
 
-void AddSaddleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
-  const std::function<Index(Index)>& vertexAt, double radius, SamplingConstraints& constraints)
+namespace
 {
+// The smoothed 1-cells of the complex, each sampled from its saddle out to `radius`, at
+// least 16 points per cubic segment and at most `step` apart.
+std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
+  const std::function<Index(Index)>& vertexAt, double radius, double step)
+{
+  std::vector<SaddleOneCell> cells;
   constexpr int samplesPerSegment = 16;
   for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()) &&
        a < static_cast<Index>(smoothed.PiecesOfSeparatrix.size());
@@ -433,7 +512,18 @@ void AddSaddleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingR
     for (std::size_t k = 0; k < pieces.size() && !outside; ++k)
     {
       const SmoothedPiece& piece = smoothed.Pieces[pieces[k]];
-      const int count = std::max(1, piece.Segments) * samplesPerSegment;
+      int count = std::max(1, piece.Segments) * samplesPerSegment;
+      if (std::isfinite(step))
+      {
+        double length = 0, previous[2], xy[2];
+        piece.Curve.Evaluate(0, previous);
+        for (int s = 1; s <= count; ++s, previous[0] = xy[0], previous[1] = xy[1])
+        {
+          piece.Curve.Evaluate(static_cast<double>(s) / count, xy);
+          length += std::hypot(xy[0] - previous[0], xy[1] - previous[1]);
+        }
+        count = std::max(count, static_cast<int>(std::ceil(length / step)));
+      }
       for (int s = (k == 0 ? 0 : 1); s <= count && !outside; ++s)
       {
         const double t = ascending ? static_cast<double>(s) / count : 1 - static_cast<double>(s) / count;
@@ -445,9 +535,46 @@ void AddSaddleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingR
     }
     if (cell.Points.size() >= 6)
     {
-      constraints.SaddleOneCells.push_back(std::move(cell));
+      cells.push_back(std::move(cell));
     }
   }
+  return cells;
+}
+} // namespace
+
+void AddSaddleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
+  const std::function<Index(Index)>& vertexAt, double radius, SamplingConstraints& constraints)
+{
+  std::vector<SaddleOneCell> cells =
+    SampleOneCells(complex, smoothed, vertexAt, radius, std::numeric_limits<double>::infinity());
+  std::move(cells.begin(), cells.end(), std::back_inserter(constraints.SaddleOneCells));
+}
+
+void AddOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
+  const std::function<Index(Index)>& vertexAt, double step, SamplingConstraints& constraints)
+{
+  std::vector<SaddleOneCell> cells =
+    SampleOneCells(complex, smoothed, vertexAt, std::numeric_limits<double>::infinity(), step);
+  std::move(cells.begin(), cells.end(), std::back_inserter(constraints.OneCells));
+}
+
+TopologicalSamplingReport SampleTopologically(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
+  const OneCellSmoothingResult& smoothed, const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
+  const std::function<Index(Index)>& vertexAt, double spacing, std::vector<double>& values, int& displacedSaddles)
+{
+  // How far from its node a saddle is looked for and carved back.
+  const double reach = 8 * spacing;
+  SamplingConstraints constraints = ComplexConstraints(complex, complexMesh, mesh, vertexAt);
+  AddSaddleOneCells(complex, smoothed, vertexAt, reach, constraints);
+  AddOneCells(complex, smoothed, vertexAt, 0.25 * spacing, constraints);
+  const std::vector<double> before = values;
+  CarveOneCells(sampling, mesh, constraints, spacing, values);
+  TopologicalSamplingReport report = EnforceCriticalVertices(mesh, constraints, values);
+  displacedSaddles = RelocateSaddles(sampling, mesh, constraints, spacing * (1 + 1e-9), reach, values);
+  report.ChangedVertices = 0;
+  report.MaximumChange = 0;
+  CountChanges(before, values, report);
+  return report;
 }
 
 void CountChanges(const std::vector<double>& before, const std::vector<double>& after,
@@ -468,13 +595,16 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
   int maximumRounds, int maximumMissing)
 {
   const std::vector<Index>& wantedSaddles = constraints.Saddles;
-  PlanarScalarField sampled = field;
+  // Values only: the extraction reads neither positions nor triangles (it is given the mesh).
+  PlanarScalarField sampled;
   const auto& p = field.Points;
   auto distance = [&p](Index a, Index b) { return std::hypot(p[2 * a] - p[2 * b], p[2 * a + 1] - p[2 * b + 1]); };
   // Unmatched wanted saddles and the found saddles no wanted one claims, for `current`.
   auto unmatched = [&](const std::vector<double>& current, std::vector<Index>& missing, std::vector<Index>& spare) {
     sampled.Values = current;
     MorseSmaleComplexExtraction extraction;
+    extraction.CriticalPointsOnly = true;
+    extraction.GivenMesh = &mesh;
     MorseSmaleComplex found;
     std::string error;
     missing.clear();
@@ -593,20 +723,7 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
   const SamplingConstraints& constraints, Index saddle, double radius, std::vector<double>& values)
 {
   const auto& p = field.Points;
-  auto neighbours = [&mesh](Index u) {
-    std::vector<Index> list;
-    for (Index i = mesh.VertexTriangleBegin(u); i < mesh.VertexTriangleEnd(u); ++i)
-    {
-      for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
-      {
-        if (w != u && std::find(list.begin(), list.end(), w) == list.end())
-        {
-          list.push_back(w);
-        }
-      }
-    }
-    return list;
-  };
+  auto neighbours = [&mesh](Index u) { return LinkOf(mesh, u); };
   std::vector<const SaddleOneCell*> cells;
   for (const SaddleOneCell& cell : constraints.SaddleOneCells)
   {
@@ -771,6 +888,90 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
       }
       current = next;
       at = nextAt;
+    }
+  }
+  return changed;
+}
+
+Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, double spacing, std::vector<double>& values)
+{
+  const auto& p = field.Points;
+  const double infinity = std::numeric_limits<double>::infinity();
+  auto distanceTo = [&p](Index v, const double* q) { return std::hypot(p[2 * v] - q[0], p[2 * v + 1] - q[1]); };
+  // What the ridges ask of a vertex (the highest value) and what the valleys ask (the lowest).
+  std::unordered_map<Index, double> raiseTo, lowerTo;
+  // The critical points themselves keep their values: a 1-cell passing next to another one's
+  // node must not lift a wanted minimum out of its pit.
+  std::unordered_set<Index> critical;
+  for (const std::vector<Index>* kind : { &constraints.Minima, &constraints.Maxima, &constraints.Saddles })
+  {
+    critical.insert(kind->begin(), kind->end());
+  }
+  for (const SaddleOneCell& cell : constraints.OneCells)
+  {
+    const std::vector<double>& q = cell.Points;
+    const bool up = cell.Ascending;
+    const double* start = &q[0];
+    const double* end = &q[q.size() - 3];
+    Index current = cell.Saddle;
+    double previous = values[cell.Saddle];
+    for (std::size_t i = 0; i + 2 < q.size(); i += 3)
+    {
+      // Walk towards the curve point, vertex by vertex, while a neighbour is nearer to it.
+      for (;;)
+      {
+        Index nearest = current;
+        double nearestDistance = distanceTo(current, &q[i]);
+        for (Index w : LinkOf(mesh, current))
+        {
+          // A ridge close along the domain boundary walks on the first row inside (the
+          // boundary curve runs lower: it is a valley there, which the boundary passes keep).
+          const double d = distanceTo(w, &q[i]);
+          if (d < nearestDistance && (!up || !mesh.IsBoundaryVertex(w) || d <= 0.25 * spacing))
+          {
+            nearest = w;
+            nearestDistance = d;
+          }
+        }
+        if (nearest == current)
+        {
+          break;
+        }
+        current = nearest;
+        if (distanceTo(current, start) <= spacing || distanceTo(current, end) <= spacing ||
+          mesh.IsBoundaryVertex(current) || critical.count(current))
+        {
+          continue;
+        }
+        const double height = q[i + 2];
+        const double wanted =
+          up ? std::max(height, std::nextafter(previous, infinity)) : std::min(height, std::nextafter(previous, -infinity));
+        auto& asked = up ? raiseTo : lowerTo;
+        auto found = asked.find(current);
+        if (found == asked.end())
+        {
+          asked.emplace(current, wanted);
+        }
+        else
+        {
+          found->second = up ? std::max(found->second, wanted) : std::min(found->second, wanted);
+        }
+        previous = up ? std::max(wanted, values[current]) : std::min(wanted, values[current]);
+      }
+    }
+  }
+  Index changed = 0;
+  for (const auto& asked : { &raiseTo, &lowerTo })
+  {
+    const bool up = asked == &raiseTo;
+    for (const auto& [v, value] : *asked)
+    {
+      if ((up ? lowerTo : raiseTo).count(v) == 0 && (up ? values[v] < value : values[v] > value))
+      {
+        values[v] = value;
+        ++changed;
+      }
     }
   }
   return changed;

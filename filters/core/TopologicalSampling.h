@@ -12,6 +12,10 @@
 // boundary cells) makes the extrema of the field along the boundary curve critical too, so
 // the same sweeps first run along the boundary curve, from the wanted boundary minima and
 // boundary saddles. Ties are ordered as stage 1 orders them: by value, then vertex id.
+// Before the floods, the complex's smoothed 1-cells are carved into the sampling
+// (CarveOneCells), so that a ridge or valley running between two rows of vertices is not cut
+// into islands; after them, saddles left off their nodes are moved back (RelocateSaddles).
+// SampleTopologically runs the whole sequence.
 #pragma once
 
 #include "CoreTypes.h"
@@ -52,6 +56,8 @@ struct SamplingConstraints
   // Optional, for RelocateSaddles: the smoothed 1-cells of the wanted saddles
   // (AddSaddleOneCells).
   std::vector<SaddleOneCell> SaddleOneCells;
+  // Optional, for CarveOneCells: every smoothed 1-cell of the complex, whole (AddOneCells).
+  std::vector<SaddleOneCell> OneCells;
 };
 
 
@@ -66,14 +72,45 @@ SamplingConstraints ComplexConstraints(const MorseSmaleComplex& complex, const T
 void AddSaddleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
   const std::function<Index(Index)>& vertexAt, double radius, SamplingConstraints& constraints);
 
+// Adds to constraints.OneCells every smoothed 1-cell of the complex, from its saddle to its
+// extremum, sampled at most `step` apart (a fraction of the grid spacing, so that a walk along
+// the samples follows the curve).
+void AddOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
+  const std::function<Index(Index)>& vertexAt, double step, SamplingConstraints& constraints);
+
+// Embeds the complex's 1-cells (constraints.OneCells) in the sampling before the floods. A
+// 1-cell is a crease of F o Phi (a ridge for an ascending one, a valley for a descending one)
+// that can run between two rows of vertices, where no vertex sees it: along a narrow ridge
+// every vertex lies on its flanks, the sampled ridge breaks into islands, and the floods
+// then cut them and route the 1-cell through the nearest pass, which may be another saddle.
+// Each 1-cell gets a chain of vertices walking along it (each the vertex nearest to the
+// curve), raised to the 1-cell's height for an ascending one (lowered for a descending one)
+// and strictly monotone from the saddle on. Vertices within `spacing` of the 1-cell's saddle
+// or extremum are left to the floods and to CarveSaddleOneCells; so are vertices that a
+// ridge and a valley both claim, and boundary vertices the 1-cell does not run through.
+// Returns the number of changed vertices.
+Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, double spacing, std::vector<double>& values);
+
+// The whole topological sampling of a reconstruction sampled at the vertices of `mesh`
+// (`sampling` holds their positions): the complex's critical points as constraints (placed by
+// `vertexAt`, as for ComplexConstraints), its smoothed 1-cells carved in (CarveOneCells), the
+// floods (EnforceCriticalVertices) and the saddles moved back onto their nodes
+// (RelocateSaddles, within `spacing`, looked for within 8 spacings). `values` holds the samples
+// and is modified in place; `displacedSaddles` receives the number of saddles left off their
+// nodes. The report counts every changed vertex.
+TopologicalSamplingReport SampleTopologically(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
+  const OneCellSmoothingResult& smoothed, const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
+  const std::function<Index(Index)>& vertexAt, double spacing, std::vector<double>& values, int& displacedSaddles);
+
 // Adds to `report` how many of `after` differ from `before`, and by how much at most.
 void CountChanges(const std::vector<double>& before, const std::vector<double>& after,
   TopologicalSamplingReport& report);
 
-// Modifies `values` (one per mesh vertex) in place. The alternation usually settles in a few
-// rounds; on a plateau pit fills and peak cuts can go on moving values by a few ulps per
-// round, so it stops after `maximumRounds` or when a round changes as many vertices as the one
-// before (Converged is then false, and a few spurious pairs may remain).
+// Modifies `values` (one per mesh vertex) in place. The alternation settles in a few rounds;
+// as a safeguard it stops after `maximumRounds` or when a round
+// changes as many vertices as the one before (Converged is then false, and a few spurious
+// pairs may remain).
 TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds = 6);
 // After EnforceCriticalVertices the extrema are the wanted ones, but a saddle can sit a few

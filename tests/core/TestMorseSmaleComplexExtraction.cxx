@@ -187,6 +187,38 @@ TEST_CASE(SequentialAndThreadedAgree)
   CHECK(samePaths);
 }
 
+TEST_CASE(CriticalPointsOnlyWithAGivenMesh)
+{
+  // The topology checks of large samplings extract only the critical points, from the values
+  // alone on the mesh the caller already has: the same critical points as the full
+  // extraction, and no 1-cells.
+  for (int seed : { 3, 8 })
+  {
+    const auto field = FieldFromGrid(ShepardField(60, 2, 300, seed));
+    const auto full = Extract(field);
+    std::string error;
+    TriangleMeshTopology mesh;
+    CHECK(mesh.Build(static_cast<Index>(field.Values.size()), field.Triangles, SequentialFor, error));
+    MorseSmaleComplexExtraction extraction;
+    extraction.CriticalPointsOnly = true;
+    extraction.GivenMesh = &mesh;
+    MorseSmaleComplex only;
+    PlanarScalarField valuesOnly; // no positions, no triangles: the mesh is given
+    valuesOnly.Values = field.Values;
+    CHECK(extraction.Extract(valuesOnly, only, error));
+    CHECK_EQ(only.CriticalPoints.size(), full.CriticalPoints.size());
+    bool same = only.CriticalPoints.size() == full.CriticalPoints.size();
+    for (std::size_t i = 0; same && i < only.CriticalPoints.size(); ++i)
+    {
+      const CriticalPoint &a = only.CriticalPoints[i], &b = full.CriticalPoints[i];
+      same = a.Id == b.Id && a.MorseIndex == b.MorseIndex && a.Vertex == b.Vertex && a.Cell == b.Cell && a.Value == b.Value;
+    }
+    CHECK(same);
+    CHECK(only.Separatrices.empty());
+    CHECK_EQ(extraction.Mesh.NumberOfVertices(), 0); // the given mesh was used, none built
+  }
+}
+
 TEST_CASE(GridTopologyEqualsGeneralBuild)
 {
   // The closed-form grid topology must number everything exactly as the general builder does

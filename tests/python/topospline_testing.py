@@ -30,6 +30,11 @@ def catalog():
         return json.load(f)["datasets"]
 
 
+def physical_memory():
+    """Bytes of physical memory of this machine."""
+    return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+
+
 def find_dataset(filename):
     """A data set shipped in tests/data, else in ../shared/data; None when absent."""
     for folder in (test_data_dir(), os.environ.get("TOPOSPLINE_SHARED_DATA", os.path.join(REPO, "..", "shared", "data"))):
