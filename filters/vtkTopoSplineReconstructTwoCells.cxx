@@ -271,8 +271,8 @@ topospline::TopologicalSamplingReport EnforceComplexTopology(const topospline::M
   const std::function<Index(Index)>& vertexAt, double spacing, vtkDoubleArray* values, int& displacedSaddles)
 {
   std::vector<double> sampled(values->GetPointer(0), values->GetPointer(0) + values->GetNumberOfTuples());
-  const auto report = topospline::SampleTopologically(
-    complex, domainMesh, smoothed, sampling, mesh, vertexAt, spacing, sampled, displacedSaddles);
+  const auto report = topospline::SampleTopologically(complex, domainMesh, smoothed, sampling, mesh, vertexAt, spacing,
+    sampled, displacedSaddles, conversion::SMPParallelFor());
   std::copy(sampled.begin(), sampled.end(), values->GetPointer(0));
   return report;
 }

@@ -560,7 +560,8 @@ void AddOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult&
 
 TopologicalSamplingReport SampleTopologically(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
   const OneCellSmoothingResult& smoothed, const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
-  const std::function<Index(Index)>& vertexAt, double spacing, std::vector<double>& values, int& displacedSaddles)
+  const std::function<Index(Index)>& vertexAt, double spacing, std::vector<double>& values, int& displacedSaddles,
+  const ParallelFor& parallel)
 {
   // How far from its node a saddle is looked for and carved back.
   const double reach = 8 * spacing;
@@ -570,7 +571,7 @@ TopologicalSamplingReport SampleTopologically(const MorseSmaleComplex& complex, 
   const std::vector<double> before = values;
   CarveOneCells(sampling, mesh, constraints, spacing, values);
   TopologicalSamplingReport report = EnforceCriticalVertices(mesh, constraints, values);
-  displacedSaddles = RelocateSaddles(sampling, mesh, constraints, spacing * (1 + 1e-9), reach, values);
+  displacedSaddles = RelocateSaddles(sampling, mesh, constraints, spacing * (1 + 1e-9), reach, values, 3, 10, parallel);
   report.ChangedVertices = 0;
   report.MaximumChange = 0;
   CountChanges(before, values, report);
@@ -592,7 +593,7 @@ void CountChanges(const std::vector<double>& before, const std::vector<double>& 
 
 int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, double tolerance, double reach, std::vector<double>& values,
-  int maximumRounds, int maximumMissing)
+  int maximumRounds, int maximumMissing, const ParallelFor& parallel)
 {
   const std::vector<Index>& wantedSaddles = constraints.Saddles;
   // Values only: the extraction reads neither positions nor triangles (it is given the mesh).
@@ -605,6 +606,7 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
     MorseSmaleComplexExtraction extraction;
     extraction.CriticalPointsOnly = true;
     extraction.GivenMesh = &mesh;
+    extraction.Parallel = parallel;
     MorseSmaleComplex found;
     std::string error;
     missing.clear();
@@ -945,8 +947,8 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
           continue;
         }
         const double height = q[i + 2];
-        const double wanted =
-          up ? std::max(height, std::nextafter(previous, infinity)) : std::min(height, std::nextafter(previous, -infinity));
+        const double wanted = up ? std::max(height, std::nextafter(previous, infinity))
+                                 : std::min(height, std::nextafter(previous, -infinity));
         auto& asked = up ? raiseTo : lowerTo;
         auto found = asked.find(current);
         if (found == asked.end())

@@ -98,10 +98,12 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
 // floods (EnforceCriticalVertices) and the saddles moved back onto their nodes
 // (RelocateSaddles, within `spacing`, looked for within 8 spacings). `values` holds the samples
 // and is modified in place; `displacedSaddles` receives the number of saddles left off their
-// nodes. The report counts every changed vertex.
+// nodes. The report counts every changed vertex. `parallel` runs the extractions of the
+// sampled critical points (the floods are sequential).
 TopologicalSamplingReport SampleTopologically(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
   const OneCellSmoothingResult& smoothed, const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
-  const std::function<Index(Index)>& vertexAt, double spacing, std::vector<double>& values, int& displacedSaddles);
+  const std::function<Index(Index)>& vertexAt, double spacing, std::vector<double>& values, int& displacedSaddles,
+  const ParallelFor& parallel = SequentialFor);
 
 // Adds to `report` how many of `after` differ from `before`, and by how much at most.
 void CountChanges(const std::vector<double>& before, const std::vector<double>& after,
@@ -128,7 +130,7 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
 // it; carving gives it vertices.
 int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, double tolerance, double reach, std::vector<double>& values,
-  int maximumRounds = 3, int maximumMissing = 10);
+  int maximumRounds = 3, int maximumMissing = 10, const ParallelFor& parallel = SequentialFor);
 
 // Makes the wanted saddle `saddle` a saddle of the sampling with its own 1-cells
 // (constraints.SaddleOneCells): each 1-cell gets a vertex of the saddle's link, in the order

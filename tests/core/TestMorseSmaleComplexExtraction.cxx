@@ -211,7 +211,8 @@ TEST_CASE(CriticalPointsOnlyWithAGivenMesh)
     for (std::size_t i = 0; same && i < only.CriticalPoints.size(); ++i)
     {
       const CriticalPoint &a = only.CriticalPoints[i], &b = full.CriticalPoints[i];
-      same = a.Id == b.Id && a.MorseIndex == b.MorseIndex && a.Vertex == b.Vertex && a.Cell == b.Cell && a.Value == b.Value;
+      same = a.Id == b.Id && a.MorseIndex == b.MorseIndex && a.Vertex == b.Vertex && a.Cell == b.Cell &&
+        a.Value == b.Value;
     }
     CHECK(same);
     CHECK(only.Separatrices.empty());
