@@ -267,12 +267,13 @@ void BuildTopology(const topospline::PlanarScalarField& field, topospline::Trian
 // sampled values (TopologicalSampling.h).
 topospline::TopologicalSamplingReport EnforceComplexTopology(const topospline::MorseSmaleComplex& complex,
   const topospline::OneCellSmoothingResult& smoothed, const topospline::TriangleMeshTopology& domainMesh,
-  const topospline::PlanarScalarField& sampling, const topospline::TriangleMeshTopology& mesh,
-  const std::function<Index(Index)>& vertexAt, double spacing, vtkDoubleArray* values, int& displacedSaddles)
+  const std::vector<double>& domainPoints, const topospline::PlanarScalarField& sampling,
+  const topospline::TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, double spacing,
+  vtkDoubleArray* values, int& displacedSaddles)
 {
   std::vector<double> sampled(values->GetPointer(0), values->GetPointer(0) + values->GetNumberOfTuples());
-  const auto report = topospline::SampleTopologically(complex, domainMesh, smoothed, sampling, mesh, vertexAt, spacing,
-    sampled, displacedSaddles, conversion::SMPParallelFor());
+  const auto report = topospline::SampleTopologically(complex, domainMesh, domainPoints, smoothed, sampling, mesh,
+    vertexAt, spacing, sampled, displacedSaddles, conversion::SMPParallelFor());
   std::copy(sampled.begin(), sampled.end(), values->GetPointer(0));
   return report;
 }
@@ -496,7 +497,8 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
     rawValues->DeepCopy(values);
     rawValues->SetName(names::ExactReconstruction);
     output->GetPointData()->AddArray(rawValues);
-    sampling = EnforceComplexTopology(complex, smoothed, domainMesh, domainField, domainMesh, [](Index v) { return v; },
+    sampling = EnforceComplexTopology(complex, smoothed, domainMesh, domainField.Points, domainField, domainMesh,
+      [](Index v) { return v; },
       gridSpacing, values, displacedSaddles);
     for (vtkIdType v = 0; v < n; ++v)
     {
@@ -632,7 +634,7 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
       const double* h = resampledOutput->GetSpacing();
       const int ni = dims[plane.U], nj = dims[plane.V];
       int fineDisplaced = 0;
-      const auto fineReport = EnforceComplexTopology(complex, smoothed, domainMesh, fine, fineMesh,
+      const auto fineReport = EnforceComplexTopology(complex, smoothed, domainMesh, domainField.Points, fine, fineMesh,
         [&](Index v) {
           const double* xy = &domainField.Points[2 * static_cast<std::size_t>(v)];
           const int i = std::clamp(static_cast<int>(std::lround((xy[0] - o[plane.U]) / h[plane.U])), 0, ni - 1);

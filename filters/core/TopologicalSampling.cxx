@@ -559,9 +559,9 @@ void AddOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult&
 }
 
 TopologicalSamplingReport SampleTopologically(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
-  const OneCellSmoothingResult& smoothed, const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
-  const std::function<Index(Index)>& vertexAt, double spacing, std::vector<double>& values, int& displacedSaddles,
-  const ParallelFor& parallel)
+  const std::vector<double>& complexPoints, const OneCellSmoothingResult& smoothed, const PlanarScalarField& sampling,
+  const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, double spacing,
+  std::vector<double>& values, int& displacedSaddles, const ParallelFor& parallel)
 {
   // How far from its node a saddle is looked for and carved back.
   const double reach = 8 * spacing;
@@ -569,6 +569,17 @@ TopologicalSamplingReport SampleTopologically(const MorseSmaleComplex& complex, 
   AddSaddleOneCells(complex, smoothed, vertexAt, reach, constraints);
   AddOneCells(complex, smoothed, vertexAt, 0.25 * spacing, constraints);
   const std::vector<double> before = values;
+  for (const CriticalPoint& cp : complex.CriticalPoints)
+  {
+    const Index v = vertexAt(cp.Vertex);
+    const std::size_t node = 2 * static_cast<std::size_t>(cp.Vertex);
+    if (v >= 0 && v < mesh.NumberOfVertices() && node + 1 < complexPoints.size() &&
+      std::hypot(sampling.Points[2 * v] - complexPoints[node], sampling.Points[2 * v + 1] - complexPoints[node + 1]) >
+        1e-6 * spacing)
+    {
+      values[v] = cp.Value;
+    }
+  }
   CarveOneCells(sampling, mesh, constraints, spacing, values);
   TopologicalSamplingReport report = EnforceCriticalVertices(mesh, constraints, values);
   displacedSaddles = RelocateSaddles(sampling, mesh, constraints, spacing * (1 + 1e-9), reach, values, 3, 10, parallel);

@@ -100,10 +100,14 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
 // and is modified in place; `displacedSaddles` receives the number of saddles left off their
 // nodes. The report counts every changed vertex. `parallel` runs the extractions of the
 // sampled critical points (the floods are sequential).
+// `complexPoints` (x, y per vertex of `complexMesh`) tells where the nodes are: on a sampling
+// whose vertices do not include them (an image resampled over a triangle mesh), the vertex
+// nearest each node first takes the node's critical value, so that the wanted extremum is
+// where the floods expect it (F o Phi peaks at the node, not at the vertex).
 TopologicalSamplingReport SampleTopologically(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
-  const OneCellSmoothingResult& smoothed, const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
-  const std::function<Index(Index)>& vertexAt, double spacing, std::vector<double>& values, int& displacedSaddles,
-  const ParallelFor& parallel = SequentialFor);
+  const std::vector<double>& complexPoints, const OneCellSmoothingResult& smoothed, const PlanarScalarField& sampling,
+  const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, double spacing,
+  std::vector<double>& values, int& displacedSaddles, const ParallelFor& parallel = SequentialFor);
 
 // Adds to `report` how many of `after` differ from `before`, and by how much at most.
 void CountChanges(const std::vector<double>& before, const std::vector<double>& after,

@@ -250,8 +250,8 @@ void CheckReconstruction(const char* name, const GridField& grid, double percent
     const auto vertexAt = [&](Index v) { return (v / nx) * factor * fineX + (v % nx) * factor; };
     // The filter's own sequence: constraints, 1-cells carved in, floods, saddles moved back.
     int unmatched = 0;
-    const auto repair = SampleTopologically(
-      p.Simplified.Complex, inputMesh, p.Smoothed, sampled, mesh, vertexAt, spacing, sampled.Values, unmatched);
+    const auto repair = SampleTopologically(p.Simplified.Complex, inputMesh, p.Field.Points, p.Smoothed, sampled, mesh,
+      vertexAt, spacing, sampled.Values, unmatched);
     MorseSmaleComplex repaired;
     CHECK(extraction.Extract(sampled, repaired, error));
     const auto after = CompareCriticalPoints(expected, CriticalPointLocations(repaired, sampled.Points), spacing);
