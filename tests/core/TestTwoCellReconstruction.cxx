@@ -1,10 +1,13 @@
 // Tests of stage 4 as a whole (TwoCellReconstruction, TopologyVerification) on the output of
 // the real stages 1-3 for the paper's synthetic fields: every 2-cell reconstructed, no Sibson
 // cell violating the monotonicity conditions, critical values interpolated, the field
-// continuous across shared 1-cells, the same result with 1 and several threads; the critical
-// points of samplings of the result (input resolution and finer) are compared with those of
-// the simplified complex and printed (not yet equal: see docs/Reconstruction.md). Also the side assembly rules on hand-made cells and degenerate
-// inputs (tiny grids, noise) that must fail cleanly, never crash.
+// continuous across shared 1-cells, the same result with 1 and several threads; after
+// topological sampling (SampleTopologically, as the filter runs it) the samplings of the result
+// (input resolution and finer) have exactly the simplified complex's critical points, each
+// within one spacing of its node. Also the topological sampling's own mechanisms on made-up
+// fields (noise, plateaus, dented boundary saddles, a ridge between rows), the side assembly
+// rules on hand-made cells and degenerate inputs (tiny grids, noise) that must fail cleanly,
+// never crash.
 //
 // Usage: TestTwoCellReconstruction
 // Prints figures per case, then "N passed, N failed"; returns nonzero on failure.

@@ -33,38 +33,33 @@ for entry in tt.catalog():
         checks.skip("%s absent (large data sets live in ../shared/data)" % entry["file"])
 
 
-def number(fd, name, index=0):
-    array = fd.GetArray(name)
-    return array.GetValue(index) if array is not None else None
-
-
 def field_range_of(fd):
-    return number(fd, "ValueRange", 1) - number(fd, "ValueRange", 0)
+    return tt.field_value(fd, "ValueRange", 1) - tt.field_value(fd, "ValueRange", 0)
 
 
 def check_reconstruction(label, reconstruct, c, resolution):
     reconstruct.UpdatePipeline()
     out = sm.Fetch(reconstruct)
     fd = out.GetFieldData()
-    checks.equal(number(fd, "ViolatingPatches"), 0, "%s: no Sibson cell violates the monotonicity conditions" % label)
-    expected = [int(number(fd, "ExpectedCriticalPoints", i)) for i in range(3)]
+    checks.equal(tt.field_value(fd, "ViolatingPatches"), 0, "%s: no Sibson cell violates the monotonicity conditions" % label)
+    expected = [int(tt.field_value(fd, "ExpectedCriticalPoints", i)) for i in range(3)]
     checks.equal(sum(expected), len(c["cp_VertexId"]), "%s: the topology check counted every node" % label)
-    found = [int(number(fd, "InputCriticalPoints", i)) for i in range(3)]
-    fine = [int(number(fd, "ResampledCriticalPoints", i)) for i in range(3)] if resolution > 1 else None
-    checks.equal(number(fd, "FailedTwoCells"), 0, "%s: every 2-cell reconstructed" % label)
+    found = [int(tt.field_value(fd, "InputCriticalPoints", i)) for i in range(3)]
+    fine = [int(tt.field_value(fd, "ResampledCriticalPoints", i)) for i in range(3)] if resolution > 1 else None
+    checks.equal(tt.field_value(fd, "FailedTwoCells"), 0, "%s: every 2-cell reconstructed" % label)
     checks.equal(found, expected, "%s: critical points of the sampling at the input resolution" % label)
     if fine is not None:
         checks.equal(fine, expected, "%s: critical points of the %dx finer sampling" % (label, resolution))
     # The full verdict: also every critical point within one grid spacing of its node, at both
     # resolutions.
-    checks.check(bool(number(fd, "TopologyVerified")),
+    checks.check(bool(tt.field_value(fd, "TopologyVerified")),
                  "%s: topology verified (counts and positions within one spacing)" % label)
-    raw = [int(number(fd, "RawInputCriticalPoints", i)) for i in range(3)]
+    raw = [int(tt.field_value(fd, "RawInputCriticalPoints", i)) for i in range(3)]
     print("%s: failed 2-cells %d; critical points expected %s, before topological sampling %s (it moved %d "
           "vertices, at most %.3g = %.2f%% of the range); verdict %d (%d spurious, %d missing within one grid spacing)"
-          % (label, number(fd, "FailedTwoCells"), expected, raw, number(fd, "SamplingChangedVertices"),
-             number(fd, "SamplingMaximumChange"), 100 * number(fd, "SamplingMaximumChange") / field_range_of(fd),
-             number(fd, "TopologyVerified"), fd.GetArray("SpuriousCriticalPoints").GetNumberOfTuples(),
+          % (label, tt.field_value(fd, "FailedTwoCells"), expected, raw, tt.field_value(fd, "SamplingChangedVertices"),
+             tt.field_value(fd, "SamplingMaximumChange"), 100 * tt.field_value(fd, "SamplingMaximumChange") / field_range_of(fd),
+             tt.field_value(fd, "TopologyVerified"), fd.GetArray("SpuriousCriticalPoints").GetNumberOfTuples(),
              fd.GetArray("MissingCriticalPoints").GetNumberOfTuples()), flush=True)
     values = vtk_to_numpy(out.GetPointData().GetArray("Reconstructed"))
     checks.check(bool(np.all(np.isfinite(values))), "%s: finite values" % label)
@@ -81,7 +76,7 @@ def check_reconstruction(label, reconstruct, c, resolution):
     checks.check(worst <= 1e-9 * field_range, "%s: critical values interpolated (worst %.3g)" % (label, worst))
     print("%s: topological sampling moved node values by up to %.3g (%.2f%% of the range)"
           % (label, moved, 100 * moved / field_range))
-    return number(fd, "MaximumError"), number(fd, "RMSError"), field_range, number(fd, "BezierTriangles")
+    return tt.field_value(fd, "MaximumError"), tt.field_value(fd, "RMSError"), field_range, tt.field_value(fd, "BezierTriangles")
 
 
 def fetch_port(proxy, port):

@@ -34,18 +34,13 @@ out.SetPoints(points)
 KNOWN_MISSES = {"shepard irregular 25% k=4": "one spurious minimum-saddle pair at the input vertices"}
 
 
-# (Not "number": the programmable filter's script runs in this module's namespace in builtin
-# mode and star-imports numpy, which has a "number".)
-def value_of(fd, name, index=0):
-    array = fd.GetArray(name)
-    return array.GetValue(index) if array is not None else None
-
-
 for field in ("trig", "shepard"):
     for mesh in ("grid", "irregular"):
         source = TrigonometricField() if field == "trig" else ShepardField()
         triangles = Triangulate(Input=ExtractSurface(Input=source))
         if mesh == "irregular":
+            # (In builtin mode its script runs in this module's namespace and star-imports numpy:
+            # module-level names such as "number" would be shadowed.)
             jittered = ProgrammableFilter(Input=triangles)
             jittered.Script = JITTER
             triangles = Delaunay2D(Input=jittered)
@@ -63,11 +58,11 @@ for field in ("trig", "shepard"):
                 checks.check(out.IsA("vtkPolyData"), "%s: the output keeps the input's type" % label)
                 checks.check(algorithm.GetOutputDataObject(2).GetNumberOfPoints() > 4 * out.GetNumberOfPoints(),
                              "%s: the resampled image is finer" % label)
-                checks.equal(value_of(fd, "FailedTwoCells"), 0, "%s: every 2-cell reconstructed" % label)
-                expected = [int(value_of(fd, "ExpectedCriticalPoints", i)) for i in range(3)]
-                found = [int(value_of(fd, "InputCriticalPoints", i)) for i in range(3)]
-                fine = [int(value_of(fd, "ResampledCriticalPoints", i)) for i in range(3)]
-                verdict = bool(value_of(fd, "TopologyVerified"))
+                checks.equal(tt.field_value(fd, "FailedTwoCells"), 0, "%s: every 2-cell reconstructed" % label)
+                expected = [int(tt.field_value(fd, "ExpectedCriticalPoints", i)) for i in range(3)]
+                found = [int(tt.field_value(fd, "InputCriticalPoints", i)) for i in range(3)]
+                fine = [int(tt.field_value(fd, "ResampledCriticalPoints", i)) for i in range(3)]
+                verdict = bool(tt.field_value(fd, "TopologyVerified"))
                 print("%s: expected %s, at the input vertices %s, 4x %s, verdict %d"
                       % (label, expected, found, fine, verdict), flush=True)
                 checks.equal(fine, expected, "%s: critical points of the 4x image" % label)

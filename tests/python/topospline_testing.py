@@ -91,6 +91,12 @@ class Checks:
         sys.exit(1 if self.failed else 0)
 
 
+def field_value(fd, name, index=0):
+    """Component `index` of field-data array `name`, or None if it is absent."""
+    array = fd.GetArray(name)
+    return array.GetValue(index) if array is not None else None
+
+
 def _arrays(data, names, where="point"):
     fd = data.GetPointData() if where == "point" else data.GetCellData()
     out = {}
