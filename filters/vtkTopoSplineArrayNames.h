@@ -70,4 +70,7 @@ constexpr const char* ExactReconstruction = "ReconstructedExact";
 
 // Field data of the complex: which input array it was computed from.
 constexpr const char* ScalarFieldName = "TopoSplineScalarField";
+// Field data of a simplified complex: vertices where boundary 1-cells turn inwards
+// (MorseSmaleComplex::BoundaryJunctions).
+constexpr const char* BoundaryJunctionVertexId = "BoundaryJunctionVertexId";
 }

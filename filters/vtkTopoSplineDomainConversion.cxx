@@ -462,6 +462,15 @@ void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
   scalarField->SetName(names::ScalarFieldName);
   scalarField->InsertNextValue(scalarName ? scalarName : "");
   output->GetFieldData()->AddArray(scalarField);
+  if (!complex.BoundaryJunctions.empty())
+  {
+    auto junctions = NewArray<vtkIntArray>(names::BoundaryJunctionVertexId);
+    for (Index v : complex.BoundaryJunctions)
+    {
+      junctions->InsertNextValue(v);
+    }
+    output->GetFieldData()->AddArray(junctions);
+  }
 }
 
 vtkDataSet* SegmentationOf(vtkMultiBlockDataSet* input)
@@ -606,6 +615,19 @@ bool FromMultiBlock(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& 
     complex.AscendingManifold[v] = local(ascending->GetComponent(v, 0));
     complex.DescendingManifold[v] = local(descending->GetComponent(v, 0));
     complex.TwoCellId[v] = static_cast<Index>(cellId->GetComponent(v, 0));
+  }
+  if (vtkDataArray* junctions = input->GetFieldData()->GetArray(names::BoundaryJunctionVertexId))
+  {
+    for (vtkIdType j = 0; j < junctions->GetNumberOfTuples(); ++j)
+    {
+      const auto v = static_cast<Index>(junctions->GetComponent(j, 0));
+      if (v < 0 || v >= nV)
+      {
+        error = "the input is not a Morse-Smale complex: a boundary junction names no vertex";
+        return false;
+      }
+      complex.BoundaryJunctions.push_back(v);
+    }
   }
   return true;
 }

@@ -88,6 +88,55 @@ vtkSmartPointer<vtkPolyData> JunctionPointsBlock(
   return block;
 }
 
+// The pairs below the threshold that the paper's rules kept, and why: users see what
+// survived although its persistence is small.
+void AddBlockedPairs(const topospline::SimplificationOutput& result, vtkFieldData* fd)
+{
+  auto count = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("BlockedCancellations");
+  count->InsertNextValue(static_cast<int>(result.Blocked.size()));
+  auto lower = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("BlockedLowerId");
+  auto upper = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("BlockedUpperId");
+  auto persistence = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>("BlockedPersistence");
+  auto reason = vtkTopoSplineDomainConversion::NewArray<vtkStringArray>("BlockedReason");
+  for (size_t i = 0; i < result.Blocked.size(); ++i)
+  {
+    lower->InsertNextValue(result.Blocked[i].Lower);
+    upper->InsertNextValue(result.Blocked[i].Upper);
+    persistence->InsertNextValue(result.Blocked[i].Persistence);
+    reason->InsertNextValue(topospline::BlockReasonName(result.BlockReasons[i]));
+  }
+  for (vtkAbstractArray* a : std::initializer_list<vtkAbstractArray*>{ count, lower, upper, persistence, reason })
+  {
+    fd->AddArray(a);
+  }
+}
+
+// The persistence curve: how many critical points remain above each threshold, one point per
+// distinct threshold of the hierarchy (a step function, constant up to the next point).
+void AddPersistenceCurve(const topospline::MorseSmaleComplexSimplification& simplification, vtkFieldData* fd)
+{
+  auto percent = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>("PersistenceCurvePercent");
+  auto remaining = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("PersistenceCurveCriticalPoints");
+  const auto& hierarchy = simplification.Hierarchy();
+  const double maximum = simplification.MaximumPersistence();
+  auto left = static_cast<int>(simplification.NumberOfInputCriticalPoints());
+  percent->InsertNextValue(0);
+  remaining->InsertNextValue(left);
+  for (size_t k = 0; k < hierarchy.size(); ++k)
+  {
+    left -= 2;
+    if (k + 1 < hierarchy.size() && hierarchy[k + 1].Threshold == hierarchy[k].Threshold)
+    {
+      continue;
+    }
+    // Performed for every threshold strictly above this one.
+    percent->InsertNextValue(maximum > 0 ? 100 * hierarchy[k].Threshold / maximum : 0);
+    remaining->InsertNextValue(left);
+  }
+  fd->AddArray(percent);
+  fd->AddArray(remaining);
+}
+
 void AddCancellations(const topospline::SimplificationOutput& result, double maximumPersistence, vtkFieldData* fd)
 {
   auto lower = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("CancelledLowerId");
@@ -176,7 +225,8 @@ int vtkTopoSplineSimplifyMorseSmaleComplex::RequestData(
   const auto counts = result.Complex.CountByIndex();
   vtkLog(TRACE, "simplified to " << counts[0] << " minima, " << counts[1] << " saddles, " << counts[2]
                                  << " maxima (" << result.Cancellations.size() << " of " << before
-                                 << " cancellations)");
+                                 << " cancellations, " << result.Blocked.size()
+                                 << " pairs below the threshold blocked by the cancellation rules)");
   {
     vtkLogScopeF(TRACE, "build output");
     auto* scalarName = vtkStringArray::SafeDownCast(input->GetFieldData()->GetAbstractArray(names::ScalarFieldName));
@@ -187,6 +237,8 @@ int vtkTopoSplineSimplifyMorseSmaleComplex::RequestData(
     output->GetMetaData(static_cast<unsigned int>(names::JunctionPointsIndex))
       ->Set(vtkCompositeDataSet::NAME(), names::JunctionPointsBlock);
     AddCancellations(result, cache.Simplification.MaximumPersistence(), output->GetFieldData());
+    AddBlockedPairs(result, output->GetFieldData());
+    AddPersistenceCurve(cache.Simplification, output->GetFieldData());
   }
   this->UpdateProgress(1.0);
   return 1;

@@ -50,7 +50,7 @@ protected:
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  double PersistenceThreshold = 2.0;
+  double PersistenceThreshold = 5.0;
   int HierarchyComputations = 0;
 
 private:

@@ -13,7 +13,7 @@ packages=(
   libgdal-dev libgl2ps-dev libglew-dev libhdf5-openmpi-dev libjpeg-dev liblz4-dev
   liblzma-dev libxml2-dev libopenmpi-dev libnetcdf-dev libgl-dev libpng-dev
   python3-dev libtheora-dev libtiff-dev libx11-dev zlib1g-dev
-  libdouble-conversion-dev python3-mpi4py python3-numpy
+  libdouble-conversion-dev python3-mpi4py python3-numpy python3-matplotlib
 )
 
 missing=()

@@ -22,8 +22,9 @@ parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.R
 parser.add_argument("--input", help="a 2D .vti/.vtu/.vtp file (default: the built-in Shepard field)")
 parser.add_argument("--array", help="point scalar array of the input (default: the active scalars)")
 parser.add_argument("--output", default="output", help="output folder (default: ./output)")
-parser.add_argument("--threshold", type=float, default=25.0,
-                    help="persistence threshold in %% of the maximum persistence (default 25, the paper's Shepard)")
+parser.add_argument("--threshold", type=float, default=5.0,
+                    help="persistence threshold in %% of the maximum persistence (default 5, the default of "
+                         "every TopoSpline filter; docs/Simplification.md says why)")
 parser.add_argument("--k", type=int, default=4, help="cubic segments per 1-cell piece (default 4)")
 parser.add_argument("--seed", type=int, default=1, help="seed of the built-in Shepard field")
 args = parser.parse_args([a for a in sys.argv[1:] if a != "--"])
@@ -97,8 +98,12 @@ if simplified_data is None or simplified_data.GetNumberOfBlocks() < 4:
     sys.exit("the simplification failed (see the error above)")
 summary["simplified_complex"] = complex_counts(simplified_data)
 summary["simplified_complex"]["persistence_threshold_percent"] = args.threshold
-summary["simplified_complex"]["maximum_persistence"] = simplified_data.GetFieldData().GetArray(
-    "MaximumPersistence").GetValue(0)
+sdf = simplified_data.GetFieldData()
+summary["simplified_complex"]["maximum_persistence"] = sdf.GetArray("MaximumPersistence").GetValue(0)
+summary["simplified_complex"]["blocked_cancellations"] = sdf.GetArray("BlockedCancellations").GetValue(0)
+curve_percent = [sdf.GetArray("PersistenceCurvePercent").GetValue(i)
+                 for i in range(sdf.GetArray("PersistenceCurvePercent").GetNumberOfTuples())]
+curve_points = [sdf.GetArray("PersistenceCurveCriticalPoints").GetValue(i) for i in range(len(curve_percent))]
 
 # --- Stage 3: smooth, strictly monotone 1-cells ---
 smoothed = Smooth1Cells(Input=simplified, CurveSegments=args.k)
@@ -200,6 +205,32 @@ def save(name):
         Hide(proxy, view)
 
 
+def save_persistence_curve(name):
+    """Critical points left against the threshold (a step function: each step is performed
+    for every threshold above it), with the chosen threshold marked."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    figure, axes = plt.subplots(figsize=(7, 4.5), dpi=140)
+    axes.step(curve_percent + [100], curve_points + [curve_points[-1]], where="post", color="black")
+    axes.axvline(args.threshold, color="tab:red", linestyle="--",
+                 label="threshold %g %%: %d critical points" % (args.threshold, sum(
+                     summary["simplified_complex"][k] for k in ("minima", "saddles", "maxima"))))
+    axes.set_xscale("symlog", linthresh=0.1)
+    axes.set_yscale("log")
+    axes.set_xlim(0, 100)
+    axes.set_xlabel("persistence threshold (% of the field's range)")
+    axes.set_ylabel("critical points left")
+    axes.set_title("Persistence curve of %s" % (os.path.basename(args.input) if args.input else "the Shepard field (seed %d)" % args.seed))
+    axes.grid(True, which="both", alpha=0.3)
+    axes.legend()
+    figure.tight_layout()
+    path = os.path.join(args.output, name)
+    figure.savefig(path)
+    plt.close(figure)
+    pictures.append(path)
+
+
 pictures = []
 show_field(source)
 save("1_input.png")
@@ -217,6 +248,7 @@ show_complex(smoothed, smooth=True)
 save("5_reconstruction_k%d.png" % args.k)
 style.field_with_isolines(reconstruction, "Reconstructed", view)
 save("6_reconstruction_isolines_k%d.png" % args.k)
+save_persistence_curve("3b_persistence_curve.png")
 summary["pictures"] = pictures
 
 with open(os.path.join(args.output, "summary.json"), "w") as f:

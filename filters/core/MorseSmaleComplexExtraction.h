@@ -74,6 +74,11 @@ struct MorseSmaleComplex
   std::vector<Index> AscendingManifold;  // id of the minimum it flows down to
   std::vector<Index> DescendingManifold; // id of the maximum it flows up to
   std::vector<Index> TwoCellId;
+  // Vertices of boundary-curve minima that simplification cancelled with the interior saddle
+  // on their own vertex (a zero-persistence pair of stage 1's boundary rule): the boundary
+  // 1-cells turn inwards there. Stage 1 extracts that pair again from any field that falls
+  // into the domain at such a vertex, so a topology check expects it (TopologyVerification).
+  std::vector<Index> BoundaryJunctions;
 
   std::array<Index, 3> CountByIndex() const;
 };

@@ -71,6 +71,27 @@ struct AdjacencyRows
 } // namespace
 
 //------------------------------------------------------------------------------
+const char* BlockReasonName(BlockReason reason)
+{
+  switch (reason)
+  {
+    case BlockReason::NotAdjacent:
+      return "not adjacent";
+    case BlockReason::DoubleOneCell:
+      return "two 1-cells";
+    case BlockReason::BoundaryInterior:
+      return "boundary-interior";
+    case BlockReason::TwoCellPinched:
+      return "2-cell pinched";
+    case BlockReason::InvertedOneCell:
+      return "inverted 1-cell";
+    case BlockReason::BoundaryMinimumPinned:
+      return "boundary minimum pinned";
+  }
+  return "unknown";
+}
+
+//------------------------------------------------------------------------------
 bool MorseSmaleComplexSimplification::Check(const MorseSmaleComplex& input, std::string& error) const
 {
   auto fail = [&error](const std::string& what) {
@@ -202,6 +223,7 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
   this->Computed = false;
   this->Sequence.clear();
   this->Steps.clear();
+
   if (!this->Check(input, error))
   {
     return false;
@@ -436,18 +458,121 @@ int MorseSmaleComplexSimplification::CellMerges(
 }
 
 //------------------------------------------------------------------------------
+// The elder rule on the complex: saddles are visited in order (upward for minima, downward
+// for maxima); each one whose two 1-cells of the extremum's kind reach two different
+// components merges them, and the younger component's extremum (the higher minimum, the
+// lower maximum) dies there. Stage 1 pairs cells only inside lower stars, so the min-saddle
+// graph of the complex carries the 0-dimensional sublevel persistence of the PL field
+// (boundary vertices included, as ordinary vertices), and the max-saddle graph the
+// superlevel one; a boundary saddle has a single ascending 1-cell and never merges maxima.
+std::vector<MorseSmaleComplexSimplification::PersistencePair> MorseSmaleComplexSimplification::ElderRulePairs(
+  bool minima) const
+{
+  const auto& cps = this->Input.CriticalPoints;
+  const Index nCP = static_cast<Index>(cps.size());
+  const int first = minima ? 0 : 2;
+  std::vector<Index> saddles;
+  for (Index s = 0; s < nCP; ++s)
+  {
+    if (cps[s].MorseIndex == 1 && this->SaddleArcs[s][first + 1] != InvalidIndex)
+    {
+      saddles.push_back(s);
+    }
+  }
+  std::sort(saddles.begin(), saddles.end(), [&cps, minima](Index a, Index b) {
+    return LowerCriticalPoint(cps[a], cps[b]) == minima;
+  });
+  // Each component's root is its elder extremum: links are set here, never by rank.
+  std::vector<Index> parent(nCP);
+  std::iota(parent.begin(), parent.end(), 0);
+  std::vector<PersistencePair> pairs;
+  for (Index s : saddles)
+  {
+    const Index a = FindRepresentative(parent, this->ArcExtremum[this->SaddleArcs[s][first]]);
+    const Index b = FindRepresentative(parent, this->ArcExtremum[this->SaddleArcs[s][first + 1]]);
+    if (a == b)
+    {
+      continue;
+    }
+    const bool aYounger = LowerCriticalPoint(cps[a], cps[b]) != minima;
+    const Index younger = aYounger ? a : b;
+    parent[younger] = aYounger ? b : a;
+    pairs.push_back({ std::abs(cps[s].Value - cps[younger].Value), s, younger });
+  }
+  return pairs;
+}
+
+//------------------------------------------------------------------------------
 // Greedy cancellation in order of increasing persistence with a lazy priority queue
 // (Shivashankar's mscomplex-tri): every saddle-extremum pair joined by a 1-cell is a
-// candidate; validity is checked when a candidate is popped. Pairs are never re-validated
-// later because validity can only be lost: an extremum's 1-cells only ever gain saddles, a
-// saddle's 1-cells only ever move to the survivor of a cancelled extremum, and 2-cells only
-// ever merge. The threshold is
-// infinite, so the sequence holds every cancellation any threshold can perform; each valid
-// pop removes two critical points, so the loop ends.
+// candidate; validity is checked when a candidate is popped. The threshold is infinite, so
+// the sequence holds every cancellation any threshold can perform; each valid pop removes two
+// critical points, so the loop ends.
+//
+// Significance is ordinary persistence (docs/Simplification.md): an extremum is cancelled
+// only through a 1-cell whose value difference is at least the extremum's own persistence
+// (the elder rule on the input complex, ElderRulePairs), so at any threshold every cancelled
+// extremum has persistence below it and none above it is lost. Without this rule a 1-cell
+// that the closed-boundary rule cuts short (to a minimum of the boundary curve that is no
+// extremum of the field) let a deep basin go at the depth of its exit across the boundary.
+// Stage 1's boundary rule makes every minimum of f along the boundary curve a critical point,
+// also where f decreases into the domain; there it dies at once (persistence 0) against the
+// interior saddle on its own vertex, and that pair is cancelled first: the boundary point
+// becomes a junction where the boundary 1-cells turn inwards (BoundaryJunctions). It is kept
+// where that saddle is also where two superlevel components meet (two hills meeting at a
+// boundary pass), which removing it would hide; such a boundary minimum then stays while its
+// saddle lives (BoundaryMinimumPinned).
 void MorseSmaleComplexSimplification::ComputeSequence()
 {
   const auto& cps = this->Input.CriticalPoints;
   const Index nCP = static_cast<Index>(cps.size());
+
+  std::vector<unsigned char> alive(nCP, 1);
+  // Ordinary persistence of every extremum (the global ones: infinite, never cancelled).
+  this->OrdinaryPersistence.assign(nCP, std::numeric_limits<double>::infinity());
+  std::vector<unsigned char> mergesMaxima(nCP, 0);
+  std::vector<Index> persistencePartner(nCP, InvalidIndex);
+  this->ElderPairs.clear();
+  for (const bool minima : { true, false })
+  {
+    const auto pairs = this->ElderRulePairs(minima);
+    this->ElderPairs.insert(this->ElderPairs.end(), pairs.begin(), pairs.end());
+    for (const PersistencePair& pair : pairs)
+    {
+      this->OrdinaryPersistence[pair.Extremum] = pair.Persistence;
+      persistencePartner[pair.Extremum] = pair.Saddle;
+      mergesMaxima[pair.Saddle] |= minima ? 0 : 1;
+    }
+  }
+  // Interior saddles whose vertex lies on the boundary: the descending 1-cell that starts at
+  // that vertex runs along the boundary (boundary vertices pair with boundary edges) to a
+  // minimum of the boundary curve, which they pin (see BoundaryMinimumPinned below). The one
+  // on the minimum's own vertex is its zero-persistence partner, cancelled with it as a
+  // boundary junction unless it also merges maxima.
+  std::vector<std::vector<Index>> pinnedBy(nCP);
+  this->StructuralPair.assign(nCP, 0);
+  for (Index e = 0; e < nCP; ++e)
+  {
+    if (cps[e].MorseIndex != 1 || this->OnBoundaryCurve[e] || !cps[e].OnBoundary)
+    {
+      continue;
+    }
+    for (int k = 0; k < 2; ++k)
+    {
+      const Index b = this->ArcExtremum[this->SaddleArcs[e][k]];
+      if (this->OnBoundaryCurve[b])
+      {
+        pinnedBy[b].push_back(e);
+        if (cps[b].Vertex == cps[e].Vertex && persistencePartner[b] == e && !mergesMaxima[e])
+        {
+          this->StructuralPair[b] = 1;
+        }
+      }
+    }
+  }
+  auto pinned = [&](Index b, Index except) {
+    return std::any_of(pinnedBy[b].begin(), pinnedBy[b].end(), [&](Index e) { return e != except && alive[e]; });
+  };
 
   struct Candidate
   {
@@ -506,7 +631,6 @@ void MorseSmaleComplexSimplification::ComputeSequence()
     }
   }
 
-  std::vector<unsigned char> alive(nCP, 1);
   std::vector<Index> forward(nCP);
   std::iota(forward.begin(), forward.end(), 0);
   std::vector<Index> stamp(nCP, InvalidIndex);
@@ -515,6 +639,10 @@ void MorseSmaleComplexSimplification::ComputeSequence()
   auto cellClass = [&cellForward](Index cell) {
     return cell == InvalidIndex ? InvalidIndex : FollowForwarding(cellForward, cell);
   };
+  // Why each surviving extremum was last refused (NotAdjacent: never offered a 1-cell that
+  // reaches its persistence).
+  this->RefusalOf.assign(nCP, BlockReason::NotAdjacent);
+  this->CancelledAt.assign(nCP, std::numeric_limits<double>::infinity());
   double threshold = 0;
   size_t pops = 0;
   while (!queue.empty())
@@ -531,11 +659,18 @@ void MorseSmaleComplexSimplification::ComputeSequence()
       continue;
     }
     // The saddle's 1-cells of the extremum's kind, and how many of them reach it now.
-    const int first = cps[x].MorseIndex == 0 ? 0 : 2;
+    const bool minimum = cps[x].MorseIndex == 0;
+    const int first = minimum ? 0 : 2;
     const auto& slots = this->SaddleArcs[s];
     if (slots[first + 1] == InvalidIndex)
     {
       // A boundary saddle has a single ascending 1-cell: no other maximum could take over.
+      continue;
+    }
+    // A 1-cell shorter in value than the extremum's persistence is not where its sublevel
+    // (superlevel) component ends: cancelling there would remove a larger feature.
+    if (candidate.Persistence < this->OrdinaryPersistence[x])
+    {
       continue;
     }
     int reaching = 0, side = 0;
@@ -551,6 +686,7 @@ void MorseSmaleComplexSimplification::ComputeSequence()
     // that the cancellation would pinch off, and the new 1-cells would be loops.
     if (reaching != 1)
     {
+      this->RefusalOf[x] = BlockReason::DoubleOneCell;
       continue;
     }
     // Boundary-boundary pairs are cancellations inside the 1D complex of the boundary curve:
@@ -558,15 +694,26 @@ void MorseSmaleComplexSimplification::ComputeSequence()
     // boundary-interior pair would remove a critical point of that curve alone: the curve
     // would lose a minimum (or saddle) without its partner, so it would no longer be made of
     // 1-cells joining boundary minima and saddles, and the 2-cells along it would not close.
-    if (this->OnBoundaryCurve[s] != this->OnBoundaryCurve[x])
+    // The one exception is a boundary junction (above): its 1-cells go on into the domain.
+    const bool junction = this->StructuralPair[x] && cps[s].Vertex == cps[x].Vertex;
+    if (this->OnBoundaryCurve[s] != this->OnBoundaryCurve[x] && !junction)
     {
+      this->RefusalOf[x] = BlockReason::BoundaryInterior;
+      continue;
+    }
+    // A boundary minimum pinned by a living interior saddle on the boundary: cancelling it
+    // along the curve would send that saddle's 1-cell on along the boundary to the survivor,
+    // back over the saddle's own vertex or past the vertices of other such saddles, which
+    // may be higher than it: stage 3 could not make it monotone.
+    if (pinned(x, s))
+    {
+      this->RefusalOf[x] = BlockReason::BoundaryMinimumPinned;
       continue;
     }
     // Each merge of 2-cells must join two different ones. In a planar complex they always
     // do; a merge inside one 2-cell would leave a 2-cell without corners. That happens only
     // when the two 2-cells on both sides of a loop of s are both pouches of s, which no
     // planar complex has: it flags a wrong sector pairing of stage 1, and the pair is kept.
-    const bool minimum = cps[x].MorseIndex == 0;
     std::array<std::array<Index, 2>, 2> merges;
     const int numberOfMerges = this->CellMerges(s, minimum, side, merges);
     std::array<Index, 2> firstMerge{ cellClass(merges[0][0]), cellClass(merges[0][1]) };
@@ -582,9 +729,21 @@ void MorseSmaleComplexSimplification::ComputeSequence()
       (firstMerge[0] == firstMerge[1] ||
         (numberOfMerges == 2 && (secondMerge[0] == secondMerge[1] || firstMerge == secondMerge))))
     {
+      this->RefusalOf[x] = BlockReason::TwoCellPinched;
       continue;
     }
     const Index survivor = FollowForwarding(forward, this->ArcExtremum[slots[first + 1 - side]]);
+    // Every other saddle of x gets a 1-cell to the survivor, which must be lower than it (a
+    // minimum; higher for a maximum). Popping in order of value difference guarantees this,
+    // unless a 1-cell shorter than its extremum's persistence was passed over above.
+    const bool inverts = std::any_of(saddlesOf[x].begin(), saddlesOf[x].end(), [&](Index other) {
+      return other != s && alive[other] && LowerCriticalPoint(cps[other], cps[survivor]) == minimum;
+    });
+    if (inverts)
+    {
+      this->RefusalOf[x] = BlockReason::InvertedOneCell;
+      continue;
+    }
     threshold = std::max(threshold, candidate.Persistence);
     for (int k = 0; k < numberOfMerges; ++k)
     {
@@ -597,6 +756,7 @@ void MorseSmaleComplexSimplification::ComputeSequence()
     this->Sequence.push_back({ minimum ? cps[x].Id : cps[s].Id, minimum ? cps[s].Id : cps[x].Id,
       cps[survivor].Id, candidate.Persistence, threshold });
     this->Steps.push_back({ s, x, survivor, side });
+    this->CancelledAt[x] = threshold;
     alive[s] = alive[x] = 0;
     forward[x] = survivor;
 
@@ -615,6 +775,21 @@ void MorseSmaleComplexSimplification::ComputeSequence()
       }
     }
     std::vector<Index>().swap(moved);
+    // A boundary minimum pinned by this saddle may be free now: offer its 1-cells again.
+    for (int k = 0; k < 2; ++k)
+    {
+      const Index b = FollowForwarding(forward, this->ArcExtremum[slots[k]]);
+      if (alive[b] && this->OnBoundaryCurve[b] && !pinned(b, InvalidIndex))
+      {
+        for (Index other : saddlesOf[b])
+        {
+          if (alive[other])
+          {
+            push(other, b);
+          }
+        }
+      }
+    }
   }
 }
 
@@ -664,6 +839,20 @@ bool MorseSmaleComplexSimplification::Simplify(
   output.AbsoluteThreshold = percent / 100 * this->MaxPersistence;
   const Index performed = this->NumberOfCancellations(percent);
   output.Cancellations.assign(this->Sequence.begin(), this->Sequence.begin() + performed);
+  // Extrema below the threshold that the rules kept (a replay at percent = 100 keeps none
+  // that any rule allows to go).
+  const double absolute = percent >= 100 ? std::numeric_limits<double>::infinity() : output.AbsoluteThreshold;
+  for (const auto& pair : this->ElderPairs)
+  {
+    const Index x = pair.Extremum;
+    if (pair.Persistence > 0 && pair.Persistence < absolute && !(this->CancelledAt[x] < absolute))
+    {
+      const bool minimum = this->Input.CriticalPoints[x].MorseIndex == 0;
+      const Index xId = this->Input.CriticalPoints[x].Id, sId = this->Input.CriticalPoints[pair.Saddle].Id;
+      output.Blocked.push_back({ minimum ? xId : sId, minimum ? sId : xId, InvalidIndex, pair.Persistence, pair.Persistence });
+      output.BlockReasons.push_back(this->RefusalOf[x]);
+    }
+  }
 
   const MorseSmaleComplex& in = this->Input;
   const auto& cps = in.CriticalPoints;
@@ -676,12 +865,18 @@ bool MorseSmaleComplexSimplification::Simplify(
   std::vector<unsigned char> alive(nCP, 1);
   std::vector<Index> forward(nCP);
   std::iota(forward.begin(), forward.end(), 0);
+  out.BoundaryJunctions = in.BoundaryJunctions;
   for (Index j = 0; j < performed; ++j)
   {
     const Step& step = this->Steps[j];
     alive[step.Saddle] = alive[step.Extremum] = 0;
     forward[step.Extremum] = step.Survivor;
+    if (this->StructuralPair[step.Extremum])
+    {
+      out.BoundaryJunctions.push_back(cps[step.Extremum].Vertex);
+    }
   }
+  std::sort(out.BoundaryJunctions.begin(), out.BoundaryJunctions.end());
   std::vector<Index> position(nCP, InvalidIndex);
   for (Index i = 0; i < nCP; ++i)
   {

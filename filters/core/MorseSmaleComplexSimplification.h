@@ -61,6 +61,22 @@ struct JunctionPoint
   std::vector<Index> Separatrices;    // output 1-cells through it, ascending order
 };
 
+// Why an extremum whose persistence is below the threshold survives it: the last rule that
+// refused a cancellation through a 1-cell reaching its persistence.
+enum class BlockReason : unsigned char
+{
+  NotAdjacent,          // no such 1-cell reached it (its saddle's 1-cell ends at a critical
+                        // point kept in between, such as a boundary minimum)
+  DoubleOneCell,        // two 1-cells join the pair: cancelling would pinch off a region
+  BoundaryInterior,     // one of the two is a critical point of the boundary curve
+  TwoCellPinched,       // a 2-cell would lose all its corners (not planar-consistent input)
+  InvertedOneCell,      // a new 1-cell would join a saddle to a higher minimum (lower maximum)
+  BoundaryMinimumPinned // a boundary minimum whose vertex holds a living interior saddle
+};
+
+// A short name for field data and messages ("boundary-interior", ...).
+const char* BlockReasonName(BlockReason reason);
+
 struct SimplificationOutput
 {
   // The simplified complex, in the form stage 1 produces. Every reference to a critical
@@ -70,6 +86,10 @@ struct SimplificationOutput
   // relative order of the input ones they come from.
   MorseSmaleComplex Complex;
   std::vector<Cancellation> Cancellations; // performed, in hierarchy order
+  // Extrema of persistence (Persistence: their elder-rule pair's) below the threshold that
+  // the rules kept (Survivor unset), in elder-rule order; zero-persistence pairs left out.
+  std::vector<Cancellation> Blocked;
+  std::vector<BlockReason> BlockReasons; // one per Blocked
   std::vector<JunctionPoint> JunctionPoints;
   double AbsoluteThreshold = 0;            // percent / 100 * MaximumPersistence()
 };
@@ -88,6 +108,7 @@ public:
   bool Simplify(double percent, MorseSmaleComplex& output, std::string& error) const;
 
   bool HasHierarchy() const { return this->Computed; }
+  Index NumberOfInputCriticalPoints() const { return static_cast<Index>(this->Input.CriticalPoints.size()); }
   double MaximumPersistence() const { return this->MaxPersistence; }
   // Every cancellation, in order; Threshold is non-decreasing along it.
   const std::vector<Cancellation>& Hierarchy() const { return this->Sequence; }
@@ -98,6 +119,12 @@ public:
 
 private:
   // Where, in the input, each cancellation happens (positions, not stable ids).
+  struct PersistencePair
+  {
+    double Persistence;
+    Index Saddle;   // positions in the input
+    Index Extremum;
+  };
   struct Step
   {
     Index Saddle;
@@ -118,6 +145,7 @@ private:
   bool Check(const MorseSmaleComplex& input, std::string& error) const;
   int CellMerges(Index saddle, bool minimum, int side, std::array<std::array<Index, 2>, 2>& pairs) const;
   void BuildForests();
+  std::vector<PersistencePair> ElderRulePairs(bool minima) const;
   void ComputeSequence();
 
   bool Computed = false;
@@ -125,12 +153,20 @@ private:
   double MaxPersistence = 0;
   std::vector<Cancellation> Sequence;
   std::vector<Step> Steps;
+  // Elder-rule pairs of the input (both kinds), each extremum's ordinary persistence, the
+  // threshold its cancellation needs (infinite if never) and why it was last refused.
+  std::vector<PersistencePair> ElderPairs;
+  std::vector<double> OrdinaryPersistence;
+  std::vector<double> CancelledAt;
+  std::vector<BlockReason> RefusalOf;
 
   // Per critical point (position): for a saddle its descending 1-cells [0..1] and ascending
   // ones [2..3] (InvalidIndex when it has a single ascending one, on the boundary).
   std::vector<std::array<Index, 4>> SaddleArcs;
   std::vector<Index> ArcExtremum; // per input 1-cell: its minimum or maximum (position)
   std::vector<unsigned char> OnBoundaryCurve; // per critical point: a cell of the boundary curve
+  // Per critical point: a boundary minimum cancelled with the interior saddle on its vertex.
+  std::vector<unsigned char> StructuralPair;
   // Per saddle, the input 2-cell at each corner: [2 d + a] for its descending 1-cell d and
   // ascending 1-cell a (0 or 1, in SaddleArcs order); InvalidIndex if the input has none.
   std::vector<std::array<Index, 4>> SaddleCorners;

@@ -1,4 +1,5 @@
 #include "TopologicalSampling.h"
+#include "TopologyVerification.h"
 
 #include "PlanarGeometry.h"
 
@@ -558,6 +559,65 @@ void AddOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult&
   std::move(cells.begin(), cells.end(), std::back_inserter(constraints.OneCells));
 }
 
+// At a boundary junction the boundary 1-cells turn into the domain. Where the sampled valley
+// meets the boundary need not be the junction's own vertex (on terraced data it is often a
+// vertex or two along the boundary), so the wanted boundary minimum is the boundary pit that
+// the junction drains into along the boundary (within `reach`), and the field must fall into
+// the domain there:
+// stage 1 then sees the junction's minimum and saddle on one vertex, and not a boundary pit
+// with its saddle a few vertices away. Where every interior neighbour is above that vertex,
+// the lowest one is brought just below it, by a step clear of rounding (the inward 1-cell goes
+// on down from there). Returns the sampling vertices chosen, one per junction.
+std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, const PlanarScalarField& sampling,
+  const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, double reach,
+  std::vector<double>& values)
+{
+  std::vector<Index> placed;
+  const auto& p = sampling.Points;
+  for (Index junction : complex.BoundaryJunctions)
+  {
+    const Index v = vertexAt(junction);
+    if (v < 0 || v >= mesh.NumberOfVertices() || !mesh.IsBoundaryVertex(v))
+    {
+      continue;
+    }
+    // Down along the boundary from the junction to the boundary pit it falls into (within
+    // reach; the junction itself where it is a pit already).
+    Index chosen = v;
+    for (;;)
+    {
+      Index next = chosen;
+      for (Index w : LinkOf(mesh, chosen))
+      {
+        if (mesh.IsBoundaryVertex(w) && (values[w] < values[next] || (values[w] == values[next] && w < next)) &&
+          std::hypot(p[2 * w] - p[2 * v], p[2 * w + 1] - p[2 * v + 1]) <= reach)
+        {
+          next = w;
+        }
+      }
+      if (next == chosen)
+      {
+        break;
+      }
+      chosen = next;
+    }
+    Index lowest = InvalidIndex;
+    for (Index w : LinkOf(mesh, chosen))
+    {
+      if (!mesh.IsBoundaryVertex(w) && (lowest == InvalidIndex || values[w] < values[lowest]))
+      {
+        lowest = w;
+      }
+    }
+    if (lowest != InvalidIndex && values[lowest] >= values[chosen])
+    {
+      values[lowest] = values[chosen] - 1e-9 * std::max(1.0, std::abs(values[chosen]));
+    }
+    placed.push_back(chosen);
+  }
+  return placed;
+}
+
 TopologicalSamplingReport SampleTopologically(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
   const std::vector<double>& complexPoints, const OneCellSmoothingResult& smoothed, const PlanarScalarField& sampling,
   const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, double spacing,
@@ -580,7 +640,29 @@ TopologicalSamplingReport SampleTopologically(const MorseSmaleComplex& complex, 
       values[v] = cp.Value;
     }
   }
+  // A boundary saddle at a domain corner cannot be sampled there: a corner above both its
+  // boundary neighbours makes the corner triangle a maximum of stage 1 as well. The peak of
+  // the boundary curve is wanted on the higher of the two neighbours instead, one step along
+  // the curve (within the verdict's one spacing).
+  for (Index& v : constraints.BoundaryMaxima)
+  {
+    const std::vector<Index> link = LinkOf(mesh, v);
+    if (std::all_of(link.begin(), link.end(), [&mesh](Index w) { return mesh.IsBoundaryVertex(w); }))
+    {
+      const auto higher = std::max_element(link.begin(), link.end(),
+        [&values](Index a, Index b) { return values[a] < values[b] || (values[a] == values[b] && a < b); });
+      if (higher != link.end())
+      {
+        v = *higher;
+      }
+    }
+  }
   CarveOneCells(sampling, mesh, constraints, spacing, values);
+  for (Index v : PlaceBoundaryJunctions(complex, sampling, mesh, vertexAt, BoundaryJunctionReach * spacing, values))
+  {
+    constraints.BoundaryMinima.push_back(v);
+    constraints.Saddles.push_back(v);
+  }
   TopologicalSamplingReport report = EnforceCriticalVertices(mesh, constraints, values);
   displacedSaddles = RelocateSaddles(sampling, mesh, constraints, spacing * (1 + 1e-9), reach, values, 3, 10, parallel);
   report.ChangedVertices = 0;

@@ -20,6 +20,22 @@ std::vector<CriticalPointLocation> CriticalPointLocations(
     location.Value = cp.Value;
     result.push_back(location);
   }
+  // A boundary junction: the boundary 1-cells fall into it and on into the domain, so it is a
+  // minimum of the field along the boundary curve with a lower interior neighbour, which
+  // stage 1's boundary rule extracts as a minimum and a saddle on that vertex.
+  for (Index v : complex.BoundaryJunctions)
+  {
+    for (int morseIndex : { 0, 1 })
+    {
+      CriticalPointLocation location;
+      location.MorseIndex = morseIndex;
+      location.Position[0] = points[2 * static_cast<std::size_t>(v)];
+      location.Position[1] = points[2 * static_cast<std::size_t>(v) + 1];
+      location.Value = std::nan("");
+      location.Reach = BoundaryJunctionReach;
+      result.push_back(location);
+    }
+  }
   return result;
 }
 
@@ -47,7 +63,7 @@ TopologyComparison CompareCriticalPoints(const std::vector<CriticalPointLocation
       }
       const double d = std::hypot(expected[e].Position[0] - found[f].Position[0],
         expected[e].Position[1] - found[f].Position[1]);
-      if (d <= tolerance)
+      if (d <= tolerance * expected[e].Reach)
       {
         pairs.emplace_back(d, e, f);
       }

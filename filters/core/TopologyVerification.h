@@ -16,9 +16,18 @@ struct CriticalPointLocation
   int MorseIndex = 0;
   double Position[2] = { 0, 0 };
   double Value = 0;
+  // How far from Position it may be found, in units of the comparison's tolerance: 1 for the
+  // complex's nodes; more for the pair stage 1 puts where the boundary 1-cells of a boundary
+  // junction turn into the domain (no critical point of the field itself: its place along
+  // the boundary is wherever the sampled valley meets it).
+  double Reach = 1;
 };
 
-// The critical points of `complex`, placed at their vertices of `points` (x, y per vertex).
+// How far (in tolerances) from a boundary junction its stage-1 pair may lie along the boundary.
+constexpr double BoundaryJunctionReach = 3;
+
+// The critical points of `complex`, placed at their vertices of `points` (x, y per vertex),
+// and a minimum and a saddle at each of its boundary junctions (MorseSmaleComplex).
 std::vector<CriticalPointLocation> CriticalPointLocations(
   const MorseSmaleComplex& complex, const std::vector<double>& points);
 
