@@ -845,7 +845,7 @@ bool MorseSmaleComplexSimplification::Simplify(
   for (const auto& pair : this->ElderPairs)
   {
     const Index x = pair.Extremum;
-    if (pair.Persistence > 0 && pair.Persistence < absolute && !(this->CancelledAt[x] < absolute))
+    if (pair.Persistence < absolute && !(this->CancelledAt[x] < absolute))
     {
       const bool minimum = this->Input.CriticalPoints[x].MorseIndex == 0;
       const Index xId = this->Input.CriticalPoints[x].Id, sId = this->Input.CriticalPoints[pair.Saddle].Id;

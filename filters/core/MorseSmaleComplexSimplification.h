@@ -7,13 +7,18 @@
 // of x). Every 1-cell keeps its saddle, so this amounts to "every 1-cell that ended at x now
 // ends at x'": x' inherits x's region, 1-cells and 2-cells.
 // A pair is cancellable (checked when it is popped, in order of increasing persistence) when
-// neither point is cancelled yet, exactly one 1-cell joins them, both or neither lie on the
-// boundary curve (boundary minima and saddles of boundary edges; see the .cxx for why), and
-// no 2-cell would lose all its corners (only stage-1 inputs that are not planar-consistent
-// trigger this last rule).
+// neither point is cancelled yet, the 1-cell is at least as long in value as the extremum's
+// ordinary persistence (the elder rule on the input complex: sublevel sets for minima,
+// superlevel sets for maxima; so no extremum at or above a threshold is ever cancelled below
+// it), exactly one 1-cell joins them, both or neither lie on the boundary curve (boundary
+// minima and saddles of boundary edges; except a boundary junction, see the .cxx), a boundary
+// minimum is not held by a living interior saddle on the boundary, no new 1-cell would be
+// inverted, and no 2-cell would lose all its corners (only stage-1 inputs that are not
+// planar-consistent trigger this last rule). docs/Simplification.md says it in words.
 //
 // Threshold semantics (saved states depend on them; never change them):
-//  * persistence of a pair = |f(saddle) - f(extremum)|;
+//  * persistence of a cancellation = |f(saddle) - f(extremum)| along its 1-cell (at least the
+//    extremum's ordinary persistence);
 //  * MaximumPersistence() = (largest critical value) - (smallest critical value) of the
 //    complex given to ComputeHierarchy; for a complex extracted from a field this is the
 //    field's range max f - min f, since the global extrema are always critical;
@@ -71,7 +76,7 @@ enum class BlockReason : unsigned char
   BoundaryInterior,     // one of the two is a critical point of the boundary curve
   TwoCellPinched,       // a 2-cell would lose all its corners (not planar-consistent input)
   InvertedOneCell,      // a new 1-cell would join a saddle to a higher minimum (lower maximum)
-  BoundaryMinimumPinned // a boundary minimum whose vertex holds a living interior saddle
+  BoundaryMinimumPinned // a boundary minimum held by a living interior saddle on the boundary
 };
 
 // A short name for field data and messages ("boundary-interior", ...).
@@ -87,7 +92,7 @@ struct SimplificationOutput
   MorseSmaleComplex Complex;
   std::vector<Cancellation> Cancellations; // performed, in hierarchy order
   // Extrema of persistence (Persistence: their elder-rule pair's) below the threshold that
-  // the rules kept (Survivor unset), in elder-rule order; zero-persistence pairs left out.
+  // the rules kept (Survivor unset), in elder-rule order.
   std::vector<Cancellation> Blocked;
   std::vector<BlockReason> BlockReasons; // one per Blocked
   std::vector<JunctionPoint> JunctionPoints;
@@ -118,13 +123,14 @@ public:
   ProgressHooks Hooks;
 
 private:
-  // Where, in the input, each cancellation happens (positions, not stable ids).
+  // An elder-rule pair: the saddle where the extremum's component dies (positions).
   struct PersistencePair
   {
     double Persistence;
-    Index Saddle;   // positions in the input
+    Index Saddle;
     Index Extremum;
   };
+  // Where, in the input, each cancellation happens (positions, not stable ids).
   struct Step
   {
     Index Saddle;
