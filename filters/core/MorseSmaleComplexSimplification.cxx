@@ -871,7 +871,7 @@ bool MorseSmaleComplexSimplification::Simplify(
     const Step& step = this->Steps[j];
     alive[step.Saddle] = alive[step.Extremum] = 0;
     forward[step.Extremum] = step.Survivor;
-    if (this->StructuralPair[step.Extremum])
+    if (this->StructuralPair[step.Extremum] && cps[step.Saddle].Vertex == cps[step.Extremum].Vertex)
     {
       out.BoundaryJunctions.push_back(cps[step.Extremum].Vertex);
     }
