@@ -559,13 +559,14 @@ void AddOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult&
   std::move(cells.begin(), cells.end(), std::back_inserter(constraints.OneCells));
 }
 
+namespace
+{
 // At a boundary junction the boundary 1-cells turn into the domain. Where the sampled valley
 // meets the boundary need not be the junction's own vertex (on terraced data it is often a
 // vertex or two along the boundary), so the wanted boundary minimum is the boundary pit that
 // the junction drains into along the boundary (within `reach`), and the field must fall into
-// the domain there:
-// stage 1 then sees the junction's minimum and saddle on one vertex, and not a boundary pit
-// with its saddle a few vertices away. Where every interior neighbour is above that vertex,
+// the domain there: stage 1 then sees the junction's minimum and saddle on one vertex, and not
+// a boundary pit with its saddle a few vertices away. Where every interior neighbour is above that vertex,
 // the lowest one is brought just below it, by a step clear of rounding (the inward 1-cell goes
 // on down from there). Returns the sampling vertices chosen, one per junction.
 std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, const PlanarScalarField& sampling,
@@ -617,6 +618,7 @@ std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, cons
   }
   return placed;
 }
+} // namespace
 
 TopologicalSamplingReport SampleTopologically(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
   const std::vector<double>& complexPoints, const OneCellSmoothingResult& smoothed, const PlanarScalarField& sampling,

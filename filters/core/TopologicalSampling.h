@@ -103,7 +103,11 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
 // `complexPoints` (x, y per vertex of `complexMesh`) tells where the nodes are: on a sampling
 // whose vertices do not include them (an image resampled over a triangle mesh), the vertex
 // nearest each node first takes the node's critical value, so that the wanted extremum is
-// where the floods expect it (F o Phi peaks at the node, not at the vertex).
+// where the floods expect it (F o Phi peaks at the node, not at the vertex). At each of the
+// complex's boundary junctions the wanted boundary pit is where the junction drains along the
+// boundary (within 3 spacings), with the field falling into the domain there; a wanted
+// boundary saddle at a domain corner is wanted on the higher corner neighbour (a corner above
+// both its neighbours is also a maximum of stage 1).
 TopologicalSamplingReport SampleTopologically(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
   const std::vector<double>& complexPoints, const OneCellSmoothingResult& smoothed, const PlanarScalarField& sampling,
   const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, double spacing,
