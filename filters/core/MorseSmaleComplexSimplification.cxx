@@ -550,7 +550,7 @@ void MorseSmaleComplexSimplification::ComputeSequence()
   // on the minimum's own vertex is its zero-persistence partner, cancelled with it as a
   // boundary junction unless it also merges maxima.
   std::vector<std::vector<Index>> pinnedBy(nCP);
-  this->StructuralPair.assign(nCP, 0);
+  std::vector<unsigned char> structuralPair(nCP, 0);
   for (Index e = 0; e < nCP; ++e)
   {
     if (cps[e].MorseIndex != 1 || this->OnBoundaryCurve[e] || !cps[e].OnBoundary)
@@ -565,7 +565,7 @@ void MorseSmaleComplexSimplification::ComputeSequence()
         pinnedBy[b].push_back(e);
         if (cps[b].Vertex == cps[e].Vertex && persistencePartner[b] == e && !mergesMaxima[e])
         {
-          this->StructuralPair[b] = 1;
+          structuralPair[b] = 1;
         }
       }
     }
@@ -695,7 +695,7 @@ void MorseSmaleComplexSimplification::ComputeSequence()
     // would lose a minimum (or saddle) without its partner, so it would no longer be made of
     // 1-cells joining boundary minima and saddles, and the 2-cells along it would not close.
     // The one exception is a boundary junction (above): its 1-cells go on into the domain.
-    const bool junction = this->StructuralPair[x] && cps[s].Vertex == cps[x].Vertex;
+    const bool junction = structuralPair[x] && cps[s].Vertex == cps[x].Vertex;
     if (this->OnBoundaryCurve[s] != this->OnBoundaryCurve[x] && !junction)
     {
       this->RefusalOf[x] = BlockReason::BoundaryInterior;
@@ -871,7 +871,8 @@ bool MorseSmaleComplexSimplification::Simplify(
     const Step& step = this->Steps[j];
     alive[step.Saddle] = alive[step.Extremum] = 0;
     forward[step.Extremum] = step.Survivor;
-    if (this->StructuralPair[step.Extremum] && cps[step.Saddle].Vertex == cps[step.Extremum].Vertex)
+    // The only boundary-interior cancellations ComputeSequence performs are boundary junctions.
+    if (this->OnBoundaryCurve[step.Extremum] != this->OnBoundaryCurve[step.Saddle])
     {
       out.BoundaryJunctions.push_back(cps[step.Extremum].Vertex);
     }

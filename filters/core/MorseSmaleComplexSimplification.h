@@ -171,8 +171,6 @@ private:
   std::vector<std::array<Index, 4>> SaddleArcs;
   std::vector<Index> ArcExtremum; // per input 1-cell: its minimum or maximum (position)
   std::vector<unsigned char> OnBoundaryCurve; // per critical point: a cell of the boundary curve
-  // Per critical point: a boundary minimum cancelled with the interior saddle on its vertex.
-  std::vector<unsigned char> StructuralPair;
   // Per saddle, the input 2-cell at each corner: [2 d + a] for its descending 1-cell d and
   // ascending 1-cell a (0 or 1, in SaddleArcs order); InvalidIndex if the input has none.
   std::vector<std::array<Index, 4>> SaddleCorners;

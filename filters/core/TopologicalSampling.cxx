@@ -566,9 +566,10 @@ namespace
 // vertex or two along the boundary), so the wanted boundary minimum is the boundary pit that
 // the junction drains into along the boundary (within `reach`), and the field must fall into
 // the domain there: stage 1 then sees the junction's minimum and saddle on one vertex, and not
-// a boundary pit with its saddle a few vertices away. Where every interior neighbour is above that vertex,
-// the lowest one is brought just below it, by a step clear of rounding (the inward 1-cell goes
-// on down from there). Returns the sampling vertices chosen, one per junction.
+// a boundary pit with its saddle a few vertices away. Where every interior neighbour is above
+// that vertex, the lowest one is brought just below it, by a step clear of rounding (the
+// inward 1-cell goes on down from there). Returns the sampling vertices chosen, one per
+// junction.
 std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, const PlanarScalarField& sampling,
   const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, double reach,
   std::vector<double>& values)
@@ -590,7 +591,7 @@ std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, cons
       Index next = chosen;
       for (Index w : LinkOf(mesh, chosen))
       {
-        if (mesh.IsBoundaryVertex(w) && (values[w] < values[next] || (values[w] == values[next] && w < next)) &&
+        if (mesh.IsBoundaryVertex(w) && Key{ values[w], w } < Key{ values[next], next } &&
           std::hypot(p[2 * w] - p[2 * v], p[2 * w + 1] - p[2 * v + 1]) <= reach)
         {
           next = w;
@@ -652,7 +653,7 @@ TopologicalSamplingReport SampleTopologically(const MorseSmaleComplex& complex, 
     if (std::all_of(link.begin(), link.end(), [&mesh](Index w) { return mesh.IsBoundaryVertex(w); }))
     {
       const auto higher = std::max_element(link.begin(), link.end(),
-        [&values](Index a, Index b) { return values[a] < values[b] || (values[a] == values[b] && a < b); });
+        [&values](Index a, Index b) { return Key{ values[a], a } < Key{ values[b], b }; });
       if (higher != link.end())
       {
         v = *higher;
