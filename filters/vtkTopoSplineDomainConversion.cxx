@@ -62,10 +62,12 @@ vtkTopoSplineDomainConversion::DomainPlane vtkTopoSplineDomainConversion::PlaneO
   DomainPlane embedding;
   if (auto* image = vtkImageData::SafeDownCast(domain))
   {
-    int dims[3];
+    int dims[3], extent[6];
     image->GetDimensions(dims);
-    double origin[3];
+    image->GetExtent(extent);
+    double origin[3], spacing[3];
     image->GetOrigin(origin);
+    image->GetSpacing(spacing);
     for (int w = 2; w >= 0; --w)
     {
       if (dims[w] == 1)
@@ -73,7 +75,8 @@ vtkTopoSplineDomainConversion::DomainPlane vtkTopoSplineDomainConversion::PlaneO
         embedding.W = w;
         embedding.U = w == 0 ? 1 : 0;
         embedding.V = w == 2 ? 1 : 2;
-        embedding.WValue = origin[w];
+        // the layer's coordinate: the extent need not start at 0
+        embedding.WValue = origin[w] + extent[2 * w] * spacing[w];
         break;
       }
     }
@@ -220,27 +223,53 @@ bool ToPlanarScalarField(vtkDataSet* input, vtkDataArray* scalars, topospline::P
     }
     const int n0 = dims[axes[0]], n1 = dims[axes[1]];
     double origin[3], spacing[3];
+    int extent[6];
     image->GetOrigin(origin);
     image->GetSpacing(spacing);
-    const bool axisAligned = image->GetDirectionMatrix()->IsIdentity();
+    image->GetExtent(extent);
+    if (!image->GetDirectionMatrix()->IsIdentity())
+    {
+      // A rotated image is not in the coordinate plane the outputs are written in.
+      error = "the image's direction matrix is not the identity; TopoSpline needs an axis-aligned image "
+              "(resample it, e.g. with Resample To Image, or clear its direction)";
+      return false;
+    }
+    for (const int a : axes)
+    {
+      if (!std::isfinite(origin[a]) || !std::isfinite(spacing[a]) || !(spacing[a] > 0))
+      {
+        error = "the image's spacing (" + std::to_string(spacing[a]) + ") or origin (" + std::to_string(origin[a]) +
+          ") along axis " + std::to_string(a) + " is not a finite positive spacing and finite origin";
+        return false;
+      }
+      // Coordinates are subtracted all along the pipeline: with an origin 1e12 spacings away,
+      // differences of neighbouring points keep fewer than 4 significant digits.
+      const double farthest = std::max(std::abs(origin[a] + extent[2 * a] * spacing[a]),
+        std::abs(origin[a] + extent[2 * a + 1] * spacing[a]));
+      if (farthest > 1e12 * spacing[a])
+      {
+        error = "the image's coordinates along axis " + std::to_string(a) + " reach " + std::to_string(farthest) +
+          ", more than 1e12 spacings (" + std::to_string(spacing[a]) +
+          ") from 0: neighbouring points cannot be told apart precisely; shift the origin";
+        return false;
+      }
+    }
+    const double ratio = spacing[axes[0]] / spacing[axes[1]];
+    if (ratio > 1e4 || ratio < 1e-4)
+    {
+      error = "the image's spacings differ by a factor above 1e4 (" + std::to_string(spacing[axes[0]]) + " and " +
+        std::to_string(spacing[axes[1]]) + "); the reconstruction's geometry cannot be resolved; rescale one axis";
+      return false;
+    }
     vtkSMPTools::For(0, n1, [&](vtkIdType begin, vtkIdType end) {
       for (vtkIdType b = begin; b < end; ++b)
       {
         for (vtkIdType a = 0; a < n0; ++a)
         {
           const vtkIdType id = b * n0 + a;
-          double p[3];
-          if (axisAligned)
-          {
-            p[axes[0]] = origin[axes[0]] + a * spacing[axes[0]];
-            p[axes[1]] = origin[axes[1]] + b * spacing[axes[1]];
-          }
-          else
-          {
-            image->GetPoint(id, p);
-          }
-          field.Points[2 * id] = p[axes[0]];
-          field.Points[2 * id + 1] = p[axes[1]];
+          // the extent need not start at 0
+          field.Points[2 * id] = origin[axes[0]] + (extent[2 * axes[0]] + a) * spacing[axes[0]];
+          field.Points[2 * id + 1] = origin[axes[1]] + (extent[2 * axes[1]] + b) * spacing[axes[1]];
         }
       }
     });

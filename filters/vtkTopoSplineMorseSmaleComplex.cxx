@@ -4,6 +4,7 @@
 
 #include "MorseSmaleComplexExtraction.h" // core
 
+#include <vtkCompositeDataSet.h>
 #include <vtkDataArray.h>
 #include <vtkDataObject.h>
 #include <vtkDataSet.h>
@@ -27,6 +28,10 @@ vtkTopoSplineMorseSmaleComplex::vtkTopoSplineMorseSmaleComplex()
 int vtkTopoSplineMorseSmaleComplex::FillInputPortInformation(int, vtkInformation* info)
 {
   vtkTopoSplineDomainConversion::AcceptPlanarDomains(info);
+  // Taken whole, so that RequestData can say what is wrong with it: otherwise the pipeline
+  // would run the filter once per block and the next filter would get a multiblock of
+  // complexes it cannot read.
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkCompositeDataSet");
   return 1;
 }
 
@@ -44,6 +49,14 @@ int vtkTopoSplineMorseSmaleComplex::RequestData(
   vtkLogScopeFunction(TRACE);
   vtkDataSet* input = vtkDataSet::GetData(inputVector[0], 0);
   vtkMultiBlockDataSet* output = vtkMultiBlockDataSet::GetData(outputVector, 0);
+  if (vtkCompositeDataSet::GetData(inputVector[0], 0))
+  {
+    vtkErrorMacro("Morse-Smale Complex: the input is a composite data set ("
+      << vtkCompositeDataSet::GetData(inputVector[0], 0)->GetClassName()
+      << "); the complex needs one 2D image or triangle mesh: pick one block (Extract Block) or merge "
+         "them (Merge Blocks) first.");
+    return 1;
+  }
   if (!input || !output)
   {
     vtkErrorMacro("Missing input or output.");

@@ -27,6 +27,7 @@
 #include <vtkSMPTools.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkStringArray.h>
+#include <vtksys/SystemInformation.hxx>
 #include <vtkUnstructuredGrid.h>
 
 #include <algorithm>
@@ -370,9 +371,9 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
     vtkErrorMacro("Reconstruct 2-Cells: Boundary Samples must be in [1, 1000], not " << this->BoundarySamples << ".");
     return 1;
   }
-  if (this->OutputResolution < 1 || this->OutputResolution > 64)
+  if (this->OutputResolution < 1 || this->OutputResolution > 16)
   {
-    vtkErrorMacro("Reconstruct 2-Cells: Output Resolution must be in [1, 64], not " << this->OutputResolution << ".");
+    vtkErrorMacro("Reconstruct 2-Cells: Output Resolution must be in [1, 16], not " << this->OutputResolution << ".");
     return 1;
   }
   std::string error;
@@ -403,6 +404,23 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
   {
     vtkErrorMacro("Reconstruct 2-Cells: " << error << ".");
     return 1;
+  }
+  if (this->OutputResolution > 1)
+  {
+    // Measured: about 200 bytes per vertex of the finer sampling (values, mask, its critical
+    // point check) on top of the pipeline; refused before any of it is allocated.
+    const double fineVertices =
+      static_cast<double>(domain->GetNumberOfPoints()) * this->OutputResolution * this->OutputResolution;
+    const double needed = 260.0 * fineVertices;
+    vtksys::SystemInformation system;
+    const double available = 1024.0 * static_cast<double>(system.GetAvailablePhysicalMemory()) * 1024.0;
+    if (available > 0 && needed > 0.8 * available)
+    {
+      vtkErrorMacro("Reconstruct 2-Cells: Output Resolution " << this->OutputResolution << " samples "
+                    << fineVertices << " points and needs about " << needed / 1e9 << " GB; this machine has "
+                    << available / 1e9 << " GB available. Choose a lower Output Resolution.");
+      return 1;
+    }
   }
 
   // The 2-cells, in parallel.
@@ -698,7 +716,9 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
     const auto verifyStart = std::chrono::steady_clock::now();
     const auto expected = topospline::CriticalPointLocations(complex, domainField.Points);
     const double tolerance = gridSpacing * (1 + 1e-9);
-    bool verified = true;
+    // The verdict covers the whole reconstruction: a failed 2-cell or a vertex outside every
+    // reconstructed cell keeps input values, which no critical-point count can vouch for.
+    bool verified = report.FailedCells == 0 && missed == 0;
     std::vector<topospline::CriticalPointLocation> spurious, missing;
     // `judged`: the check is on an output (the raw sampling before topological sampling is
     // only reported).

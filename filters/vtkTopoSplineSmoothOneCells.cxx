@@ -124,9 +124,9 @@ int vtkTopoSplineSmoothOneCells::RequestData(
     // that was already reported. Nothing to do.
     return 1;
   }
-  if (this->CurveSegments < 2 || this->CurveSegments > topospline::MonotoneBSplineFit::MaximumSegments)
+  if (this->CurveSegments < 2 || this->CurveSegments > topospline::OneCellSmoothing::MaximumCurveSegments)
   {
-    vtkErrorMacro("Smooth 1-Cells: Curve Segments must be in [2, " << topospline::MonotoneBSplineFit::MaximumSegments
+    vtkErrorMacro("Smooth 1-Cells: Curve Segments must be in [2, " << topospline::OneCellSmoothing::MaximumCurveSegments
                                                                    << "], not " << this->CurveSegments << ".");
     return 1;
   }
@@ -174,6 +174,14 @@ int vtkTopoSplineSmoothOneCells::RequestData(
       }
       return 1;
     }
+  }
+  if (result.SpreadCriticalValues > 0)
+  {
+    // Not an error: equal or nearly equal critical values (a plateau, a constant field) that
+    // the complex orders by point id get numbers that strictly increase.
+    vtkLog(INFO, "Smooth 1-Cells: " << result.SpreadCriticalValues
+                                    << " critical value(s) raised by at most " << result.MaximumSpread
+                                    << " so that values strictly increase along every 1-cell.");
   }
   if (result.RemainingCrossings > 0)
   {
@@ -325,6 +333,8 @@ int vtkTopoSplineSmoothOneCells::RequestData(
   AddFieldNumbers(fd, "L1Error", { l1 });
   AddFieldNumbers(fd, "UnconstrainedL1Error", { free });
   AddFieldNumbers(fd, "JunctionMargin", { result.JunctionMargin });
+  AddFieldNumbers(fd, "SpreadCriticalValues", { static_cast<double>(result.SpreadCriticalValues) });
+  AddFieldNumbers(fd, "MaximumSpread", { result.MaximumSpread });
   this->UpdateProgress(1.0);
   return 1;
 }

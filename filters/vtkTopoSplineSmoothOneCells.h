@@ -30,7 +30,7 @@ public:
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
   //@{
-  /** k, cubic Bezier segments per piece of 1-cell (the paper uses 4 and 7). In [2, 1000]. */
+  /** k, cubic Bezier segments per piece of 1-cell (the paper uses 4 and 7). In [2, 30]. */
   vtkSetMacro(CurveSegments, int);
   vtkGetMacro(CurveSegments, int);
   //@}

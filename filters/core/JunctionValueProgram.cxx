@@ -20,9 +20,11 @@ std::string DescribeNode(const std::vector<JunctionValueNode>& nodes, Index n)
 } // namespace
 
 //------------------------------------------------------------------------------
-bool JunctionValueProgram::Solve(const std::vector<JunctionValueNode>& nodes,
+bool JunctionValueProgram::Solve(const std::vector<JunctionValueNode>& originalNodes,
   const std::vector<std::array<Index, 2>>& lowerThan, std::vector<double>& values, std::string& error)
 {
+  std::vector<JunctionValueNode> nodes = originalNodes; // fixed values may be spread below
+  this->FoundCycle = false;
   if (!(this->MarginFraction > 0) || !(this->MarginSafety > 0 && this->MarginSafety < 1))
   {
     error = "the junction program needs MarginFraction > 0 and MarginSafety in (0, 1)";
@@ -101,12 +103,34 @@ bool JunctionValueProgram::Solve(const std::vector<JunctionValueNode>& nodes,
     }
     if (static_cast<Index>(order.size()) != count)
     {
-      Index blocked = 0;
-      while (inDegree[blocked] == 0)
+      // Every leftover node has a leftover predecessor: walking backwards from one must
+      // repeat a node, and the walk from there is a cycle. Named in the message.
+      std::vector<Index> predecessor(count, InvalidIndex);
+      for (const auto& r : relations)
       {
-        ++blocked;
+        if (inDegree[r[0]] > 0 && inDegree[r[1]] > 0)
+        {
+          predecessor[r[1]] = r[0];
+        }
       }
-      error = "the 'lower than' relations of the 1-cells contain a cycle (reaching " + DescribeNode(nodes, blocked) +
+      Index at = 0;
+      while (inDegree[at] == 0)
+      {
+        ++at;
+      }
+      std::vector<char> seen(count, 0);
+      while (!seen[at])
+      {
+        seen[at] = 1;
+        at = predecessor[at];
+      }
+      std::string cycle = DescribeNode(nodes, at);
+      for (Index n = predecessor[at]; n != at; n = predecessor[n])
+      {
+        cycle = DescribeNode(nodes, n) + " < " + cycle;
+      }
+      this->FoundCycle = true;
+      error = "the 'lower than' relations of the 1-cells contain a cycle (" + cycle + " < " + DescribeNode(nodes, at) +
         "): no strictly monotone values exist";
       return false;
     }
@@ -129,6 +153,65 @@ bool JunctionValueProgram::Solve(const std::vector<JunctionValueNode>& nodes,
     // All values equal: fall back to their magnitude (or 1) as the scale of the margin.
     range = std::max(std::abs(minimumValue), 1.0);
     minimumValue = count > 0 ? minimumValue : 0.0;
+  }
+
+  // Value spreading. The complex orders equal values by vertex id (simulation of simplicity),
+  // but the smoothed 1-cells need numbers that strictly increase, with room for k strictly
+  // increasing Bezier ordinates in double precision. Where a chain of d relations from a fixed
+  // node to another rises by less than d * gap (equal critical values on a plateau or a
+  // constant field, values a few ulps apart in noise), the higher fixed values are raised to
+  // the smallest values that leave that room, in topological order; nothing moves elsewhere.
+  double gap = 0;
+  {
+    double scale = 0;
+    for (const auto& node : nodes)
+    {
+      scale = std::max(scale, std::abs(node.Value));
+    }
+    if (count > 0)
+    {
+      scale = std::max(scale, maximumValue - minimumValue);
+    }
+    gap = SpreadingGap * (scale > 0 ? scale : 1.0);
+    // floor: the least value v can take with room below it; reached: the highest original
+    // fixed value below v (ties are spread, an inversion is an error further down).
+    std::vector<double> floor(count, -std::numeric_limits<double>::infinity());
+    std::vector<double> reached(count, -std::numeric_limits<double>::infinity());
+    this->SpreadCriticalValues = 0;
+    this->MaximumSpread = 0;
+    for (const Index v : order)
+    {
+      if (nodes[v].Fixed && reached[v] > nodes[v].Value)
+      {
+        break; // fixed values in the wrong order: reported by the chain check below
+      }
+      const double below = nodes[v].Fixed ? nodes[v].Value : reached[v];
+      for (Index e = offsets[v]; e < offsets[v + 1]; ++e)
+      {
+        reached[successors[e]] = std::max(reached[successors[e]], below);
+      }
+      if (nodes[v].Fixed && floor[v] > nodes[v].Value)
+      {
+        this->MaximumSpread = std::max(this->MaximumSpread, floor[v] - nodes[v].Value);
+        ++this->SpreadCriticalValues;
+        nodes[v].Value = floor[v];
+      }
+      // a free node can take any value above its floor: its successors only need room above that
+      const double level = nodes[v].Fixed ? nodes[v].Value : floor[v];
+      for (Index e = offsets[v]; e < offsets[v + 1]; ++e)
+      {
+        floor[successors[e]] = std::max(floor[successors[e]], level + gap);
+      }
+    }
+    if (this->SpreadCriticalValues > 0)
+    {
+      maximumValue = -std::numeric_limits<double>::infinity();
+      for (const auto& node : nodes)
+      {
+        maximumValue = std::max(maximumValue, node.Value);
+      }
+      range = std::max(range, maximumValue - minimumValue);
+    }
   }
 
   // Chains between fixed nodes through free ones: d relations from f_a to f_b need
@@ -187,7 +270,10 @@ bool JunctionValueProgram::Solve(const std::vector<JunctionValueNode>& nodes,
       }
     }
   }
-  const double margin = std::min(this->MarginFraction * range, this->MarginSafety * tightestRatio);
+  // At least half the spreading gap: a field whose whole range is a few ulps of its values
+  // (near-constant) still needs steps the fits can resolve; the chains allow it (>= gap).
+  const double margin =
+    std::min(std::max(this->MarginFraction * range, 0.5 * gap), this->MarginSafety * tightestRatio);
   if (!(margin > 0) || !std::isfinite(margin))
   {
     error = "the junction program found no positive margin for the value range " + std::to_string(range);
@@ -292,10 +378,10 @@ bool JunctionValueProgram::Solve(const std::vector<JunctionValueNode>& nodes,
         }
       }
     }
-    glp_term_out(GLP_OFF);
-    if (!program.solve())
+    std::string solverError;
+    if (!SolveLinearProgram(program, solverError))
     {
-      error = "the linear program of the junction values failed: " + program.error_message();
+      error = "the linear program of the junction values failed: " + solverError;
       return false;
     }
     const std::vector<double>& solution = program.solution();

@@ -36,6 +36,12 @@ public:
   // with room to spare; Margin below reports the value used.
   double MarginFraction = 1e-3;
   double MarginSafety = 0.5;
+  // Fixed values closer than this fraction of the value scale (max of the range and of the
+  // largest magnitude) per relation along a chain are spread apart (see Solve). 1e-11 leaves
+  // the fits' smallest steps (MonotoneBSplineFit: 0.01 of a piece's rise / k, k <= 30) several
+  // ulps apart, and keeps the raise well inside stage 4's consistency tolerance (1e-9 of a
+  // cell's range): 1e-9 broke the paper's trigonometric field, whose extrema tie.
+  static constexpr double SpreadingGap = 1e-11;
 
   // Relations only couple the free nodes of one connected component: by default every
   // component is its own (small) linear program and a lone junction is solved in closed
@@ -43,15 +49,21 @@ public:
   // of the single global program; false builds that single program instead (for testing).
   bool SplitIntoComponents = true;
 
-  // values receives one value per node (fixed nodes keep theirs exactly). Returns false
-  // with a message when the relations are not satisfiable: a cycle, a self relation, or
-  // fixed nodes in the wrong order (or equal) along a chain of relations, an index out of
-  // range, non-finite values, or a solver failure.
+  // values receives one value per node. Fixed nodes keep theirs exactly, unless two of them
+  // are closer along a chain of d relations than d * SpreadingGap of the value scale (equal
+  // values on plateaus and constant fields, which the complex orders by vertex id): the higher
+  // ones are then raised just enough (SpreadCriticalValues, MaximumSpread). Returns false with
+  // a message when the relations are not satisfiable: a cycle, a self relation, fixed nodes
+  // in the wrong order along a chain (lower by more than the spreading allows), an index out
+  // of range, non-finite values, or a solver failure.
   bool Solve(const std::vector<JunctionValueNode>& nodes, const std::vector<std::array<Index, 2>>& lowerThan,
     std::vector<double>& values, std::string& error);
 
   // About the last successful Solve.
   double Margin = 0;
+  bool FoundCycle = false; // the last Solve failed on a cycle of relations
+  int SpreadCriticalValues = 0; // fixed values raised by the value spreading
+  double MaximumSpread = 0;     // the largest such raise
   double TotalChange = 0;   // sum over free nodes of |x_j - f_j|
   double MaximumChange = 0; // max over free nodes of |x_j - f_j|
   int NumberOfPrograms = 0; // linear programs solved (components with more than one node)

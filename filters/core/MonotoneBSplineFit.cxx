@@ -119,10 +119,10 @@ bool SolvePrimal(const L1Program& l1, std::vector<double>& x, int& variables, in
   }
   variables = static_cast<int>(program.number_of_variables());
   constraints = static_cast<int>(program.number_of_constraints());
-  glp_term_out(GLP_OFF);
-  if (!program.solve())
+  std::string solverError;
+  if (!SolveLinearProgram(program, solverError))
   {
-    error = "the linear program of the height fit failed: " + program.error_message();
+    error = "the linear program of the height fit failed: " + solverError;
     return false;
   }
   x.resize(l1.Unknowns);
@@ -220,8 +220,8 @@ bool SolveThroughDual(const L1Program& l1, std::vector<double>& x, int& variable
   }
   variables = static_cast<int>(program.number_of_variables());
   constraints = static_cast<int>(program.number_of_constraints());
-  glp_term_out(GLP_OFF);
-  if (!program.solve())
+  std::string ignored;
+  if (!SolveLinearProgram(program, ignored))
   {
     return false; // leave it to the primal
   }

@@ -417,7 +417,11 @@ bool MonotoneSibsonSurface::Build(
     }
   }
   const double range = highest - lowest;
-  const double allowedMismatch = options.ConsistencyTolerance * (range > 0 ? range : 1.0);
+  // Relative to the cell's range, but never below rounding: a nearly flat cell far from 0
+  // (a constant field at 7.25 spread by 1e-11) has a range of a few thousand ulps only.
+  const double magnitude = std::max(std::abs(lowest), std::abs(highest));
+  const double allowedMismatch = std::max(options.ConsistencyTolerance * (range > 0 ? range : 1.0),
+    64 * std::numeric_limits<double>::epsilon() * magnitude);
 
   this->N = n;
   const int nodeCount = (n + 1) * (n + 1);

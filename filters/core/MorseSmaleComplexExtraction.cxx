@@ -173,7 +173,8 @@ bool MorseSmaleComplexExtraction::Extract(
   {
     this->Mesh.BuildGrid(field.GridDimensions[0], field.GridDimensions[1], this->Parallel);
   }
-  else if (!this->Mesh.Build(nV, field.Triangles, this->Parallel, error))
+  else if (!this->Mesh.Build(nV, field.Triangles, this->Parallel, error) ||
+    (!field.Points.empty() && !this->Mesh.CheckPlanarDisk(field.Points, error)))
   {
     return false;
   }

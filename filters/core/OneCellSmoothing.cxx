@@ -45,6 +45,44 @@ bool SegmentsIntersect(const Segment2& s, const Segment2& t)
   const double d3 = Cross(t.A, t.B, s.A), d4 = Cross(t.A, t.B, s.B);
   return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
 }
+// Keeps, of the cuts of one 1-cell (source first, destination last), the longest chain whose
+// nodes rise strictly in (value, node index) from the source to the destination.
+void KeepRisingCuts(std::vector<std::pair<long, Index>>& at, const std::vector<SmoothingNode>& nodes)
+{
+  auto below = [&nodes](Index x, Index y) {
+    return nodes[x].Value != nodes[y].Value ? nodes[x].Value < nodes[y].Value : x < y;
+  };
+  const size_t m = at.size();
+  std::vector<int> length(m, 0);
+  std::vector<size_t> previous(m, 0);
+  length[0] = 1;
+  for (size_t i = 1; i < m; ++i)
+  {
+    for (size_t j = 0; j < i; ++j)
+    {
+      if (length[j] > 0 && length[j] + 1 > length[i] && below(at[j].second, at[i].second))
+      {
+        length[i] = length[j] + 1;
+        previous[i] = j;
+      }
+    }
+  }
+  if (m < 2 || length[m - 1] == 0)
+  {
+    return; // the ends themselves are out of order: left to the program's error
+  }
+  std::vector<std::pair<long, Index>> kept;
+  for (size_t i = m - 1;; i = previous[i])
+  {
+    kept.push_back(at[i]);
+    if (i == 0)
+    {
+      break;
+    }
+  }
+  std::reverse(kept.begin(), kept.end());
+  at = std::move(kept);
+}
 } // namespace
 
 bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments,
@@ -112,9 +150,9 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
   const double domainBounds[4], OneCellSmoothingResult& result, std::string& error) const
 {
   result = OneCellSmoothingResult();
-  if (this->Segments < 2 || this->Segments > MonotoneBSplineFit::MaximumSegments)
+  if (this->Segments < 2 || this->Segments > MaximumCurveSegments)
   {
-    error = "the number of curve segments must be in [2, " + std::to_string(MonotoneBSplineFit::MaximumSegments) +
+    error = "the number of curve segments must be in [2, " + std::to_string(MaximumCurveSegments) +
       "], not " + std::to_string(this->Segments);
     return false;
   }
@@ -183,133 +221,171 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
     junctionNode[j] = static_cast<Index>(nodes.size());
     nodes.push_back(node);
   }
-  std::map<std::pair<double, double>, Index> cornerNode;
-  const double corners[4][2] = { { domainBounds[0], domainBounds[2] }, { domainBounds[1], domainBounds[2] },
-    { domainBounds[1], domainBounds[3] }, { domainBounds[0], domainBounds[3] } };
-
-  // Cut every 1-cell at its nodes; identical pieces (merged 1-cells) are kept once.
-  std::vector<std::vector<std::pair<long, Index>>> cuts(complex.Separatrices.size());
-  for (size_t j = 0; j < junctions.size(); ++j)
+  // Normally every 1-cell is cut at every node it passes. A 1-cell merged by cancellations
+  // runs up and down; where it passes another 1-cell's node on its way down, the pieces order
+  // nodes against each other's 1-cells and the relations hold a cycle. Only then the pieces
+  // are cut again at the nodes that rise along each 1-cell (KeepRisingCuts): the relations
+  // then follow one order of the nodes, so they hold no cycle, and the passed nodes are
+  // merely crossed.
+  const size_t nodesBeforeCorners = nodes.size();
+  for (const bool risingCutsOnly : { false, true })
   {
-    for (Index a : junctions[j].Separatrices)
+    nodes.resize(nodesBeforeCorners);
+    result.Pieces.clear();
+    result.PiecesOfSeparatrix.clear();
+    result.RisingCutsOnly = risingCutsOnly;
+    std::map<std::pair<double, double>, Index> cornerNode;
+    const double corners[4][2] = { { domainBounds[0], domainBounds[2] }, { domainBounds[1], domainBounds[2] },
+      { domainBounds[1], domainBounds[3] }, { domainBounds[0], domainBounds[3] } };
+
+    // Cut every 1-cell at its nodes; identical pieces (merged 1-cells) are kept once.
+    std::vector<std::vector<std::pair<long, Index>>> cuts(complex.Separatrices.size());
+    for (size_t j = 0; j < junctions.size(); ++j)
     {
-      const long at = PointIndexOfCell(complex.Separatrices[a], junctions[j].Cell);
-      if (at > 0 && at + 1 < static_cast<long>(complex.Separatrices[a].Values.size()))
+      for (Index a : junctions[j].Separatrices)
       {
-        cuts[a].push_back({ at, junctionNode[j] });
+        const long at = PointIndexOfCell(complex.Separatrices[a], junctions[j].Cell);
+        if (at > 0 && at + 1 < static_cast<long>(complex.Separatrices[a].Values.size()))
+        {
+          cuts[a].push_back({ at, junctionNode[j] });
+        }
       }
     }
-  }
-  std::map<std::vector<double>, Index> pieceOfGeometry;
-  result.PiecesOfSeparatrix.resize(complex.Separatrices.size());
-  for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
-  {
-    const Separatrix& arc = complex.Separatrices[a];
-    const long n = static_cast<long>(arc.Values.size());
-    auto& at = cuts[a];
-    for (long p = 1; p + 1 < n; ++p)
+    std::map<std::vector<double>, Index> pieceOfGeometry;
+    result.PiecesOfSeparatrix.resize(complex.Separatrices.size());
+    for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
     {
-      for (int c = 0; c < 4; ++c)
+      const Separatrix& arc = complex.Separatrices[a];
+      const long n = static_cast<long>(arc.Values.size());
+      auto& at = cuts[a];
+      for (long p = 1; p + 1 < n; ++p)
       {
-        if (arc.Points[2 * p] == corners[c][0] && arc.Points[2 * p + 1] == corners[c][1])
+        for (int c = 0; c < 4; ++c)
         {
-          auto found = cornerNode.find({ corners[c][0], corners[c][1] });
-          if (found == cornerNode.end())
+          if (arc.Points[2 * p] == corners[c][0] && arc.Points[2 * p + 1] == corners[c][1])
           {
-            SmoothingNode node;
-            node.Type = SmoothingNode::DomainCorner;
-            node.Position[0] = corners[c][0];
-            node.Position[1] = corners[c][1];
-            node.FieldValue = node.Value = arc.Values[p];
-            found = cornerNode.insert({ { corners[c][0], corners[c][1] }, static_cast<Index>(nodes.size()) }).first;
-            nodes.push_back(node);
+            auto found = cornerNode.find({ corners[c][0], corners[c][1] });
+            if (found == cornerNode.end())
+            {
+              SmoothingNode node;
+              node.Type = SmoothingNode::DomainCorner;
+              node.Position[0] = corners[c][0];
+              node.Position[1] = corners[c][1];
+              node.FieldValue = node.Value = arc.Values[p];
+              found = cornerNode.insert({ { corners[c][0], corners[c][1] }, static_cast<Index>(nodes.size()) }).first;
+              nodes.push_back(node);
+            }
+            at.push_back({ p, found->second });
           }
-          at.push_back({ p, found->second });
         }
       }
-    }
-    // A merged 1-cell may pass its own end's vertex before it ends there (the trivial
-    // embedding): no cut at its own ends' nodes, nor twice in a row at one node, which would
-    // make a piece from a node to itself.
-    at.erase(std::remove_if(at.begin(), at.end(),
-               [&](const auto& cut) { return cut.second == arc.Source || cut.second == arc.Destination; }),
-      at.end());
-    at.push_back({ 0, arc.Source });
-    at.push_back({ n - 1, arc.Destination });
-    std::sort(at.begin(), at.end());
-    at.erase(std::unique(at.begin(), at.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
-      at.end());
-    at.erase(std::unique(at.begin(), at.end(), [](const auto& x, const auto& y) { return x.second == y.second; }),
-      at.end());
-    for (size_t k = 0; k + 1 < at.size(); ++k)
-    {
-      const long from = at[k].first, to = at[k + 1].first;
-      std::vector<double> key(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
-      key.push_back(arc.Type);
-      auto found = pieceOfGeometry.find(key);
-      if (found == pieceOfGeometry.end())
+      // A merged 1-cell may pass its own end's vertex before it ends there (the trivial
+      // embedding): no cut at its own ends' nodes, nor twice in a row at one node, which would
+      // make a piece from a node to itself.
+      at.erase(std::remove_if(at.begin(), at.end(),
+                 [&](const auto& cut) { return cut.second == arc.Source || cut.second == arc.Destination; }),
+        at.end());
+      at.push_back({ 0, arc.Source });
+      at.push_back({ n - 1, arc.Destination });
+      std::sort(at.begin(), at.end());
+      at.erase(std::unique(at.begin(), at.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
+        at.end());
+      at.erase(std::unique(at.begin(), at.end(), [](const auto& x, const auto& y) { return x.second == y.second; }),
+        at.end());
+      // A merged 1-cell can run out to a cancelled extremum and back along the same path,
+      // passing its nodes a second time in the opposite order. Pieces cut at both visits would
+      // order those nodes both ways (a cycle no values can satisfy): the excursion stays inside
+      // one piece, from the first visit to the node after the last one.
+      for (size_t k = 0; k < at.size(); ++k)
       {
-        SmoothedPiece piece;
-        piece.Type = arc.Type;
-        piece.StartNode = at[k].second;
-        piece.EndNode = at[k + 1].second;
-        piece.Points.assign(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
-        piece.Values.assign(arc.Values.begin() + from, arc.Values.begin() + to + 1);
-        if (arc.Type == Separatrix::Ascending && to == n - 1 && piece.Values.size() > 2)
+        size_t last = k;
+        for (size_t m = k + 1; m < at.size(); ++m)
         {
-          // Every ascending 1-cell into a maximum ends "centroid of the maximum's triangle,
-          // maximum's vertex": a segment they would all share. Go straight to the vertex.
-          piece.Points.erase(piece.Points.end() - 4, piece.Points.end() - 2);
-          piece.Values.erase(piece.Values.end() - 2);
+          last = at[m].second == at[k].second ? m : last;
         }
-        found = pieceOfGeometry.insert({ key, static_cast<Index>(result.Pieces.size()) }).first;
-        result.Pieces.push_back(std::move(piece));
+        at.erase(at.begin() + k + 1, at.begin() + last + 1);
       }
-      result.Pieces[found->second].Separatrices.push_back(a);
-      result.PiecesOfSeparatrix[a].push_back(found->second);
+      if (risingCutsOnly)
+      {
+        KeepRisingCuts(at, nodes);
+      }
+      for (size_t k = 0; k + 1 < at.size(); ++k)
+      {
+        const long from = at[k].first, to = at[k + 1].first;
+        std::vector<double> key(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
+        key.push_back(arc.Type);
+        auto found = pieceOfGeometry.find(key);
+        if (found == pieceOfGeometry.end())
+        {
+          SmoothedPiece piece;
+          piece.Type = arc.Type;
+          piece.StartNode = at[k].second;
+          piece.EndNode = at[k + 1].second;
+          piece.Points.assign(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
+          piece.Values.assign(arc.Values.begin() + from, arc.Values.begin() + to + 1);
+          if (arc.Type == Separatrix::Ascending && to == n - 1 && piece.Values.size() > 2)
+          {
+            // Every ascending 1-cell into a maximum ends "centroid of the maximum's triangle,
+            // maximum's vertex": a segment they would all share. Go straight to the vertex.
+            piece.Points.erase(piece.Points.end() - 4, piece.Points.end() - 2);
+            piece.Values.erase(piece.Values.end() - 2);
+          }
+          found = pieceOfGeometry.insert({ key, static_cast<Index>(result.Pieces.size()) }).first;
+          result.Pieces.push_back(std::move(piece));
+        }
+        result.Pieces[found->second].Separatrices.push_back(a);
+        result.PiecesOfSeparatrix[a].push_back(found->second);
+      }
     }
-  }
-  // Node positions: the ends of the pieces that meet there.
-  for (const SmoothedPiece& piece : result.Pieces)
-  {
-    for (int end = 0; end < 2; ++end)
-    {
-      SmoothingNode& node = nodes[end == 0 ? piece.StartNode : piece.EndNode];
-      const size_t p = end == 0 ? 0 : piece.Values.size() - 1;
-      node.Position[0] = piece.Points[2 * p];
-      node.Position[1] = piece.Points[2 * p + 1];
-    }
-  }
-  this->Hooks.Report(0.1);
-
-  // Junction (and corner) values: one global program, strictly increasing along every piece.
-  {
-    std::vector<JunctionValueNode> programNodes(nodes.size());
-    for (size_t i = 0; i < nodes.size(); ++i)
-    {
-      programNodes[i].Value = nodes[i].Type == SmoothingNode::Critical ? nodes[i].Value : nodes[i].FieldValue;
-      programNodes[i].Fixed = nodes[i].Type == SmoothingNode::Critical;
-    }
-    std::vector<std::array<Index, 2>> lowerThan;
+    // Node positions: the ends of the pieces that meet there.
     for (const SmoothedPiece& piece : result.Pieces)
     {
-      lowerThan.push_back({ piece.StartNode, piece.EndNode });
+      for (int end = 0; end < 2; ++end)
+      {
+        SmoothingNode& node = nodes[end == 0 ? piece.StartNode : piece.EndNode];
+        const size_t p = end == 0 ? 0 : piece.Values.size() - 1;
+        node.Position[0] = piece.Points[2 * p];
+        node.Position[1] = piece.Points[2 * p + 1];
+      }
     }
-    std::sort(lowerThan.begin(), lowerThan.end());
-    lowerThan.erase(std::unique(lowerThan.begin(), lowerThan.end()), lowerThan.end());
-    JunctionValueProgram program;
-    std::vector<double> values;
-    if (!program.Solve(programNodes, lowerThan, values, error))
+    this->Hooks.Report(0.1);
+
+    // Junction (and corner) values: one global program, strictly increasing along every piece.
     {
-      error = "junction values: " + error;
-      return false;
+      std::vector<JunctionValueNode> programNodes(nodes.size());
+      for (size_t i = 0; i < nodes.size(); ++i)
+      {
+        programNodes[i].Value = nodes[i].Type == SmoothingNode::Critical ? nodes[i].Value : nodes[i].FieldValue;
+        programNodes[i].Fixed = nodes[i].Type == SmoothingNode::Critical;
+      }
+      std::vector<std::array<Index, 2>> lowerThan;
+      for (const SmoothedPiece& piece : result.Pieces)
+      {
+        lowerThan.push_back({ piece.StartNode, piece.EndNode });
+      }
+      std::sort(lowerThan.begin(), lowerThan.end());
+      lowerThan.erase(std::unique(lowerThan.begin(), lowerThan.end()), lowerThan.end());
+      JunctionValueProgram program;
+      std::vector<double> values;
+      if (!program.Solve(programNodes, lowerThan, values, error))
+      {
+        if (program.FoundCycle && !risingCutsOnly)
+        {
+          continue;
+        }
+        error = "junction values: " + error;
+        return false;
+      }
+      for (size_t i = 0; i < nodes.size(); ++i)
+      {
+        nodes[i].Value = values[i];
+      }
+      result.JunctionMargin = program.Margin;
+      result.SpreadCriticalValues = program.SpreadCriticalValues;
+      result.MaximumSpread = program.MaximumSpread;
+      result.JunctionTotalChange = program.TotalChange;
     }
-    for (size_t i = 0; i < nodes.size(); ++i)
-    {
-      nodes[i].Value = values[i];
-    }
-    result.JunctionMargin = program.Margin;
-    result.JunctionTotalChange = program.TotalChange;
+    break;
   }
   this->Hooks.Report(0.2);
 
@@ -467,11 +543,12 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
       // Up to MaximumSegments, or to the piece's number of samples for long pieces: with about
       // one segment per sample the least-squares curve follows the jagged 1-cell, which does
       // not cross the others.
-      // k doubles, so that the counts of the pieces around a 2-cell keep small common multiples:
-      // stage 4 subdivides the four sides of every cell to one common count.
+      // k doubles, and only doubles (a cap between would leave counts like 25 and 37, whose
+      // common multiples exceed stage 4's grid limit): stage 4 subdivides each piece of the
+      // four sides of a cell by a whole factor to one common count.
       const int cap = std::max(this->MaximumSegments, static_cast<int>(piece.Values.size()) - 1);
-      const int next = std::min(cap, 2 * piece.Segments);
-      if (next > piece.Segments && next <= MonotoneBSplineFit::MaximumSegments)
+      const int next = 2 * piece.Segments;
+      if (piece.Segments < cap && next <= MonotoneBSplineFit::MaximumSegments)
       {
         if (!this->FitPiece(piece, nodes, next, domainBounds, error))
         {

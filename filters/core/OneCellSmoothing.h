@@ -59,12 +59,18 @@ struct OneCellSmoothingResult
   int ClampedPieces = 0;       // pieces kept inside it by clamping control points
   double JunctionMargin = 0;
   double JunctionTotalChange = 0;
+  bool RisingCutsOnly = false;  // the pieces were cut only where nodes rise (see Smooth)
+  int SpreadCriticalValues = 0; // critical values raised to make room for strict monotonicity
+  double MaximumSpread = 0;     // the largest raise (see JunctionValueProgram)
 };
 
 class OneCellSmoothing
 {
 public:
-  // k: cubic segments per piece (the paper's "Curve Segments": 4 or 7).
+  // The range of k a user may ask for (the GUI's range): beyond 30 the pieces have more
+  // segments than most 1-cells have samples, and the fits become long and fail.
+  static constexpr int MaximumCurveSegments = 30;
+  // k: cubic segments per piece (the paper's "Curve Segments": 4 or 7), in [2, MaximumCurveSegments].
   int Segments = 4;
   // Crossings are removed by raising k on the pieces involved, up to this many segments (or
   // up to the piece's number of samples, if larger).

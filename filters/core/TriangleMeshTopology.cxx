@@ -1,5 +1,7 @@
 #include "TriangleMeshTopology.h"
 
+#include "DisjointSets.h"
+
 #include <algorithm>
 
 namespace topospline
@@ -296,6 +298,104 @@ bool TriangleMeshTopology::Build(Index numberOfVertices, const std::vector<Index
     {
       this->BoundaryVertex[this->EdgeVertices[e][0]] = 1;
       this->BoundaryVertex[this->EdgeVertices[e][1]] = 1;
+    }
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool TriangleMeshTopology::CheckPlanarDisk(const std::vector<double>& points, std::string& error) const
+{
+  const Index nV = this->NumVertices;
+  if (points.size() != 2 * static_cast<std::size_t>(nV))
+  {
+    error = "expected two coordinates per point";
+    return false;
+  }
+  // One fan per vertex: its link is one path (boundary) or one cycle, so a boundary vertex has
+  // two boundary edges and one edge more than triangles, an interior one as many as triangles.
+  std::vector<Index> edges(nV, 0), boundaryEdges(nV, 0);
+  UnionFind pieces(nV);
+  for (Index e = 0; e < this->NumberOfEdges(); ++e)
+  {
+    for (const Index v : this->EdgeVertices[e])
+    {
+      ++edges[v];
+      boundaryEdges[v] += this->IsBoundaryEdge(e) ? 1 : 0;
+    }
+    pieces.Union(this->EdgeVertices[e][0], this->EdgeVertices[e][1]);
+  }
+  for (Index v = 0; v < nV; ++v)
+  {
+    const Index triangles = this->VertexTriangleEnd(v) - this->VertexTriangleBegin(v);
+    if (triangles == 0)
+    {
+      error = "point " + std::to_string(v) + " is not used by any triangle";
+      return false;
+    }
+    const bool oneFan = this->IsBoundaryVertex(v) ? boundaryEdges[v] == 2 && edges[v] == triangles + 1
+                                                  : edges[v] == triangles;
+    if (!oneFan)
+    {
+      error = "point " + std::to_string(v) + " joins several fans of triangles (a bow-tie: parts of the mesh " +
+        "meet only at this point); TopoSpline needs a mesh shaped like a disk";
+      return false;
+    }
+  }
+  Index components = 0;
+  for (Index v = 0; v < nV; ++v)
+  {
+    components += pieces.Find(v) == v ? 1 : 0;
+  }
+  if (components != 1)
+  {
+    error = "the mesh has " + std::to_string(components) + " separate pieces; TopoSpline needs one piece shaped like a disk";
+    return false;
+  }
+  if (this->EulerCharacteristic() != 1)
+  {
+    error = "the mesh has " + std::to_string(1 - this->EulerCharacteristic()) +
+      " hole(s) (Euler characteristic " + std::to_string(this->EulerCharacteristic()) +
+      "); TopoSpline needs a mesh shaped like a disk";
+    return false;
+  }
+  // Signed doubled area of (a, b, c).
+  auto orientation = [&points](Index a, Index b, Index c) {
+    return (points[2 * b] - points[2 * a]) * (points[2 * c + 1] - points[2 * a + 1]) -
+      (points[2 * b + 1] - points[2 * a + 1]) * (points[2 * c] - points[2 * a]);
+  };
+  auto squared = [&points](Index a, Index b) {
+    const double dx = points[2 * b] - points[2 * a], dy = points[2 * b + 1] - points[2 * a + 1];
+    return dx * dx + dy * dy;
+  };
+  for (Index t = 0; t < this->NumberOfTriangles(); ++t)
+  {
+    const auto& v = this->TriangleVertices[t];
+    const double longest = std::max({ squared(v[0], v[1]), squared(v[1], v[2]), squared(v[2], v[0]) });
+    // Relative to the longest edge: a sliver this thin has no direction left in double precision.
+    if (!(std::abs(orientation(v[0], v[1], v[2])) > 1e-12 * longest))
+    {
+      error = "triangle " + std::to_string(t) + " has zero area (its points are collinear or coincide)";
+      return false;
+    }
+  }
+  for (Index e = 0; e < this->NumberOfEdges(); ++e)
+  {
+    if (this->IsBoundaryEdge(e))
+    {
+      continue;
+    }
+    const Index a = this->EdgeVertices[e][0], b = this->EdgeVertices[e][1];
+    const auto third = [&](Index t) {
+      const auto& v = this->TriangleVertices[t];
+      return v[0] != a && v[0] != b ? v[0] : (v[1] != a && v[1] != b ? v[1] : v[2]);
+    };
+    const Index t0 = this->EdgeTriangles[e][0], t1 = this->EdgeTriangles[e][1];
+    if (!(orientation(a, b, third(t0)) * orientation(a, b, third(t1)) < 0))
+    {
+      error = "triangles " + std::to_string(t0) + " and " + std::to_string(t1) + " overlap: the mesh folds over " +
+        "the edge of points " + std::to_string(a) + " and " + std::to_string(b);
+      return false;
     }
   }
   return true;

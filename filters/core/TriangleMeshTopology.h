@@ -18,6 +18,12 @@ public:
   bool Build(Index numberOfVertices, const std::vector<Index>& triangles, const ParallelFor& parallelFor,
     std::string& error);
 
+  // After Build: false with `error` unless the mesh is a planar disk as the complex needs it:
+  // one fan of triangles around every vertex (no bow-tie), one piece without holes (Euler
+  // characteristic 1), no zero-area triangle, and no fold (the two triangles of every
+  // interior edge on opposite sides of it). points: x, y per vertex.
+  bool CheckPlanarDisk(const std::vector<double>& points, std::string& error) const;
+
   // The same structure, numbered exactly as Build(nx * ny, GridTriangles(nx, ny)) numbers it,
   // written in closed form: no searching or sorting. For image data.
   void BuildGrid(int nx, int ny, const ParallelFor& parallelFor);

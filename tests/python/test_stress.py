@@ -1,0 +1,512 @@
+"""Stress test: seeded inputs a new user would try, each run through the four filters and
+checked by an independent PL critical-point counter written here (no code shared with the core).
+
+Cases (seeded, reproducible): uniform noise 16^2-1000^2, random crops of every catalog data set,
+triangle-mesh versions (the same grids as vtkPolyData with jittered points, and Delaunay meshes
+of random points), constant and near-constant fields, images with extents that do not start at
+0, shifted origins and anisotropic spacing; thresholds 0.5-50 %, k 2-30.
+
+For every case it records:
+- VTK errors, crashes (each batch runs in its own pvpython process; a crash is recorded against
+  the case that was running) and time-outs;
+- the topology verdict;
+- whether the counter below, run on `Reconstructed` at the input vertices, finds exactly the
+  simplified complex's critical points (plus the minimum and saddle of each boundary junction),
+  by index, with saddle multiplicity, boundary included;
+- whether every critical point it finds lies within two edges of a node of its index (boundary
+  junction pairs: within three).
+It also checks that the 1-cells lie within the input's bounds (images whose extent does not
+start at 0, or at z != 0). It fails on a crash or time-out, on 1-cells outside the input, and
+on a dishonest verdict (1 while the counter disagrees).
+Errors and verdicts of 0 on valid input are printed with their totals: they are still open
+(docs/StressTest.md); TOPOSPLINE_STRESS_STRICT=1 fails on those too.
+
+The counter: vertices ordered by (value, id); an interior vertex is a minimum (empty lower link),
+a maximum (whole link lower) or a saddle of multiplicity c - 1 (c lower-link components, c >= 2).
+A boundary vertex follows the complex's closed-boundary rule, derived in docs/MorseSmaleComplex.md:
+along the boundary curve it is a minimum when both boundary neighbours are higher, a saddle when
+both are lower; inside, every lower-link component touching neither boundary neighbour is a
+saddle, and a lower link covering the whole link path adds a maximum.
+
+TOPOSPLINE_STRESS=full runs the full set (>= 300 cases, a few hours); the default is the CI
+subset (about 5 minutes). TOPOSPLINE_STRESS_SEED changes the seed of both. The full set's last
+result is in docs/StressTest.md."""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+FULL = os.environ.get("TOPOSPLINE_STRESS") == "full"
+SEED = int(os.environ.get("TOPOSPLINE_STRESS_SEED", "13"))
+# Each worker process runs this many cases, then a fresh one goes on: what ParaView keeps of
+# hundreds of pipelines adds up (2.4 GB after 3 minutes of the full set).
+CASES_PER_WORKER = 10
+PVPYTHON = os.environ.get("PVPYTHON") or shutil.which("pvpython") or "pvpython"
+THRESHOLDS = [0.5, 1, 2, 5, 10, 25, 50]
+
+
+# --- the cases ----------------------------------------------------------------------------------
+def make_cases(catalog_entries, full, seed):
+    rng = np.random.default_rng(seed)
+    cases = []
+
+    def add(kind, **spec):
+        spec.setdefault("percent", float(rng.choice(THRESHOLDS)))
+        spec.setdefault("k", int(rng.integers(2, 31)))
+        spec["kind"] = kind
+        spec["seed"] = int(rng.integers(0, 2**31))
+        spec["id"] = len(cases)
+        cases.append(spec)
+
+    noise_sizes = [16, 24, 32] if not full else [16, 24, 32, 48, 64, 100, 128, 200, 300, 500, 1000]
+    for n in noise_sizes:
+        for _ in range(2 if not full else (12 if n <= 200 else 3)):
+            add("noise", nx=n, ny=n)
+    for entry in catalog_entries:
+        nx, ny = entry["dimensions"][:2]
+        for _ in range(2 if not full else 20):
+            limit = 80 if not full else 300
+            w, h = int(rng.integers(16, min(limit, nx) + 1)), int(rng.integers(16, min(limit, ny) + 1))
+            add("crop", file=entry["file"], i0=int(rng.integers(0, nx - w + 1)), j0=int(rng.integers(0, ny - h + 1)),
+                w=w, h=h)
+    for _ in range(3 if not full else 30):
+        n = int(rng.integers(16, 40 if not full else 150))
+        add("mesh_grid", nx=n, ny=int(rng.integers(16, 40 if not full else 150)))
+    for _ in range(2 if not full else 20):
+        add("delaunay", points=int(rng.integers(200, 800 if not full else 6000)))
+    add("constant", nx=20, ny=15, value=1.0)
+    add("constant", nx=33, ny=33, value=-7.25)
+    add("near_constant", nx=30, ny=30, scale=1e-13)
+    add("near_constant", nx=40, ny=25, scale=1e-300)
+    add("extent", nx=40, ny=30, x0=5, y0=-3, z0=2)
+    add("origin", nx=30, ny=30, origin=[1e6, -2e6, 5.0])
+    add("spacing", nx=30, ny=30, spacing=[0.01, 3.0])
+    if full:
+        for _ in range(10):
+            add("extent", nx=int(rng.integers(16, 80)), ny=int(rng.integers(16, 80)),
+                x0=int(rng.integers(-50, 50)), y0=int(rng.integers(-50, 50)), z0=int(rng.integers(-5, 5)))
+            add("spacing", nx=int(rng.integers(16, 80)), ny=int(rng.integers(16, 80)),
+                spacing=[float(10 ** rng.uniform(-3, 3)), float(10 ** rng.uniform(-3, 3))])
+    return cases
+
+
+# --- the independent counter -------------------------------------------------------------------
+def triangles_of_grid(nx, ny):
+    """The complex's split of each quad along its (i+1,j)-(i,j+1) diagonal."""
+    ids = np.arange(nx * ny).reshape(ny, nx)
+    a, b, c, d = ids[:-1, :-1].ravel(), ids[:-1, 1:].ravel(), ids[1:, :-1].ravel(), ids[1:, 1:].ravel()
+    return np.concatenate([np.column_stack([a, b, c]), np.column_stack([b, d, c])])
+
+
+def vertex_links(triangles, n):
+    """For each vertex: its link as a list of (u, w) edges."""
+    links = [[] for _ in range(n)]
+    for a, b, c in triangles.tolist():
+        links[a].append((b, c))
+        links[b].append((c, a))
+        links[c].append((a, b))
+    return links
+
+
+def critical_points(values, triangles):
+    """List of (vertex, index, multiplicity) by the rules in the module docstring."""
+    n = len(values)
+    order = np.lexsort((np.arange(n), values))
+    rank = np.empty(n, dtype=np.int64)
+    rank[order] = np.arange(n)
+    links = vertex_links(triangles, n)
+    found = []
+    for v in range(n):
+        edges = links[v]
+        if not edges:
+            continue
+        # Walk the link: a cycle (interior) or a path (boundary).
+        succ, pred = {}, {}
+        for u, w in edges:
+            succ[u] = w
+            pred[w] = u
+        start = next((u for u in succ if u not in pred), None)
+        boundary = start is not None
+        first = start if boundary else edges[0][0]
+        walk = [first]
+        while True:
+            nxt = succ.get(walk[-1])
+            if nxt is None or nxt == first:
+                break
+            walk.append(nxt)
+        lower = [rank[u] < rank[v] for u in walk]
+        if not boundary:
+            changes = sum(1 for i in range(len(walk)) if lower[i] and not lower[i - 1])
+            if not any(lower):
+                found.append((v, 0, 1))
+            elif all(lower):
+                found.append((v, 2, 1))
+            elif changes >= 2:
+                found.append((v, 1, changes - 1))
+            continue
+        ends = int(lower[0]) + int(lower[-1])
+        if ends == 0:
+            found.append((v, 0, 1))
+        elif ends == 2:
+            found.append((v, 1, 1))
+        if all(lower):
+            found.append((v, 2, 1))
+            continue
+        # lower-link components (runs along the path) touching neither end of the path
+        runs = 0
+        i = 0
+        while i < len(walk):
+            if not lower[i]:
+                i += 1
+                continue
+            j = i
+            while j + 1 < len(walk) and lower[j + 1]:
+                j += 1
+            if i > 0 and j < len(walk) - 1:
+                runs += 1
+            i = j + 1
+        if runs:
+            found.append((v, 1, runs))
+    return found
+
+
+def graph_distance_ok(found, nodes, neighbours, hops):
+    """Vertices of `found` farther than `hops` edges from every vertex of `nodes`."""
+    reach = set(nodes)
+    frontier = set(nodes)
+    for _ in range(hops):
+        frontier = {w for u in frontier for w in neighbours[u]} - reach
+        reach |= frontier
+    return [v for v in found if v not in reach]
+
+
+# --- one case, in the worker process ----------------------------------------------------------
+def worker(cases_file, first):
+    from paraview.simple import LoadPlugin, TrivialProducer, XMLImageDataReader, Delete
+    from paraview import servermanager as sm
+    from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+    from vtkmodules.vtkCommonCore import vtkPoints, vtkCommand
+    from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPolyData, vtkCellArray
+    from vtkmodules.vtkFiltersCore import vtkDelaunay2D
+    from vtkmodules.util.misc import calldata_type
+    from vtkmodules.util.vtkConstants import VTK_STRING
+    import topospline_testing as tt
+
+    import paraview.simple as simple
+    LoadPlugin(tt.plugin_path(), remote=False)
+    MorseSmaleComplex, SimplifyMorseSmaleComplex = simple.MorseSmaleComplex, simple.SimplifyMorseSmaleComplex
+    Smooth1Cells, Reconstruct2Cells = simple.Smooth1Cells, simple.Reconstruct2Cells
+    with open(cases_file) as f:
+        cases = json.load(f)
+
+    def image(values2d, origin=(0, 0, 0), spacing=(1, 1, 1), extent_start=(0, 0, 0)):
+        ny, nx = values2d.shape
+        im = vtkImageData()
+        x0, y0, z0 = extent_start
+        im.SetExtent(x0, x0 + nx - 1, y0, y0 + ny - 1, z0, z0)
+        im.SetOrigin(*origin)
+        im.SetSpacing(*spacing)
+        arr = numpy_to_vtk(np.ascontiguousarray(values2d.ravel(), dtype=np.float64), deep=1)
+        arr.SetName("f")
+        im.GetPointData().AddArray(arr)
+        return im
+
+    def polydata(points2d, triangles, values):
+        pd = vtkPolyData()
+        pts = vtkPoints()
+        pts.SetData(numpy_to_vtk(np.column_stack([points2d, np.zeros(len(points2d))]).astype(np.float64), deep=1))
+        pd.SetPoints(pts)
+        cells = vtkCellArray()
+        from vtkmodules.util.numpy_support import numpy_to_vtkIdTypeArray
+        offsets = numpy_to_vtkIdTypeArray(np.arange(0, 3 * len(triangles) + 1, 3, dtype=np.int64), deep=1)
+        conn = numpy_to_vtkIdTypeArray(np.ascontiguousarray(triangles.ravel(), dtype=np.int64), deep=1)
+        cells.SetData(offsets, conn)
+        pd.SetPolys(cells)
+        arr = numpy_to_vtk(np.ascontiguousarray(values, dtype=np.float64), deep=1)
+        arr.SetName("f")
+        pd.GetPointData().AddArray(arr)
+        return pd
+
+    def build_input(case):
+        rng = np.random.default_rng(case["seed"])
+        kind = case["kind"]
+        if kind == "noise":
+            v = rng.uniform(0, 1, (case["ny"], case["nx"]))
+            return image(v), v.ravel(), triangles_of_grid(case["nx"], case["ny"])
+        if kind == "crop":
+            reader = XMLImageDataReader(FileName=[tt.find_dataset(case["file"])])
+            reader.UpdatePipeline()
+            data = sm.Fetch(reader)
+            Delete(reader)
+            nx, ny, _ = data.GetDimensions()
+            allv = vtk_to_numpy(data.GetPointData().GetArray("elevation")).reshape(ny, nx)
+            v = np.array(allv[case["j0"]:case["j0"] + case["h"], case["i0"]:case["i0"] + case["w"]], dtype=np.float64)
+            return image(v), v.ravel(), triangles_of_grid(case["w"], case["h"])
+        if kind == "mesh_grid":
+            nx, ny = case["nx"], case["ny"]
+            x, y = np.meshgrid(np.arange(nx, dtype=float), np.arange(ny, dtype=float))
+            pts = np.column_stack([x.ravel(), y.ravel()]) + rng.uniform(-0.2, 0.2, (nx * ny, 2))
+            v = np.sin(x.ravel() / 5.0) * np.cos(y.ravel() / 7.0) + 0.3 * rng.uniform(0, 1, nx * ny)
+            tris = triangles_of_grid(nx, ny)
+            return polydata(pts, tris, v), v, tris
+        if kind == "delaunay":
+            n = case["points"]
+            pts = np.concatenate([rng.uniform(0, 1, (n, 2)), [[0, 0], [1, 0], [0, 1], [1, 1]]])
+            v = np.sin(6 * pts[:, 0]) * np.cos(5 * pts[:, 1]) + 0.2 * rng.uniform(0, 1, len(pts))
+            cloud = polydata(pts, np.zeros((0, 3), dtype=np.int64), v)
+            delaunay = vtkDelaunay2D()
+            delaunay.SetInputData(cloud)
+            delaunay.Update()
+            out = delaunay.GetOutput()
+            tris = vtk_to_numpy(out.GetPolys().GetConnectivityArray()).reshape(-1, 3).astype(np.int64)
+            return polydata(pts, tris, v), v, tris
+        if kind == "constant":
+            v = np.full((case["ny"], case["nx"]), case["value"])
+            return image(v), v.ravel(), triangles_of_grid(case["nx"], case["ny"])
+        if kind == "near_constant":
+            v = 1.0 + case["scale"] * rng.uniform(0, 1, (case["ny"], case["nx"]))
+            return image(v), v.ravel(), triangles_of_grid(case["nx"], case["ny"])
+        nx, ny = case["nx"], case["ny"]
+        x, y = np.meshgrid(np.arange(nx, dtype=float), np.arange(ny, dtype=float))
+        v = np.sin(x / 4.0) * np.cos(y / 5.0) + 0.05 * rng.uniform(0, 1, (ny, nx))
+        if kind == "extent":
+            return image(v, extent_start=(case["x0"], case["y0"], case["z0"])), v.ravel(), triangles_of_grid(nx, ny)
+        if kind == "origin":
+            return image(v, origin=case["origin"]), v.ravel(), triangles_of_grid(nx, ny)
+        if kind == "spacing":
+            return image(v, spacing=case["spacing"] + [1.0]), v.ravel(), triangles_of_grid(nx, ny)
+        raise ValueError(kind)
+
+    for case in cases[first:first + CASES_PER_WORKER]:
+        print("START %d" % case["id"], flush=True)
+        result = {"id": case["id"], "errors": []}
+        started = time.time()
+        data, values, triangles = build_input(case)
+        producer = TrivialProducer()
+        producer.GetClientSideObject().SetOutput(data)
+        ms = MorseSmaleComplex(Input=producer)
+        ms.ScalarField = ["POINTS", "f"]
+        simplify = SimplifyMorseSmaleComplex(Input=ms, PersistenceThreshold=case["percent"])
+        smooth = Smooth1Cells(Input=simplify, CurveSegments=case["k"])
+        reconstruct = Reconstruct2Cells(Input=smooth)
+        # pvpython prints through VTK's output window, so the filters' errors are caught by
+        # observers (the driver also counts error lines printed while the case runs)
+        @calldata_type(VTK_STRING)
+        def on_error(caller, event, text):
+            result["errors"].append("%s: %s" % (caller.GetClassName(), text.strip()[-400:]))
+
+        for proxy in (ms, simplify, smooth, reconstruct):
+            proxy.GetClientSideObject().AddObserver(vtkCommand.ErrorEvent, on_error)
+        reconstruct.UpdatePipeline()
+        # the built-in session: the outputs are here, no need for Fetch's reduction filters
+        out = reconstruct.GetClientSideObject().GetOutputDataObject(0)
+        complex_ = simplify.GetClientSideObject().GetOutputDataObject(0)
+        result["seconds"] = time.time() - started
+        fd = out.GetFieldData()
+        recon = out.GetPointData().GetArray("Reconstructed")
+        verdict = fd.GetArray("TopologyVerified")
+        result["verdict"] = int(verdict.GetValue(0)) if verdict else -1
+        result["failed_cells"] = int(fd.GetArray("FailedTwoCells").GetValue(0)) if fd.GetArray("FailedTwoCells") else -1
+        expected = [0, 0, 0]
+        nodes = {0: [], 1: [], 2: []}
+        junctions = []
+        if complex_ is not None and complex_.GetNumberOfBlocks() > 0 and complex_.GetBlock(0) is not None \
+                and complex_.GetBlock(0).GetPointData().GetArray("CriticalIndex") is not None:
+            cps = complex_.GetBlock(0).GetPointData()
+            index = vtk_to_numpy(cps.GetArray("CriticalIndex")).astype(int)
+            vertex = vtk_to_numpy(cps.GetArray("VertexId")).astype(int)
+            for i, v in zip(index, vertex):
+                expected[i] += 1
+                nodes[i].append(int(v))
+            ja = complex_.GetFieldData().GetArray("BoundaryJunctionVertexId")
+            if ja is not None:
+                junctions = [int(ja.GetValue(i)) for i in range(ja.GetNumberOfTuples())]
+            expected[0] += len(junctions)
+            expected[1] += len(junctions)
+        result["expected"] = expected
+        # The geometry where the input is: the 1-cells inside the input's bounds (an image's
+        # extent need not start at 0, nor its z at 0).
+        result["outside"] = False
+        if complex_ is not None and complex_.GetNumberOfBlocks() > 1 and complex_.GetBlock(1) is not None \
+                and complex_.GetBlock(1).GetNumberOfPoints() > 0:
+            lines, domain = complex_.GetBlock(1).GetBounds(), data.GetBounds()
+            slack = 1e-9 * max(domain[1] - domain[0], domain[3] - domain[2], 1e-300)
+            result["outside"] = any(lines[2 * a] < domain[2 * a] - slack or lines[2 * a + 1] > domain[2 * a + 1] + slack
+                                    for a in range(3))
+        if recon is not None and recon.GetNumberOfTuples() == len(values):
+            sampled = vtk_to_numpy(recon).astype(np.float64)
+            found = critical_points(sampled, triangles)
+            counted = [0, 0, 0]
+            for v, i, m in found:
+                counted[i] += m
+            result["counted"] = counted
+            neighbours = [set() for _ in range(len(values))]
+            for a, b, c in triangles.tolist():
+                neighbours[a] |= {b, c}
+                neighbours[b] |= {a, c}
+                neighbours[c] |= {a, b}
+            far = 0
+            for index in range(3):
+                near_nodes = nodes[index] + (junctions if index < 2 else [])
+                hops = 3 if junctions and index < 2 else 2
+                far += len(graph_distance_ok([v for v, i, m in found if i == index], near_nodes, neighbours, hops))
+            result["far"] = far
+            # of the range (constant fields: of the magnitude)
+            scale = np.ptp(values) if np.ptp(values) > 0 else max(float(np.max(np.abs(values))), 1.0)
+            result["max_error_percent"] = float(100 * np.max(np.abs(sampled - values)) / scale)
+        else:
+            result["counted"] = None
+        print("RESULT " + json.dumps(result), flush=True)
+        for proxy in (reconstruct, smooth, simplify, ms, producer):
+            Delete(proxy)
+
+
+# --- the driver ---------------------------------------------------------------------------------
+def describe(case):
+    skip = {"id", "seed", "kind"}
+    return "#%d %s %s seed %d" % (case["id"], case["kind"],
+                                  " ".join("%s=%s" % (k, v) for k, v in case.items() if k not in skip), case["seed"])
+
+
+def judge(r, totals):
+    """The problems of one case's result, counted into totals."""
+    problems = []
+    if "crash" in r:
+        totals["crashes"] += 1
+        return ["crash (%s)" % r["crash"]]
+    if r["errors"]:
+        totals["errors"] += 1
+        problems.append("errors: %s" % r["errors"][0][:300])
+    if r["verdict"] != 1:
+        totals["verdict 0"] += 1
+        problems.append("verdict %d (failed 2-cells %d)" % (r["verdict"], r["failed_cells"]))
+    if r["counted"] != r["expected"]:
+        totals["count mismatches"] += 1
+        problems.append("independent count %s, complex %s" % (r["counted"], r["expected"]))
+    if r.get("far"):
+        totals["far critical points"] += 1
+        problems.append("%d critical points far from their nodes" % r["far"])
+    if r.get("outside"):
+        totals["geometry outside the input"] += 1
+        problems.append("1-cells outside the input's bounds")
+    if r["verdict"] == 1 and (r["counted"] != r["expected"] or r.get("far")):
+        totals["dishonest verdicts"] += 1
+        problems.append("DISHONEST VERDICT: 1 although the independent check disagrees")
+    return problems
+
+
+def main():
+    sys.path.insert(0, HERE)
+    with open(os.path.join(os.environ.get("TOPOSPLINE_TEST_DATA", os.path.join(HERE, "..", "data")),
+                           "catalog.json")) as f:
+        entries = json.load(f)["datasets"]
+    shared = os.environ.get("TOPOSPLINE_SHARED_DATA", os.path.join(HERE, "..", "..", "..", "shared", "data"))
+    local = os.environ.get("TOPOSPLINE_TEST_DATA", os.path.join(HERE, "..", "data"))
+    present = []
+    for entry in entries:
+        if any(os.path.exists(os.path.join(d, entry["file"])) for d in (local, shared)):
+            present.append(entry)
+        else:
+            print("SKIP %s: not found (large data sets live in ../shared/data)" % entry["file"], flush=True)
+    cases = make_cases(present, FULL, SEED)
+    if not FULL:
+        # the CI subset: crops of the data sets shipped in the repo only, so it runs the same
+        # everywhere
+        cases = [c for c in cases if c["kind"] != "crop" or os.path.exists(os.path.join(local, c["file"]))]
+    print("%d cases, seed %d (%s set)" % (len(cases), SEED, "full" if FULL else "CI"), flush=True)
+    import tempfile
+    results = {}
+    # Smallest first, so that a run cut short has covered every kind of case.
+    order = sorted(cases, key=lambda c: (c.get("nx", c.get("w", 40)) * c.get("ny", c.get("h", 40))
+                                         if c["kind"] != "delaunay" else c["points"], c["id"]))
+    by_id = {c["id"]: c for c in cases}
+    with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
+        json.dump(order, f)
+        cases_file = f.name
+    position = 0
+    timeout = 3600 if FULL else 600
+    while position < len(cases):
+        proc = subprocess.Popen([PVPYTHON, os.path.abspath(__file__), "--worker", cases_file, str(position)],
+                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        current = None
+        state = {"started": time.time(), "timed out": False, "running": True}
+        output = []
+
+        def watchdog(proc=proc, state=state):
+            # a hung case sends no line: the reader alone would wait forever
+            while state["running"]:
+                if time.time() - state["started"] > timeout and not state["timed out"]:
+                    state["timed out"] = True
+                    proc.kill()
+                time.sleep(2)
+
+        threading.Thread(target=watchdog, daemon=True).start()
+        for line in proc.stdout:
+            output.append(line)
+            if line.startswith("START "):
+                current = int(line.split()[1])
+                current_position = next(i for i, c in enumerate(order) if c["id"] == current)
+                state["started"] = time.time()
+                printed_errors = []
+            elif line.startswith("RESULT "):
+                r = json.loads(line[7:])
+                r["errors"] += printed_errors
+                results[r["id"]] = r
+                current = None
+                problems = judge(r, {key: 0 for key in ("errors", "crashes", "verdict 0", "count mismatches",
+                                                        "far critical points", "dishonest verdicts",
+                                                        "geometry outside the input")})
+                print("%s %s: %.1f s, L_inf %.1f %% of the range%s" % (
+                    "FAIL" if problems else "ok", describe(by_id[r["id"]]), r["seconds"], r.get("max_error_percent", -1),
+                    (": " + "; ".join(problems)) if problems else ""), flush=True)
+            elif line.strip() and current is not None and ("ERR" in line or "rror" in line or "Segmentation" in line):
+                printed_errors.append(line.strip()[:300])
+        code = proc.wait()
+        state["running"] = False
+        if current is None and code != 0 and not any(line.startswith("START ") for line in output):
+            sys.exit("the stress worker failed before its first case:\n" + "".join(output[-30:]))
+        if current is not None:
+            tail = [line.strip() for line in output[-6:] if not line.startswith(("START", "RESULT"))]
+            results[current] = {"id": current, "crash": ("time-out after %d s" % timeout) if state["timed out"] else
+                                "exit code %d: %s" % (code, " | ".join(tail)[-500:])}
+            print("FAIL %s: crash (%s)" % (describe(by_id[current]), results[current]["crash"]), flush=True)
+            position = current_position + 1
+        elif code != 0 and not state["timed out"]:
+            sys.exit("the stress worker failed between cases (exit code %d):\n%s" % (code, "".join(output[-30:])))
+        else:
+            position = min(position + CASES_PER_WORKER, len(cases))
+    os.unlink(cases_file)
+
+    totals = {"cases": len(cases), "errors": 0, "crashes": 0, "verdict 0": 0, "count mismatches": 0,
+              "far critical points": 0, "dishonest verdicts": 0, "geometry outside the input": 0}
+    print("\nsummary of the failed cases:")
+    for case in cases:
+        problems = judge(results.get(case["id"], {"crash": "no result"}), totals)
+        if problems:
+            print("  FAIL %s: %s" % (describe(case), "; ".join(problems)), flush=True)
+    print("totals: %(cases)d cases, %(crashes)d crashes or time-outs, %(errors)d with errors, %(verdict 0)d verdicts "
+          "not 1, %(count mismatches)d independent-count mismatches, %(far critical points)d with far critical points, "
+          "%(dishonest verdicts)d dishonest verdicts, %(geometry outside the input)d with 1-cells outside the input"
+          % totals, flush=True)
+    # Asserted now: no crash or hang, and a verdict of 1 only where the independent check agrees.
+    # Errors and verdicts of 0 on valid input are still open (docs/StressTest.md); with
+    # TOPOSPLINE_STRESS_STRICT=1 they fail the run too.
+    hard = totals["crashes"] + totals["dishonest verdicts"] + totals["geometry outside the input"]
+    if os.environ.get("TOPOSPLINE_STRESS_STRICT") == "1":
+        hard += totals["errors"] + totals["verdict 0"] + totals["count mismatches"] + totals["far critical points"]
+    print("stress test %s" % ("FAILED" if hard else "passed (no crash, no dishonest verdict)"), flush=True)
+    sys.exit(1 if hard else 0)
+
+
+if __name__ in ("__main__", "__vtkconsole__") or os.path.basename(sys.argv[0]) == os.path.basename(__file__):
+    if len(sys.argv) > 1 and sys.argv[1] == "--worker":
+        sys.path.insert(0, HERE)
+        worker(sys.argv[2], int(sys.argv[3]))
+    else:
+        main()
