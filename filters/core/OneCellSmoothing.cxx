@@ -389,19 +389,33 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
   }
   this->Hooks.Report(0.2);
 
-  // Fit every piece.
-  for (size_t p = 0; p < result.Pieces.size(); ++p)
+  // Fit every piece, in parallel, in chunks between which progress is reported and an abort
+  // is seen (from this thread only); the first failing piece in order names the error.
   {
-    SmoothedPiece& piece = result.Pieces[p];
-    piece.Parameters = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
-    if (!this->FitPiece(piece, nodes, this->Segments, domainBounds, error))
+    const Index count = static_cast<Index>(result.Pieces.size());
+    const Index chunk = std::max<Index>(256, count / 16);
+    std::vector<std::string> pieceErrors(static_cast<std::size_t>(count));
+    std::vector<unsigned char> failed(static_cast<std::size_t>(count), 0);
+    for (Index first = 0; first < count; first += chunk)
     {
-      error = "1-cell piece " + std::to_string(p) + ": " + error;
-      return false;
-    }
-    if (p % 64 == 0)
-    {
-      this->Hooks.Report(0.2 + 0.5 * static_cast<double>(p) / result.Pieces.size());
+      const Index last = std::min(count, first + chunk);
+      this->Parallel(first, last, [&](Index begin, Index end) {
+        for (Index p = begin; p < end; ++p)
+        {
+          SmoothedPiece& piece = result.Pieces[p];
+          piece.Parameters = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
+          failed[p] = !this->FitPiece(piece, nodes, this->Segments, domainBounds, pieceErrors[p]);
+        }
+      });
+      for (Index p = first; p < last; ++p)
+      {
+        if (failed[p])
+        {
+          error = "1-cell piece " + std::to_string(p) + ": " + pieceErrors[p];
+          return false;
+        }
+      }
+      this->Hooks.Report(0.2 + 0.5 * static_cast<double>(last) / count);
       if (this->Hooks.Aborted())
       {
         error = "aborted";

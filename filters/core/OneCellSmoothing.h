@@ -84,6 +84,8 @@ public:
     const double domainBounds[4], OneCellSmoothingResult& result, std::string& error) const;
 
   ProgressHooks Hooks;
+  // The per-piece fits are independent (GLPK keeps its state per thread): they run on this.
+  ParallelFor Parallel = SequentialFor;
 
 private:
   bool FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments, const double bounds[4],

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <tuple>
 
 namespace topospline
@@ -51,21 +52,49 @@ TopologyComparison CompareCriticalPoints(const std::vector<CriticalPointLocation
   {
     ++comparison.Found[std::clamp(cp.MorseIndex, 0, 2)];
   }
-  // Candidate pairs within the tolerance, closest first.
+  // Candidate pairs within the tolerance, closest first. The found points are bucketed in
+  // squares of the largest reach, so each expected point looks at its 3 x 3 neighbourhood
+  // only (comparing all pairs took 5.6 s for the 20 000 critical points of 200 x 200 noise).
+  double reach = 1;
+  for (const auto& cp : expected)
+  {
+    reach = std::max(reach, cp.Reach);
+  }
+  const double side = tolerance * reach > 0 ? tolerance * reach : 1.0;
+  auto bucketOf = [side](double x, double y) {
+    return std::make_pair(static_cast<long long>(std::floor(x / side)), static_cast<long long>(std::floor(y / side)));
+  };
+  std::map<std::pair<long long, long long>, std::vector<std::size_t>> buckets;
+  for (std::size_t f = 0; f < found.size(); ++f)
+  {
+    buckets[bucketOf(found[f].Position[0], found[f].Position[1])].push_back(f);
+  }
   std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
   for (std::size_t e = 0; e < expected.size(); ++e)
   {
-    for (std::size_t f = 0; f < found.size(); ++f)
+    const auto home = bucketOf(expected[e].Position[0], expected[e].Position[1]);
+    for (long long i = home.first - 1; i <= home.first + 1; ++i)
     {
-      if (expected[e].MorseIndex != found[f].MorseIndex)
+      for (long long j = home.second - 1; j <= home.second + 1; ++j)
       {
-        continue;
-      }
-      const double d = std::hypot(expected[e].Position[0] - found[f].Position[0],
-        expected[e].Position[1] - found[f].Position[1]);
-      if (d <= tolerance * expected[e].Reach)
-      {
-        pairs.emplace_back(d, e, f);
+        const auto bucket = buckets.find({ i, j });
+        if (bucket == buckets.end())
+        {
+          continue;
+        }
+        for (const std::size_t f : bucket->second)
+        {
+          if (expected[e].MorseIndex != found[f].MorseIndex)
+          {
+            continue;
+          }
+          const double d = std::hypot(expected[e].Position[0] - found[f].Position[0],
+            expected[e].Position[1] - found[f].Position[1]);
+          if (d <= tolerance * expected[e].Reach)
+          {
+            pairs.emplace_back(d, e, f);
+          }
+        }
       }
     }
   }

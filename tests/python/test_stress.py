@@ -17,7 +17,7 @@ For every case it records:
   junction pairs: within three).
 It also checks that the 1-cells lie within the input's bounds (images whose extent does not
 start at 0, or at z != 0). It fails on a crash or time-out, on 1-cells outside the input, and
-on a dishonest verdict (1 while the counter disagrees).
+on a dishonest verdict (1 while the counter disagrees or 2-cells failed).
 Errors and verdicts of 0 on valid input are printed with their totals: they are still open
 (docs/StressTest.md); TOPOSPLINE_STRESS_STRICT=1 fails on those too.
 
@@ -395,9 +395,9 @@ def judge(r, totals):
     if r.get("outside"):
         totals["geometry outside the input"] += 1
         problems.append("1-cells outside the input's bounds")
-    if r["verdict"] == 1 and (r["counted"] != r["expected"] or r.get("far")):
+    if r["verdict"] == 1 and (r["counted"] != r["expected"] or r.get("far") or r["failed_cells"] != 0):
         totals["dishonest verdicts"] += 1
-        problems.append("DISHONEST VERDICT: 1 although the independent check disagrees")
+        problems.append("DISHONEST VERDICT: 1 although the independent check disagrees or 2-cells failed")
     return problems
 
 
