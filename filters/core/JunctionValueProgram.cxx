@@ -24,7 +24,7 @@ bool JunctionValueProgram::Solve(const std::vector<JunctionValueNode>& originalN
   const std::vector<std::array<Index, 2>>& lowerThan, std::vector<double>& values, std::string& error)
 {
   std::vector<JunctionValueNode> nodes = originalNodes; // fixed values may be spread below
-  this->FoundCycle = false;
+  this->FoundOrderConflict = false;
   if (!(this->MarginFraction > 0) || !(this->MarginSafety > 0 && this->MarginSafety < 1))
   {
     error = "the junction program needs MarginFraction > 0 and MarginSafety in (0, 1)";
@@ -129,7 +129,7 @@ bool JunctionValueProgram::Solve(const std::vector<JunctionValueNode>& originalN
       {
         cycle = DescribeNode(nodes, n) + " < " + cycle;
       }
-      this->FoundCycle = true;
+      this->FoundOrderConflict = true;
       error = "the 'lower than' relations of the 1-cells contain a cycle (" + cycle + " < " + DescribeNode(nodes, at) +
         "): no strictly monotone values exist";
       return false;
@@ -261,6 +261,7 @@ bool JunctionValueProgram::Solve(const std::vector<JunctionValueNode>& originalN
           const double rise = nodes[w].Value - nodes[a].Value;
           if (!(rise > 0))
           {
+            this->FoundOrderConflict = true;
             error = "the 1-cells require " + DescribeNode(nodes, a) + " to be strictly lower than " +
               DescribeNode(nodes, w) + " (through " + std::to_string(chain) + " relations): no monotone values exist";
             return false;

@@ -61,7 +61,9 @@ public:
 
   // About the last successful Solve.
   double Margin = 0;
-  bool FoundCycle = false; // the last Solve failed on a cycle of relations
+  // The last Solve failed because the relations order nodes against each other: a cycle, or
+  // fixed values in the wrong order along a chain.
+  bool FoundOrderConflict = false;
   int SpreadCriticalValues = 0; // fixed values raised by the value spreading
   double MaximumSpread = 0;     // the largest such raise
   double TotalChange = 0;   // sum over free nodes of |x_j - f_j|

@@ -223,10 +223,10 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
   }
   // Normally every 1-cell is cut at every node it passes. A 1-cell merged by cancellations
   // runs up and down; where it passes another 1-cell's node on its way down, the pieces order
-  // nodes against each other's 1-cells and the relations hold a cycle. Only then the pieces
-  // are cut again at the nodes that rise along each 1-cell (KeepRisingCuts): the relations
-  // then follow one order of the nodes, so they hold no cycle, and the passed nodes are
-  // merely crossed.
+  // nodes against each other's 1-cells: the relations hold a cycle, or put a critical value
+  // above a lower one. Only then the pieces are cut again at the nodes that rise along each
+  // 1-cell (KeepRisingCuts): the relations then follow one order of the nodes, so they hold
+  // neither, and the passed nodes are merely crossed.
   const size_t nodesBeforeCorners = nodes.size();
   for (const bool risingCutsOnly : { false, true })
   {
@@ -369,7 +369,7 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
       std::vector<double> values;
       if (!program.Solve(programNodes, lowerThan, values, error))
       {
-        if (program.FoundCycle && !risingCutsOnly)
+        if (program.FoundOrderConflict && !risingCutsOnly)
         {
           continue;
         }

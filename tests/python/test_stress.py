@@ -91,8 +91,10 @@ def make_cases(catalog_entries, full, seed):
         for _ in range(10):
             add("extent", nx=int(rng.integers(16, 80)), ny=int(rng.integers(16, 80)),
                 x0=int(rng.integers(-50, 50)), y0=int(rng.integers(-50, 50)), z0=int(rng.integers(-5, 5)))
+            # any scale, the two axes up to 1e3 apart (beyond 1e4 the input is refused)
+            scale = float(10 ** rng.uniform(-3, 3))
             add("spacing", nx=int(rng.integers(16, 80)), ny=int(rng.integers(16, 80)),
-                spacing=[float(10 ** rng.uniform(-3, 3)), float(10 ** rng.uniform(-3, 3))])
+                spacing=[scale, scale * float(10 ** rng.uniform(-3, 3))])
     return cases
 
 
