@@ -182,14 +182,10 @@ int vtkTopoSplineSmoothOneCells::RequestData(
     // the complex orders by point id get numbers that strictly increase. Said aloud only where
     // it shows (above 1e-6 of the range: constant and near-constant fields); terrain plateaus
     // move by about 1e-11 of the range, reported in field data and at TRACE level.
-    double low = 0, high = 0;
-    for (std::size_t c = 0; c < complex.CriticalPoints.size(); ++c)
-    {
-      const double v = complex.CriticalPoints[c].Value;
-      low = c == 0 ? v : std::min(low, v);
-      high = c == 0 ? v : std::max(high, v);
-    }
-    vtkVLog(result.MaximumSpread > 1e-6 * (high - low) ? vtkLogger::VERBOSITY_INFO : vtkLogger::VERBOSITY_TRACE,
+    const auto [low, high] = std::minmax_element(complex.CriticalPoints.begin(), complex.CriticalPoints.end(),
+      [](const auto& a, const auto& b) { return a.Value < b.Value; });
+    vtkVLog(result.MaximumSpread > 1e-6 * (high->Value - low->Value) ? vtkLogger::VERBOSITY_INFO
+                                                                      : vtkLogger::VERBOSITY_TRACE,
       "Smooth 1-Cells: " << result.SpreadCriticalValues << " critical value(s) raised by at most "
                          << result.MaximumSpread << " so that values strictly increase along every 1-cell.");
   }

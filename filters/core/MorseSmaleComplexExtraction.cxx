@@ -173,8 +173,7 @@ bool MorseSmaleComplexExtraction::Extract(
   {
     this->Mesh.BuildGrid(field.GridDimensions[0], field.GridDimensions[1], this->Parallel);
   }
-  else if (!this->Mesh.Build(nV, field.Triangles, this->Parallel, error) ||
-    (!field.Points.empty() && !this->Mesh.CheckPlanarDisk(field.Points, error)))
+  else if (!this->Mesh.Build(nV, field.Triangles, this->Parallel, error))
   {
     return false;
   }
@@ -186,6 +185,11 @@ bool MorseSmaleComplexExtraction::Extract(
       error = "point " + std::to_string(v) + " is not used by any triangle";
       return false;
     }
+  }
+  // A mesh given as triangles (not a grid, not the caller's): must be a planar disk.
+  if (!this->GivenMesh && !field.IsGrid() && !field.Points.empty() && !this->Mesh.CheckPlanarDisk(field.Points, error))
+  {
+    return false;
   }
   this->Hooks.Report(0.2);
   if (this->Hooks.Aborted())

@@ -83,6 +83,160 @@ void KeepRisingCuts(std::vector<std::pair<long, Index>>& at, const std::vector<S
   std::reverse(kept.begin(), kept.end());
   at = std::move(kept);
 }
+// Cuts every 1-cell at the nodes it passes (its junction points, and the domain corners it
+// meets, which are added to `nodes`) into pieces; identical pieces (merged 1-cells) are kept
+// once. With risingCutsOnly only the cuts KeepRisingCuts keeps (see Smooth). Node positions
+// become the ends of the pieces that meet there.
+void CutIntoPieces(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
+  const std::vector<Index>& junctionNode, const double domainBounds[4], bool risingCutsOnly,
+  std::vector<SmoothingNode>& nodes, OneCellSmoothingResult& result)
+{
+  std::map<std::pair<double, double>, Index> cornerNode;
+  const double corners[4][2] = { { domainBounds[0], domainBounds[2] }, { domainBounds[1], domainBounds[2] },
+    { domainBounds[1], domainBounds[3] }, { domainBounds[0], domainBounds[3] } };
+  std::vector<std::vector<std::pair<long, Index>>> cuts(complex.Separatrices.size());
+  for (size_t j = 0; j < junctions.size(); ++j)
+  {
+    for (Index a : junctions[j].Separatrices)
+    {
+      const long at = PointIndexOfCell(complex.Separatrices[a], junctions[j].Cell);
+      if (at > 0 && at + 1 < static_cast<long>(complex.Separatrices[a].Values.size()))
+      {
+        cuts[a].push_back({ at, junctionNode[j] });
+      }
+    }
+  }
+  std::map<std::vector<double>, Index> pieceOfGeometry;
+  result.PiecesOfSeparatrix.resize(complex.Separatrices.size());
+  for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
+  {
+    const Separatrix& arc = complex.Separatrices[a];
+    const long n = static_cast<long>(arc.Values.size());
+    auto& at = cuts[a];
+    for (long p = 1; p + 1 < n; ++p)
+    {
+      for (int c = 0; c < 4; ++c)
+      {
+        if (arc.Points[2 * p] == corners[c][0] && arc.Points[2 * p + 1] == corners[c][1])
+        {
+          auto found = cornerNode.find({ corners[c][0], corners[c][1] });
+          if (found == cornerNode.end())
+          {
+            SmoothingNode node;
+            node.Type = SmoothingNode::DomainCorner;
+            node.Position[0] = corners[c][0];
+            node.Position[1] = corners[c][1];
+            node.FieldValue = node.Value = arc.Values[p];
+            found = cornerNode.insert({ { corners[c][0], corners[c][1] }, static_cast<Index>(nodes.size()) }).first;
+            nodes.push_back(node);
+          }
+          at.push_back({ p, found->second });
+        }
+      }
+    }
+    // A merged 1-cell may pass its own end's vertex before it ends there (the trivial
+    // embedding): no cut at its own ends' nodes.
+    at.erase(std::remove_if(at.begin(), at.end(),
+               [&](const auto& cut) { return cut.second == arc.Source || cut.second == arc.Destination; }),
+      at.end());
+    at.push_back({ 0, arc.Source });
+    at.push_back({ n - 1, arc.Destination });
+    std::sort(at.begin(), at.end());
+    at.erase(std::unique(at.begin(), at.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
+      at.end());
+    // A node passed twice, in a row (which would make a piece from a node to itself) or after
+    // an excursion: a merged 1-cell can run out to a cancelled extremum and back along the
+    // same path, passing its nodes a second time in the opposite order, and pieces cut at both
+    // visits would order those nodes both ways (a cycle no values can satisfy). The excursion
+    // stays inside one piece, from the first visit to the node after the last one.
+    for (size_t k = 0; k < at.size(); ++k)
+    {
+      size_t last = k;
+      for (size_t m = k + 1; m < at.size(); ++m)
+      {
+        last = at[m].second == at[k].second ? m : last;
+      }
+      at.erase(at.begin() + k + 1, at.begin() + last + 1);
+    }
+    if (risingCutsOnly)
+    {
+      KeepRisingCuts(at, nodes);
+    }
+    for (size_t k = 0; k + 1 < at.size(); ++k)
+    {
+      const long from = at[k].first, to = at[k + 1].first;
+      std::vector<double> key(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
+      key.push_back(arc.Type);
+      auto found = pieceOfGeometry.find(key);
+      if (found == pieceOfGeometry.end())
+      {
+        SmoothedPiece piece;
+        piece.Type = arc.Type;
+        piece.StartNode = at[k].second;
+        piece.EndNode = at[k + 1].second;
+        piece.Points.assign(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
+        piece.Values.assign(arc.Values.begin() + from, arc.Values.begin() + to + 1);
+        if (arc.Type == Separatrix::Ascending && to == n - 1 && piece.Values.size() > 2)
+        {
+          // Every ascending 1-cell into a maximum ends "centroid of the maximum's triangle,
+          // maximum's vertex": a segment they would all share. Go straight to the vertex.
+          piece.Points.erase(piece.Points.end() - 4, piece.Points.end() - 2);
+          piece.Values.erase(piece.Values.end() - 2);
+        }
+        found = pieceOfGeometry.insert({ key, static_cast<Index>(result.Pieces.size()) }).first;
+        result.Pieces.push_back(std::move(piece));
+      }
+      result.Pieces[found->second].Separatrices.push_back(a);
+      result.PiecesOfSeparatrix[a].push_back(found->second);
+    }
+  }
+  // Node positions: the ends of the pieces that meet there.
+  for (const SmoothedPiece& piece : result.Pieces)
+  {
+    for (int end = 0; end < 2; ++end)
+    {
+      SmoothingNode& node = nodes[end == 0 ? piece.StartNode : piece.EndNode];
+      const size_t p = end == 0 ? 0 : piece.Values.size() - 1;
+      node.Position[0] = piece.Points[2 * p];
+      node.Position[1] = piece.Points[2 * p + 1];
+    }
+  }
+}
+
+// Junction (and corner) values: one global program, strictly increasing along every piece.
+// False with the program's error (program.FoundOrderConflict says whether the pieces order
+// nodes against each other).
+bool SolveJunctionValues(std::vector<SmoothingNode>& nodes, OneCellSmoothingResult& result,
+  JunctionValueProgram& program, std::string& error)
+{
+  std::vector<JunctionValueNode> programNodes(nodes.size());
+  for (size_t i = 0; i < nodes.size(); ++i)
+  {
+    programNodes[i].Value = nodes[i].Type == SmoothingNode::Critical ? nodes[i].Value : nodes[i].FieldValue;
+    programNodes[i].Fixed = nodes[i].Type == SmoothingNode::Critical;
+  }
+  std::vector<std::array<Index, 2>> lowerThan;
+  for (const SmoothedPiece& piece : result.Pieces)
+  {
+    lowerThan.push_back({ piece.StartNode, piece.EndNode });
+  }
+  std::sort(lowerThan.begin(), lowerThan.end());
+  lowerThan.erase(std::unique(lowerThan.begin(), lowerThan.end()), lowerThan.end());
+  std::vector<double> values;
+  if (!program.Solve(programNodes, lowerThan, values, error))
+  {
+    return false;
+  }
+  for (size_t i = 0; i < nodes.size(); ++i)
+  {
+    nodes[i].Value = values[i];
+  }
+  result.JunctionMargin = program.Margin;
+  result.SpreadCriticalValues = program.SpreadCriticalValues;
+  result.MaximumSpread = program.MaximumSpread;
+  result.JunctionTotalChange = program.TotalChange;
+  return true;
+}
 } // namespace
 
 bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments,
@@ -234,158 +388,18 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
     result.Pieces.clear();
     result.PiecesOfSeparatrix.clear();
     result.RisingCutsOnly = risingCutsOnly;
-    std::map<std::pair<double, double>, Index> cornerNode;
-    const double corners[4][2] = { { domainBounds[0], domainBounds[2] }, { domainBounds[1], domainBounds[2] },
-      { domainBounds[1], domainBounds[3] }, { domainBounds[0], domainBounds[3] } };
-
-    // Cut every 1-cell at its nodes; identical pieces (merged 1-cells) are kept once.
-    std::vector<std::vector<std::pair<long, Index>>> cuts(complex.Separatrices.size());
-    for (size_t j = 0; j < junctions.size(); ++j)
-    {
-      for (Index a : junctions[j].Separatrices)
-      {
-        const long at = PointIndexOfCell(complex.Separatrices[a], junctions[j].Cell);
-        if (at > 0 && at + 1 < static_cast<long>(complex.Separatrices[a].Values.size()))
-        {
-          cuts[a].push_back({ at, junctionNode[j] });
-        }
-      }
-    }
-    std::map<std::vector<double>, Index> pieceOfGeometry;
-    result.PiecesOfSeparatrix.resize(complex.Separatrices.size());
-    for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
-    {
-      const Separatrix& arc = complex.Separatrices[a];
-      const long n = static_cast<long>(arc.Values.size());
-      auto& at = cuts[a];
-      for (long p = 1; p + 1 < n; ++p)
-      {
-        for (int c = 0; c < 4; ++c)
-        {
-          if (arc.Points[2 * p] == corners[c][0] && arc.Points[2 * p + 1] == corners[c][1])
-          {
-            auto found = cornerNode.find({ corners[c][0], corners[c][1] });
-            if (found == cornerNode.end())
-            {
-              SmoothingNode node;
-              node.Type = SmoothingNode::DomainCorner;
-              node.Position[0] = corners[c][0];
-              node.Position[1] = corners[c][1];
-              node.FieldValue = node.Value = arc.Values[p];
-              found = cornerNode.insert({ { corners[c][0], corners[c][1] }, static_cast<Index>(nodes.size()) }).first;
-              nodes.push_back(node);
-            }
-            at.push_back({ p, found->second });
-          }
-        }
-      }
-      // A merged 1-cell may pass its own end's vertex before it ends there (the trivial
-      // embedding): no cut at its own ends' nodes, nor twice in a row at one node, which would
-      // make a piece from a node to itself.
-      at.erase(std::remove_if(at.begin(), at.end(),
-                 [&](const auto& cut) { return cut.second == arc.Source || cut.second == arc.Destination; }),
-        at.end());
-      at.push_back({ 0, arc.Source });
-      at.push_back({ n - 1, arc.Destination });
-      std::sort(at.begin(), at.end());
-      at.erase(std::unique(at.begin(), at.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
-        at.end());
-      at.erase(std::unique(at.begin(), at.end(), [](const auto& x, const auto& y) { return x.second == y.second; }),
-        at.end());
-      // A merged 1-cell can run out to a cancelled extremum and back along the same path,
-      // passing its nodes a second time in the opposite order. Pieces cut at both visits would
-      // order those nodes both ways (a cycle no values can satisfy): the excursion stays inside
-      // one piece, from the first visit to the node after the last one.
-      for (size_t k = 0; k < at.size(); ++k)
-      {
-        size_t last = k;
-        for (size_t m = k + 1; m < at.size(); ++m)
-        {
-          last = at[m].second == at[k].second ? m : last;
-        }
-        at.erase(at.begin() + k + 1, at.begin() + last + 1);
-      }
-      if (risingCutsOnly)
-      {
-        KeepRisingCuts(at, nodes);
-      }
-      for (size_t k = 0; k + 1 < at.size(); ++k)
-      {
-        const long from = at[k].first, to = at[k + 1].first;
-        std::vector<double> key(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
-        key.push_back(arc.Type);
-        auto found = pieceOfGeometry.find(key);
-        if (found == pieceOfGeometry.end())
-        {
-          SmoothedPiece piece;
-          piece.Type = arc.Type;
-          piece.StartNode = at[k].second;
-          piece.EndNode = at[k + 1].second;
-          piece.Points.assign(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
-          piece.Values.assign(arc.Values.begin() + from, arc.Values.begin() + to + 1);
-          if (arc.Type == Separatrix::Ascending && to == n - 1 && piece.Values.size() > 2)
-          {
-            // Every ascending 1-cell into a maximum ends "centroid of the maximum's triangle,
-            // maximum's vertex": a segment they would all share. Go straight to the vertex.
-            piece.Points.erase(piece.Points.end() - 4, piece.Points.end() - 2);
-            piece.Values.erase(piece.Values.end() - 2);
-          }
-          found = pieceOfGeometry.insert({ key, static_cast<Index>(result.Pieces.size()) }).first;
-          result.Pieces.push_back(std::move(piece));
-        }
-        result.Pieces[found->second].Separatrices.push_back(a);
-        result.PiecesOfSeparatrix[a].push_back(found->second);
-      }
-    }
-    // Node positions: the ends of the pieces that meet there.
-    for (const SmoothedPiece& piece : result.Pieces)
-    {
-      for (int end = 0; end < 2; ++end)
-      {
-        SmoothingNode& node = nodes[end == 0 ? piece.StartNode : piece.EndNode];
-        const size_t p = end == 0 ? 0 : piece.Values.size() - 1;
-        node.Position[0] = piece.Points[2 * p];
-        node.Position[1] = piece.Points[2 * p + 1];
-      }
-    }
+    CutIntoPieces(complex, junctions, junctionNode, domainBounds, risingCutsOnly, nodes, result);
     this->Hooks.Report(0.1);
-
-    // Junction (and corner) values: one global program, strictly increasing along every piece.
+    JunctionValueProgram program;
+    if (SolveJunctionValues(nodes, result, program, error))
     {
-      std::vector<JunctionValueNode> programNodes(nodes.size());
-      for (size_t i = 0; i < nodes.size(); ++i)
-      {
-        programNodes[i].Value = nodes[i].Type == SmoothingNode::Critical ? nodes[i].Value : nodes[i].FieldValue;
-        programNodes[i].Fixed = nodes[i].Type == SmoothingNode::Critical;
-      }
-      std::vector<std::array<Index, 2>> lowerThan;
-      for (const SmoothedPiece& piece : result.Pieces)
-      {
-        lowerThan.push_back({ piece.StartNode, piece.EndNode });
-      }
-      std::sort(lowerThan.begin(), lowerThan.end());
-      lowerThan.erase(std::unique(lowerThan.begin(), lowerThan.end()), lowerThan.end());
-      JunctionValueProgram program;
-      std::vector<double> values;
-      if (!program.Solve(programNodes, lowerThan, values, error))
-      {
-        if (program.FoundOrderConflict && !risingCutsOnly)
-        {
-          continue;
-        }
-        error = "junction values: " + error;
-        return false;
-      }
-      for (size_t i = 0; i < nodes.size(); ++i)
-      {
-        nodes[i].Value = values[i];
-      }
-      result.JunctionMargin = program.Margin;
-      result.SpreadCriticalValues = program.SpreadCriticalValues;
-      result.MaximumSpread = program.MaximumSpread;
-      result.JunctionTotalChange = program.TotalChange;
+      break;
     }
-    break;
+    if (!program.FoundOrderConflict || risingCutsOnly)
+    {
+      error = "junction values: " + error;
+      return false;
+    }
   }
   this->Hooks.Report(0.2);
 

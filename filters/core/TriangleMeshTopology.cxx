@@ -328,11 +328,6 @@ bool TriangleMeshTopology::CheckPlanarDisk(const std::vector<double>& points, st
   for (Index v = 0; v < nV; ++v)
   {
     const Index triangles = this->VertexTriangleEnd(v) - this->VertexTriangleBegin(v);
-    if (triangles == 0)
-    {
-      error = "point " + std::to_string(v) + " is not used by any triangle";
-      return false;
-    }
     const bool oneFan = this->IsBoundaryVertex(v) ? boundaryEdges[v] == 2 && edges[v] == triangles + 1
                                                   : edges[v] == triangles;
     if (!oneFan)

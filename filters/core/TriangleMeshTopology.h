@@ -18,7 +18,8 @@ public:
   bool Build(Index numberOfVertices, const std::vector<Index>& triangles, const ParallelFor& parallelFor,
     std::string& error);
 
-  // After Build: false with `error` unless the mesh is a planar disk as the complex needs it:
+  // After Build, on a mesh whose every point is in a triangle (MorseSmaleComplexExtraction
+  // checks that first): false with `error` unless the mesh is a planar disk as the complex needs it:
   // one fan of triangles around every vertex (no bow-tie), one piece without holes (Euler
   // characteristic 1), no zero-area triangle, and no fold (the two triangles of every
   // interior edge on opposite sides of it). points: x, y per vertex.

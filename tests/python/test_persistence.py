@@ -20,7 +20,6 @@ import numpy as np
 from paraview.simple import *
 from paraview import servermanager as sm
 from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
-from vtkmodules.vtkCommonDataModel import vtkImageData
 
 import topospline_testing as tt
 
@@ -98,15 +97,8 @@ def edges_reversed(edges, n):
 
 # --- running the filters on numpy fields ------------------------------------------------------
 def image_source(values2d, spacing=(1.0, 1.0)):
-    ny, nx = values2d.shape
-    image = vtkImageData()
-    image.SetDimensions(nx, ny, 1)
-    image.SetSpacing(spacing[0], spacing[1], 1)
-    array = numpy_to_vtk(np.ascontiguousarray(values2d.ravel(), dtype=np.float64), deep=1)
-    array.SetName("f")
-    image.GetPointData().AddArray(array)
     producer = TrivialProducer()
-    producer.GetClientSideObject().SetOutput(image)
+    producer.GetClientSideObject().SetOutput(tt.image_data(values2d, spacing=(spacing[0], spacing[1], 1)))
     return producer
 
 

@@ -194,7 +194,7 @@ def worker(cases_file, first):
     from paraview import servermanager as sm
     from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
     from vtkmodules.vtkCommonCore import vtkPoints, vtkCommand
-    from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPolyData, vtkCellArray
+    from vtkmodules.vtkCommonDataModel import vtkPolyData, vtkCellArray
     from vtkmodules.vtkFiltersCore import vtkDelaunay2D
     from vtkmodules.util.misc import calldata_type
     from vtkmodules.util.vtkConstants import VTK_STRING
@@ -207,17 +207,7 @@ def worker(cases_file, first):
     with open(cases_file) as f:
         cases = json.load(f)
 
-    def image(values2d, origin=(0, 0, 0), spacing=(1, 1, 1), extent_start=(0, 0, 0)):
-        ny, nx = values2d.shape
-        im = vtkImageData()
-        x0, y0, z0 = extent_start
-        im.SetExtent(x0, x0 + nx - 1, y0, y0 + ny - 1, z0, z0)
-        im.SetOrigin(*origin)
-        im.SetSpacing(*spacing)
-        arr = numpy_to_vtk(np.ascontiguousarray(values2d.ravel(), dtype=np.float64), deep=1)
-        arr.SetName("f")
-        im.GetPointData().AddArray(arr)
-        return im
+    image = tt.image_data
 
     def polydata(points2d, triangles, values):
         pd = vtkPolyData()
@@ -376,6 +366,10 @@ def describe(case):
                                   " ".join("%s=%s" % (k, v) for k, v in case.items() if k not in skip), case["seed"])
 
 
+PROBLEMS = ("errors", "crashes", "verdict 0", "count mismatches", "far critical points", "dishonest verdicts",
+            "geometry outside the input")
+
+
 def judge(r, totals):
     """The problems of one case's result, counted into totals."""
     problems = []
@@ -405,14 +399,10 @@ def judge(r, totals):
 
 def main():
     sys.path.insert(0, HERE)
-    with open(os.path.join(os.environ.get("TOPOSPLINE_TEST_DATA", os.path.join(HERE, "..", "data")),
-                           "catalog.json")) as f:
-        entries = json.load(f)["datasets"]
-    shared = os.environ.get("TOPOSPLINE_SHARED_DATA", os.path.join(HERE, "..", "..", "..", "shared", "data"))
-    local = os.environ.get("TOPOSPLINE_TEST_DATA", os.path.join(HERE, "..", "data"))
+    import topospline_testing as tt
     present = []
-    for entry in entries:
-        if any(os.path.exists(os.path.join(d, entry["file"])) for d in (local, shared)):
+    for entry in tt.catalog():
+        if tt.find_dataset(entry["file"]):
             present.append(entry)
         else:
             print("SKIP %s: not found (large data sets live in ../shared/data)" % entry["file"], flush=True)
@@ -420,7 +410,8 @@ def main():
     if not FULL:
         # the CI subset: crops of the data sets shipped in the repo only, so it runs the same
         # everywhere
-        cases = [c for c in cases if c["kind"] != "crop" or os.path.exists(os.path.join(local, c["file"]))]
+        cases = [c for c in cases
+                 if c["kind"] != "crop" or os.path.exists(os.path.join(tt.test_data_dir(), c["file"]))]
     print("%d cases, seed %d (%s set)" % (len(cases), SEED, "full" if FULL else "CI"), flush=True)
     import tempfile
     results = {}
@@ -461,9 +452,7 @@ def main():
                 r["errors"] += printed_errors
                 results[r["id"]] = r
                 current = None
-                problems = judge(r, {key: 0 for key in ("errors", "crashes", "verdict 0", "count mismatches",
-                                                        "far critical points", "dishonest verdicts",
-                                                        "geometry outside the input")})
+                problems = judge(r, dict.fromkeys(PROBLEMS, 0))
                 print("%s %s: %.1f s, L_inf %.1f %% of the range%s" % (
                     "FAIL" if problems else "ok", describe(by_id[r["id"]]), r["seconds"], r.get("max_error_percent", -1),
                     (": " + "; ".join(problems)) if problems else ""), flush=True)
@@ -485,8 +474,8 @@ def main():
             position = min(position + CASES_PER_WORKER, len(cases))
     os.unlink(cases_file)
 
-    totals = {"cases": len(cases), "errors": 0, "crashes": 0, "verdict 0": 0, "count mismatches": 0,
-              "far critical points": 0, "dishonest verdicts": 0, "geometry outside the input": 0}
+    totals = dict.fromkeys(PROBLEMS, 0)
+    totals["cases"] = len(cases)
     print("\nsummary of the failed cases:")
     for case in cases:
         problems = judge(results.get(case["id"], {"crash": "no result"}), totals)

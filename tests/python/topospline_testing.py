@@ -91,6 +91,22 @@ class Checks:
         sys.exit(1 if self.failed else 0)
 
 
+def image_data(values2d, name="f", origin=(0, 0, 0), spacing=(1, 1, 1), extent_start=(0, 0, 0)):
+    """A one-layer vtkImageData with values2d (ny x nx) as the point array `name`."""
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    ny, nx = values2d.shape
+    image = vtkImageData()
+    x0, y0, z0 = extent_start
+    image.SetExtent(x0, x0 + nx - 1, y0, y0 + ny - 1, z0, z0)
+    image.SetOrigin(*origin)
+    image.SetSpacing(*spacing)
+    array = numpy_to_vtk(np.ascontiguousarray(values2d.ravel(), dtype=np.float64), deep=1)
+    array.SetName(name)
+    image.GetPointData().AddArray(array)
+    return image
+
+
 def field_value(fd, name, index=0):
     """Component `index` of field-data array `name`, or None if it is absent."""
     array = fd.GetArray(name)
