@@ -7,13 +7,13 @@ namespace vtkTopoSplineArrayNames
 // Blocks of the complex (a vtkMultiBlockDataSet, in this order). The names are valid
 // data-assembly node names, so ParaView selectors are simply "/Root/OneCells" etc.
 constexpr const char* CriticalPointsBlock = "CriticalPoints";
-constexpr const char* SeparatricesBlock = "OneCells";
+constexpr const char* OneCellsBlock = "OneCells";
 constexpr const char* TwoCellsBlock = "TwoCells";
 constexpr const char* SegmentationBlock = "Segmentation";
 enum BlockIndex
 {
   CriticalPointsIndex = 0,
-  SeparatricesIndex = 1,
+  OneCellsIndex = 1,
   TwoCellsIndex = 2,
   SegmentationIndex = 3,
   NumberOfBlocks = 4,

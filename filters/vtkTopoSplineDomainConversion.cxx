@@ -368,14 +368,14 @@ void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
   }
 
   // 1-cells as polylines.
-  vtkNew<vtkPolyData> separatrices;
+  vtkNew<vtkPolyData> oneCells;
   {
     vtkIdType nPoints = 0;
-    for (const auto& arc : complex.Separatrices)
+    for (const auto& arc : complex.OneCells)
     {
       nPoints += static_cast<vtkIdType>(arc.Values.size());
     }
-    const vtkIdType n = static_cast<vtkIdType>(complex.Separatrices.size());
+    const vtkIdType n = static_cast<vtkIdType>(complex.OneCells.size());
     vtkNew<vtkPoints> points;
     points->SetDataTypeToDouble();
     points->SetNumberOfPoints(nPoints);
@@ -390,10 +390,10 @@ void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
     std::vector<vtkIdType> ids;
     for (vtkIdType a = 0; a < n; ++a)
     {
-      const auto& arc = complex.Separatrices[a];
+      const auto& arc = complex.OneCells[a];
       const vtkIdType count = static_cast<vtkIdType>(arc.Values.size());
       // Ascending arcs carry one more point at each end than mesh cells (saddle, maximum).
-      const vtkIdType offset = arc.Type == topospline::Separatrix::Ascending ? 1 : 0;
+      const vtkIdType offset = arc.Type == topospline::OneCell::Ascending ? 1 : 0;
       ids.resize(count);
       for (vtkIdType p = 0; p < count; ++p)
       {
@@ -411,12 +411,12 @@ void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
       destination->SetValue(a, cps[arc.Destination].Id);
       type->SetValue(a, arc.Type);
     }
-    separatrices->SetPoints(points);
-    separatrices->SetLines(lines);
-    separatrices->GetPointData()->AddArray(along);
-    separatrices->GetPointData()->AddArray(meshCell);
-    separatrices->GetPointData()->SetActiveScalars(names::ScalarAlong);
-    AddArrays(separatrices->GetCellData(), { id, source, destination, type });
+    oneCells->SetPoints(points);
+    oneCells->SetLines(lines);
+    oneCells->GetPointData()->AddArray(along);
+    oneCells->GetPointData()->AddArray(meshCell);
+    oneCells->GetPointData()->SetActiveScalars(names::ScalarAlong);
+    AddArrays(oneCells->GetCellData(), { id, source, destination, type });
   }
 
   // 2-cells: one point per cell at its centroid, carrying its corners and sides.
@@ -449,7 +449,7 @@ void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
       saddles->SetTypedComponent(c, 1, stable(cell.Saddles[1]));
       for (int k = 0; k < 4; ++k)
       {
-        arcs->SetTypedComponent(c, k, cell.Arcs[k]);
+        arcs->SetTypedComponent(c, k, cell.BoundaryOneCells[k]);
       }
       pouch->SetValue(c, cell.Pouch ? 1 : 0);
       size->SetValue(c, cell.NumberOfVertices);
@@ -480,7 +480,7 @@ void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
 
   output->SetNumberOfBlocks(names::NumberOfBlocks);
   const std::pair<vtkDataObject*, const char*> blocks[] = { { critical, names::CriticalPointsBlock },
-    { separatrices, names::SeparatricesBlock }, { twoCells, names::TwoCellsBlock },
+    { oneCells, names::OneCellsBlock }, { twoCells, names::TwoCellsBlock },
     { segmentation, names::SegmentationBlock } };
   for (unsigned int b = 0; b < names::NumberOfBlocks; ++b)
   {
@@ -515,10 +515,10 @@ bool FromMultiBlock(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& 
 {
   complex = topospline::MorseSmaleComplex();
   auto* critical = input ? vtkPolyData::SafeDownCast(input->GetBlock(names::CriticalPointsIndex)) : nullptr;
-  auto* separatrices = input ? vtkPolyData::SafeDownCast(input->GetBlock(names::SeparatricesIndex)) : nullptr;
+  auto* oneCells = input ? vtkPolyData::SafeDownCast(input->GetBlock(names::OneCellsIndex)) : nullptr;
   auto* twoCells = input ? vtkPolyData::SafeDownCast(input->GetBlock(names::TwoCellsIndex)) : nullptr;
   vtkDataSet* segmentation = SegmentationOf(input);
-  if (!critical || !separatrices || !twoCells || !segmentation)
+  if (!critical || !oneCells || !twoCells || !segmentation)
   {
     error = "the input is not a Morse-Smale complex (expected the output of the \"Morse-Smale Complex\" filter)";
     return false;
@@ -532,12 +532,12 @@ bool FromMultiBlock(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& 
   vtkDataArray* vertex = RequireArray(pd, names::VertexId, error);
   vtkDataArray* cell = RequireArray(pd, "CriticalCellId", error);
   vtkDataArray* boundary = RequireArray(pd, names::IsOnBoundary, error);
-  auto* cd = separatrices->GetCellData();
+  auto* cd = oneCells->GetCellData();
   vtkDataArray* source = RequireArray(cd, names::SourceId, error);
   vtkDataArray* destination = RequireArray(cd, names::DestinationId, error);
   vtkDataArray* type = RequireArray(cd, names::SeparatrixType, error);
-  vtkDataArray* along = RequireArray(separatrices->GetPointData(), names::ScalarAlong, error);
-  vtkDataArray* meshCell = RequireArray(separatrices->GetPointData(), names::MeshCellId, error);
+  vtkDataArray* along = RequireArray(oneCells->GetPointData(), names::ScalarAlong, error);
+  vtkDataArray* meshCell = RequireArray(oneCells->GetPointData(), names::MeshCellId, error);
   auto* sd = segmentation->GetPointData();
   vtkDataArray* ascending = RequireArray(sd, names::AscendingManifoldId, error);
   vtkDataArray* descending = RequireArray(sd, names::DescendingManifoldId, error);
@@ -584,19 +584,19 @@ bool FromMultiBlock(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& 
     return s >= 0 && s < static_cast<long long>(position.size()) ? position[s] : topospline::InvalidIndex;
   };
 
-  vtkCellArray* lines = separatrices->GetLines();
+  vtkCellArray* lines = oneCells->GetLines();
   vtkNew<vtkIdList> ids;
   lines->InitTraversal();
   for (vtkIdType a = 0; lines->GetNextCell(ids); ++a)
   {
-    topospline::Separatrix arc;
-    arc.Type = type->GetComponent(a, 0) == 0 ? topospline::Separatrix::Descending : topospline::Separatrix::Ascending;
+    topospline::OneCell arc;
+    arc.Type = type->GetComponent(a, 0) == 0 ? topospline::OneCell::Descending : topospline::OneCell::Ascending;
     arc.Source = local(source->GetComponent(a, 0));
     arc.Destination = local(destination->GetComponent(a, 0));
     for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k)
     {
       double xyz[3];
-      separatrices->GetPoint(ids->GetId(k), xyz);
+      oneCells->GetPoint(ids->GetId(k), xyz);
       arc.Points.push_back(xyz[embedding.U]);
       arc.Points.push_back(xyz[embedding.V]);
       arc.Values.push_back(along->GetComponent(ids->GetId(k), 0));
@@ -611,7 +611,7 @@ bool FromMultiBlock(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& 
       error = "the input is not a Morse-Smale complex: a 1-cell refers to a missing critical point";
       return false;
     }
-    complex.Separatrices.push_back(std::move(arc));
+    complex.OneCells.push_back(std::move(arc));
   }
 
   const vtkIdType nCells = twoCells->GetNumberOfPoints();
@@ -623,7 +623,7 @@ bool FromMultiBlock(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& 
     twoCell.Saddles = { local(saddles->GetComponent(c, 0)), local(saddles->GetComponent(c, 1)) };
     for (int k = 0; k < 4; ++k)
     {
-      twoCell.Arcs[k] = static_cast<Index>(arcs->GetComponent(c, k));
+      twoCell.BoundaryOneCells[k] = static_cast<Index>(arcs->GetComponent(c, k));
     }
     twoCell.Pouch = pouch->GetComponent(c, 0) != 0;
     twoCell.NumberOfVertices = static_cast<Index>(size->GetComponent(c, 0));

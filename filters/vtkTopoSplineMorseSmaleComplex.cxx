@@ -108,7 +108,7 @@ int vtkTopoSplineMorseSmaleComplex::RequestData(
   }
   const auto counts = complex.CountByIndex();
   vtkLog(TRACE, "Morse-Smale complex: " << counts[0] << " minima, " << counts[1] << " saddles, " << counts[2]
-                                       << " maxima, " << complex.Separatrices.size() << " 1-cells, "
+                                       << " maxima, " << complex.OneCells.size() << " 1-cells, "
                                        << complex.TwoCells.size() << " 2-cells");
   {
     vtkLogScopeF(TRACE, "build output");

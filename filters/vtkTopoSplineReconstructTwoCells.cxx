@@ -104,7 +104,7 @@ bool ReadSmoothedPieces(vtkMultiBlockDataSet* input, const topospline::MorseSmal
     return false;
   }
   const vtkIdType arcs = offsets->GetNumberOfTuples() - 1;
-  if (arcs != static_cast<vtkIdType>(complex.Separatrices.size()))
+  if (arcs != static_cast<vtkIdType>(complex.OneCells.size()))
   {
     error = "the smoothed 1-cells do not match the complex";
     return false;
@@ -146,7 +146,7 @@ bool ReadSmoothedPieces(vtkMultiBlockDataSet* input, const topospline::MorseSmal
     ++smoothed.Curve.Segments;
     ++smoothed.Height.Segments;
   }
-  result.PiecesOfSeparatrix.resize(arcs);
+  result.PiecesOfOneCell.resize(arcs);
   for (vtkIdType a = 0; a < arcs; ++a)
   {
     const vtkIdType begin = static_cast<vtkIdType>(offsets->GetComponent(a, 0));
@@ -159,7 +159,7 @@ bool ReadSmoothedPieces(vtkMultiBlockDataSet* input, const topospline::MorseSmal
         error = "the smoothed 1-cells list unknown pieces";
         return false;
       }
-      result.PiecesOfSeparatrix[a].push_back(p);
+      result.PiecesOfOneCell[a].push_back(p);
     }
   }
   return true;

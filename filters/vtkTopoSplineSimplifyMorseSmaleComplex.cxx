@@ -77,7 +77,7 @@ vtkSmartPointer<vtkPolyData> JunctionPointsBlock(
     value->InsertNextValue(junction.Value);
     critical->InsertNextValue(
       junction.CriticalPoint == topospline::InvalidIndex ? -1 : cps[junction.CriticalPoint].Id);
-    count->InsertNextValue(static_cast<int>(junction.Separatrices.size()));
+    count->InsertNextValue(static_cast<int>(junction.OneCells.size()));
   }
   block->SetPoints(points);
   block->SetVerts(verts);

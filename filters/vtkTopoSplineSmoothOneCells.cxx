@@ -68,16 +68,16 @@ bool ReadJunctions(vtkMultiBlockDataSet* input, const topospline::MorseSmaleComp
     position[complex.CriticalPoints[i].Id] = i;
   }
   std::map<Index, std::vector<Index>> arcsOfExtremum;
-  for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
+  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
   {
-    const auto& arc = complex.Separatrices[a];
-    arcsOfExtremum[arc.Type == topospline::Separatrix::Descending ? arc.Source : arc.Destination].push_back(a);
+    const auto& arc = complex.OneCells[a];
+    arcsOfExtremum[arc.Type == topospline::OneCell::Descending ? arc.Source : arc.Destination].push_back(a);
   }
   const auto plane = vtkTopoSplineDomainConversion::PlaneOf(vtkTopoSplineDomainConversion::SegmentationOf(input));
   for (vtkIdType j = 0; j < block->GetNumberOfPoints(); ++j)
   {
     topospline::JunctionPoint junction;
-    junction.Type = type->GetComponent(j, 0) == 0 ? topospline::Separatrix::Descending : topospline::Separatrix::Ascending;
+    junction.Type = type->GetComponent(j, 0) == 0 ? topospline::OneCell::Descending : topospline::OneCell::Ascending;
     const auto ext = position.find(static_cast<Index>(extremum->GetComponent(j, 0)));
     const auto cp = position.find(static_cast<Index>(critical->GetComponent(j, 0)));
     if (ext == position.end())
@@ -93,11 +93,11 @@ bool ReadJunctions(vtkMultiBlockDataSet* input, const topospline::MorseSmaleComp
     plane.ToPlanar(xyz, junction.Position);
     for (Index a : arcsOfExtremum[junction.Extremum])
     {
-      const auto& arc = complex.Separatrices[a];
+      const auto& arc = complex.OneCells[a];
       if (arc.Type == junction.Type &&
         std::find(arc.MeshCells.begin(), arc.MeshCells.end(), junction.Cell) != arc.MeshCells.end())
       {
-        junction.Separatrices.push_back(a);
+        junction.OneCells.push_back(a);
       }
     }
     junctions.push_back(std::move(junction));
@@ -250,7 +250,7 @@ int vtkTopoSplineSmoothOneCells::RequestData(
     auto offsets = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::SeparatrixPieceOffsets);
     auto list = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::SeparatrixPieces);
     offsets->InsertNextValue(0);
-    for (const auto& pieces : result.PiecesOfSeparatrix)
+    for (const auto& pieces : result.PiecesOfOneCell)
     {
       for (Index p : pieces)
       {
@@ -277,10 +277,10 @@ int vtkTopoSplineSmoothOneCells::RequestData(
     auto destination = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::DestinationId);
     auto type = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::SeparatrixType);
     std::vector<vtkIdType> ids;
-    for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
+    for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
     {
       ids.clear();
-      for (Index p : result.PiecesOfSeparatrix[a])
+      for (Index p : result.PiecesOfOneCell[a])
       {
         const auto& smoothed = result.Pieces[p];
         const int count = smoothed.Curve.Segments * this->SamplesPerSegment;
@@ -294,7 +294,7 @@ int vtkTopoSplineSmoothOneCells::RequestData(
           height->InsertNextValue(smoothed.Height.Value(t));
         }
       }
-      const auto& arc = complex.Separatrices[a];
+      const auto& arc = complex.OneCells[a];
       if (ids.empty())
       {
         // A 1-cell of one point (a saddle on its minimum's vertex, zero persistence).

@@ -82,7 +82,7 @@ void MorseSmaleComplexExtraction::SortAroundExtremum(const MorseSmaleComplex& co
   std::vector<std::vector<std::array<double, 2>>> paths(arcs.size());
   for (size_t k = 0; k < arcs.size(); ++k)
   {
-    const Separatrix& arc = complex.Separatrices[arcs[k]];
+    const OneCell& arc = complex.OneCells[arcs[k]];
     // From the extremum outwards; ascending 1-cells are stored from the saddle.
     for (size_t p = 0; p < arc.Values.size(); ++p)
     {
@@ -121,16 +121,6 @@ void MorseSmaleComplexExtraction::SortAroundExtremum(const MorseSmaleComplex& co
   std::vector<Index> sorted = arcs;
   std::sort(sorted.begin(), sorted.end(), less);
   arcs = sorted;
-}
-
-std::array<Index, 3> MorseSmaleComplex::CountByIndex() const
-{
-  std::array<Index, 3> counts{ 0, 0, 0 };
-  for (const auto& cp : this->CriticalPoints)
-  {
-    ++counts[cp.MorseIndex];
-  }
-  return counts;
 }
 
 bool MorseSmaleComplexExtraction::Extract(
@@ -287,10 +277,10 @@ bool MorseSmaleComplexExtraction::Extract(
   }
   this->Hooks.Report(0.65);
 
-  // Separatrices: two descending and up to two ascending V-paths per saddle. Slots are fixed
+  // OneCells: two descending and up to two ascending V-paths per saddle. Slots are fixed
   // per saddle so the parallel tracing writes disjoint entries.
   const Index nS = static_cast<Index>(saddles.size());
-  std::vector<Separatrix> slots(4 * static_cast<size_t>(nS));
+  std::vector<OneCell> slots(4 * static_cast<size_t>(nS));
   std::vector<unsigned char> traced(4 * static_cast<size_t>(nS), 0);
   auto point = [&](Index v, std::vector<double>& pts) {
     pts.push_back(field.Points[2 * v]);
@@ -305,8 +295,8 @@ bool MorseSmaleComplexExtraction::Extract(
       const Index owner = saddle.Vertex;
       for (int side = 0; side < 2; ++side)
       {
-        Separatrix& arc = slots[4 * k + side];
-        arc.Type = Separatrix::Descending;
+        OneCell& arc = slots[4 * k + side];
+        arc.Type = OneCell::Descending;
         arc.Destination = saddles[k];
         std::vector<Index> cells{ owner };
         Index u = mesh.EdgeVertices[e][side];
@@ -336,8 +326,8 @@ bool MorseSmaleComplexExtraction::Extract(
         {
           continue;
         }
-        Separatrix& arc = slots[4 * k + 2 + side];
-        arc.Type = Separatrix::Ascending;
+        OneCell& arc = slots[4 * k + 2 + side];
+        arc.Type = OneCell::Ascending;
         arc.Source = saddles[k];
         point(owner, arc.Points);
         arc.Values.push_back(f[owner]);
@@ -381,27 +371,27 @@ bool MorseSmaleComplexExtraction::Extract(
   {
     if (traced[s])
     {
-      arcOfSlot[s] = static_cast<Index>(complex.Separatrices.size());
-      complex.Separatrices.push_back(std::move(slots[s]));
+      arcOfSlot[s] = static_cast<Index>(complex.OneCells.size());
+      complex.OneCells.push_back(std::move(slots[s]));
     }
   }
   this->Hooks.Report(0.8);
 
-  // 2-cells. A 2-cell is a region of vertices that no separatrix crosses. Cut the mesh along
-  // the separatrices: vertices of descending 1-cells and of maximum triangles join no region
+  // 2-cells. A 2-cell is a region of vertices that no 1-cell crosses. Cut the mesh along
+  // the 1-cells: vertices of descending 1-cells and of maximum triangles join no region
   // directly, and edges that an ascending 1-cell crosses join nothing. Descending 1-cells
   // bound the descending manifolds, so each region lies in one of them; its maximum is read
   // from the sectors. (Per-vertex labels alone are not enough: both sides of a 1-cell can
   // flow to the same extrema, e.g. next to a saddle whose descending 1-cells share a minimum.)
-  std::vector<unsigned char> onSeparatrix(nV, 0);
+  std::vector<unsigned char> onOneCell(nV, 0);
   std::vector<unsigned char> crossed(mesh.NumberOfEdges(), 0);
-  for (const Separatrix& arc : complex.Separatrices)
+  for (const OneCell& arc : complex.OneCells)
   {
-    if (arc.Type == Separatrix::Descending)
+    if (arc.Type == OneCell::Descending)
     {
       for (Index v : arc.MeshCells)
       {
-        onSeparatrix[v] = 1;
+        onOneCell[v] = 1;
       }
     }
     else
@@ -419,7 +409,7 @@ bool MorseSmaleComplexExtraction::Extract(
     {
       for (Index v : mesh.TriangleVertices[cp.Cell])
       {
-        onSeparatrix[v] = 1;
+        onOneCell[v] = 1;
       }
     }
   }
@@ -430,17 +420,17 @@ bool MorseSmaleComplexExtraction::Extract(
   for (Index e = 0; e < mesh.NumberOfEdges(); ++e)
   {
     const Index a = mesh.EdgeVertices[e][0], b = mesh.EdgeVertices[e][1];
-    if (!crossed[e] && !onSeparatrix[a] && !onSeparatrix[b] && sameLabels(a, b))
+    if (!crossed[e] && !onOneCell[a] && !onOneCell[b] && sameLabels(a, b))
     {
       components.Union(a, b);
     }
   }
 
   // Each saddle opens into 4 sectors (2 on the boundary), each between one descending and
-  // one ascending separatrix: a corner of one 2-cell. That 2-cell runs along the whole
-  // ascending separatrix on the side of the descending one, so walk the ascending path,
+  // one ascending 1-cell: a corner of one 2-cell. That 2-cell runs along the whole
+  // ascending 1-cell on the side of the descending one, so walk the ascending path,
   // tracking which endpoint of each crossed edge is on that side, and take the region of the
-  // first such vertex that is off the separatrices and carries the sector's labels.
+  // first such vertex that is off the 1-cells and carries the sector's labels.
   struct Sector
   {
     Index Saddle, Descending, Ascending, Component;
@@ -460,7 +450,7 @@ bool MorseSmaleComplexExtraction::Extract(
       {
         continue;
       }
-      const Separatrix& up = complex.Separatrices[ascending];
+      const OneCell& up = complex.OneCells[ascending];
       for (int dside = 0; dside < 2; ++dside)
       {
         // The sector lies left of the curve (minimum -> x -> y -> other minimum) through the
@@ -469,9 +459,9 @@ bool MorseSmaleComplexExtraction::Extract(
         const Index c = ThirdVertex(mesh, up.MeshCells.front(), x, y);
         Sector sector{ saddles[k], arcOfSlot[4 * k + dside], ascending, InvalidIndex,
           Orientation(field.Points, x, y, c) > 0 };
-        const Index m = complex.Separatrices[sector.Descending].Source;
+        const Index m = complex.OneCells[sector.Descending].Source;
         auto accept = [&](Index w) {
-          if (!onSeparatrix[w] && complex.AscendingManifold[w] == m)
+          if (!onOneCell[w] && complex.AscendingManifold[w] == m)
           {
             sector.Component = components.Find(w);
             return true;
@@ -503,12 +493,12 @@ bool MorseSmaleComplexExtraction::Extract(
   // counter-clockwise around it, and each 1-cell's place in its extremum's order. Each 1-cell
   // ends at the midpoint of its saddle edge: two saddles that share their highest vertex
   // share a 1-cell path up to it, and only their edges tell the two apart.
-  std::vector<double> saddleEdgeMidpoints(2 * complex.Separatrices.size());
+  std::vector<double> saddleEdgeMidpoints(2 * complex.OneCells.size());
   std::vector<std::vector<Index>> arcsOfExtremum(cps.size());
-  for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
+  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
   {
-    const Separatrix& arc = complex.Separatrices[a];
-    const bool descending = arc.Type == Separatrix::Descending;
+    const OneCell& arc = complex.OneCells[a];
+    const bool descending = arc.Type == OneCell::Descending;
     arcsOfExtremum[descending ? arc.Source : arc.Destination].push_back(a);
     const Index edge = cps[descending ? arc.Destination : arc.Source].Cell;
     for (int c = 0; c < 2; ++c)
@@ -517,7 +507,7 @@ bool MorseSmaleComplexExtraction::Extract(
         (field.Points[2 * mesh.EdgeVertices[edge][0] + c] + field.Points[2 * mesh.EdgeVertices[edge][1] + c]);
     }
   }
-  std::vector<Index> placeAroundExtremum(complex.Separatrices.size(), InvalidIndex);
+  std::vector<Index> placeAroundExtremum(complex.OneCells.size(), InvalidIndex);
   this->Parallel(0, static_cast<Index>(cps.size()), [&](Index begin, Index end) {
     for (Index x = begin; x < end; ++x)
     {
@@ -530,8 +520,8 @@ bool MorseSmaleComplexExtraction::Extract(
   });
   // The 1-cell next to `arc` around its extremum: counter-clockwise (+1) or clockwise (-1).
   auto neighbourAround = [&](Index arc, int direction) {
-    const Separatrix& sep = complex.Separatrices[arc];
-    const auto& around = arcsOfExtremum[sep.Type == Separatrix::Descending ? sep.Source : sep.Destination];
+    const OneCell& sep = complex.OneCells[arc];
+    const auto& around = arcsOfExtremum[sep.Type == OneCell::Descending ? sep.Source : sep.Destination];
     const Index n = static_cast<Index>(around.size());
     return around[(placeAroundExtremum[arc] + n + direction) % n];
   };
@@ -570,7 +560,7 @@ bool MorseSmaleComplexExtraction::Extract(
 
   // What the planar order leaves (it fails only where it ties): two sectors form a 2-cell when
   // they share (minimum, maximum) and open into the same region. A cell thinner than the mesh
-  // may have no region (no vertex off its separatrices) or fall apart into two: within a
+  // may have no region (no vertex off its 1-cells) or fall apart into two: within a
   // (minimum, maximum) group, the sectors left over after pairing by region pair up when
   // exactly two are left.
   std::vector<Index> bySector;
@@ -582,8 +572,8 @@ bool MorseSmaleComplexExtraction::Extract(
     }
   }
   auto groupKey = [&](Index i) {
-    return std::make_pair(complex.Separatrices[sectors[i].Descending].Source,
-      complex.Separatrices[sectors[i].Ascending].Destination);
+    return std::make_pair(complex.OneCells[sectors[i].Descending].Source,
+      complex.OneCells[sectors[i].Ascending].Destination);
   };
   std::stable_sort(bySector.begin(), bySector.end(), [&](Index a, Index b) {
     const auto ka = groupKey(a), kb = groupKey(b);
@@ -714,16 +704,16 @@ bool MorseSmaleComplexExtraction::Extract(
     {
       const Sector& sector = sectors[pair[k]];
       cell.Saddles[k] = sector.Saddle;
-      cell.Arcs[2 * k] = sector.Descending;
-      cell.Arcs[2 * k + 1] = sector.Ascending;
+      cell.BoundaryOneCells[2 * k] = sector.Descending;
+      cell.BoundaryOneCells[2 * k + 1] = sector.Ascending;
       if (sector.Component != InvalidIndex)
       {
         cellOfRoot[sector.Component] = static_cast<Index>(complex.TwoCells.size());
       }
     }
     cell.Sectors = 2;
-    cell.Minimum = complex.Separatrices[cell.Arcs[0]].Source;
-    cell.Maximum = complex.Separatrices[cell.Arcs[1]].Destination;
+    cell.Minimum = complex.OneCells[cell.BoundaryOneCells[0]].Source;
+    cell.Maximum = complex.OneCells[cell.BoundaryOneCells[1]].Destination;
     cell.Pouch = cell.Saddles[0] == cell.Saddles[1];
     complex.TwoCells.push_back(cell);
   }
@@ -734,11 +724,11 @@ bool MorseSmaleComplexExtraction::Extract(
     const Sector& sector = sectors[i];
     TwoCell cell;
     cell.Saddles[0] = sector.Saddle;
-    cell.Arcs[0] = sector.Descending;
-    cell.Arcs[1] = sector.Ascending;
+    cell.BoundaryOneCells[0] = sector.Descending;
+    cell.BoundaryOneCells[1] = sector.Ascending;
     cell.Sectors = 1;
-    cell.Minimum = complex.Separatrices[sector.Descending].Source;
-    cell.Maximum = complex.Separatrices[sector.Ascending].Destination;
+    cell.Minimum = complex.OneCells[sector.Descending].Source;
+    cell.Maximum = complex.OneCells[sector.Ascending].Destination;
     if (sector.Component != InvalidIndex && cellOfRoot[sector.Component] == InvalidIndex)
     {
       cellOfRoot[sector.Component] = static_cast<Index>(complex.TwoCells.size());
@@ -746,7 +736,7 @@ bool MorseSmaleComplexExtraction::Extract(
     complex.TwoCells.push_back(cell);
   }
 
-  // Every vertex joins a 2-cell: vertices of regions get their cell; the rest (separatrix
+  // Every vertex joins a 2-cell: vertices of regions get their cell; the rest (1-cell
   // vertices, slivers) join a neighbouring cell, first through neighbours flowing to the same
   // minimum, then through any neighbour.
   complex.TwoCellId.assign(nV, InvalidIndex);

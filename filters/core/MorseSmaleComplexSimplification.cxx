@@ -116,17 +116,17 @@ bool MorseSmaleComplexSimplification::Check(const MorseSmaleComplex& input, std:
     return i >= 0 && i < nCP && cps[i].MorseIndex == morseIndex;
   };
   std::vector<int> descending(nCP, 0), ascending(nCP, 0);
-  const auto& arcs = input.Separatrices;
+  const auto& arcs = input.OneCells;
   for (size_t a = 0; a < arcs.size(); ++a)
   {
-    const Separatrix& arc = arcs[a];
+    const OneCell& arc = arcs[a];
     const std::string name = "1-cell " + std::to_string(a);
     const size_t n = arc.MeshCells.size();
     if (std::any_of(arc.MeshCells.begin(), arc.MeshCells.end(), [](Index c) { return c < 0; }))
     {
       return fail(name + " has a negative mesh cell id");
     }
-    if (arc.Type == Separatrix::Descending)
+    if (arc.Type == OneCell::Descending)
     {
       if (!isCriticalPoint(arc.Source, 0) || !isCriticalPoint(arc.Destination, 1))
       {
@@ -142,7 +142,7 @@ bool MorseSmaleComplexSimplification::Check(const MorseSmaleComplex& input, std:
       }
       ++descending[arc.Destination];
     }
-    else if (arc.Type == Separatrix::Ascending)
+    else if (arc.Type == OneCell::Ascending)
     {
       if (!isCriticalPoint(arc.Source, 1) || !isCriticalPoint(arc.Destination, 2))
       {
@@ -186,10 +186,10 @@ bool MorseSmaleComplexSimplification::Check(const MorseSmaleComplex& input, std:
       {
         continue;
       }
-      const Index d = cell.Arcs[2 * k], u = cell.Arcs[2 * k + 1];
+      const Index d = cell.BoundaryOneCells[2 * k], u = cell.BoundaryOneCells[2 * k + 1];
       if (!isCriticalPoint(cell.Saddles[k], 1) || d < 0 || d >= nArcs || u < 0 || u >= nArcs ||
-        arcs[d].Type != Separatrix::Descending || arcs[d].Destination != cell.Saddles[k] ||
-        arcs[u].Type != Separatrix::Ascending || arcs[u].Source != cell.Saddles[k])
+        arcs[d].Type != OneCell::Descending || arcs[d].Destination != cell.Saddles[k] ||
+        arcs[u].Type != OneCell::Ascending || arcs[u].Source != cell.Saddles[k])
       {
         return fail(name + " has a corner whose 1-cells do not belong to its saddle");
       }
@@ -230,7 +230,7 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
   }
   this->Input = input;
   const auto& cps = this->Input.CriticalPoints;
-  const auto& arcs = this->Input.Separatrices;
+  const auto& arcs = this->Input.OneCells;
   const Index nCP = static_cast<Index>(cps.size());
 
   double lowest = cps[0].Value, highest = cps[0].Value;
@@ -241,15 +241,15 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
   }
   this->MaxPersistence = highest - lowest;
 
-  this->SaddleArcs.assign(nCP, { InvalidIndex, InvalidIndex, InvalidIndex, InvalidIndex });
+  this->SaddleOneCells.assign(nCP, { InvalidIndex, InvalidIndex, InvalidIndex, InvalidIndex });
   this->ArcExtremum.resize(arcs.size());
   for (Index a = 0; a < static_cast<Index>(arcs.size()); ++a)
   {
-    const Separatrix& arc = arcs[a];
-    auto& slots = this->SaddleArcs[arc.Type == Separatrix::Descending ? arc.Destination : arc.Source];
-    const int first = arc.Type == Separatrix::Descending ? 0 : 2;
+    const OneCell& arc = arcs[a];
+    auto& slots = this->SaddleOneCells[arc.Type == OneCell::Descending ? arc.Destination : arc.Source];
+    const int first = arc.Type == OneCell::Descending ? 0 : 2;
     slots[slots[first] == InvalidIndex ? first : first + 1] = a;
-    this->ArcExtremum[a] = arc.Type == Separatrix::Descending ? arc.Source : arc.Destination;
+    this->ArcExtremum[a] = arc.Type == OneCell::Descending ? arc.Source : arc.Destination;
   }
 
   // The domain boundary is a closed curve made of descending 1-cells between boundary minima
@@ -264,11 +264,11 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
   this->OnBoundaryCurve.assign(nCP, 0);
   for (Index s = 0; s < nCP; ++s)
   {
-    if (cps[s].MorseIndex == 1 && this->SaddleArcs[s][3] == InvalidIndex)
+    if (cps[s].MorseIndex == 1 && this->SaddleOneCells[s][3] == InvalidIndex)
     {
       this->OnBoundaryCurve[s] = 1;
-      this->OnBoundaryCurve[this->ArcExtremum[this->SaddleArcs[s][0]]] = 1;
-      this->OnBoundaryCurve[this->ArcExtremum[this->SaddleArcs[s][1]]] = 1;
+      this->OnBoundaryCurve[this->ArcExtremum[this->SaddleOneCells[s][0]]] = 1;
+      this->OnBoundaryCurve[this->ArcExtremum[this->SaddleOneCells[s][1]]] = 1;
     }
   }
 
@@ -282,9 +282,9 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
       const Index s = cell.Saddles[k];
       if (s != InvalidIndex)
       {
-        const auto& slots = this->SaddleArcs[s];
-        const int d = slots[0] == cell.Arcs[2 * k] ? 0 : 1;
-        const int a = slots[2] == cell.Arcs[2 * k + 1] ? 0 : 1;
+        const auto& slots = this->SaddleOneCells[s];
+        const int d = slots[0] == cell.BoundaryOneCells[2 * k] ? 0 : 1;
+        const int a = slots[2] == cell.BoundaryOneCells[2 * k + 1] ? 0 : 1;
         if (this->SaddleCorners[s][2 * d + a] != InvalidIndex)
         {
           error = "the input is not a Morse-Smale complex: 2-cells " +
@@ -330,16 +330,16 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
 void MorseSmaleComplexSimplification::BuildForests()
 {
   const auto& cps = this->Input.CriticalPoints;
-  const auto& arcs = this->Input.Separatrices;
+  const auto& arcs = this->Input.OneCells;
   const Index nCP = static_cast<Index>(cps.size());
   const Index nArcs = static_cast<Index>(arcs.size());
 
   Index vertexBound = 0, triangleBound = 0;
-  for (const Separatrix& arc : arcs)
+  for (const OneCell& arc : arcs)
   {
     for (Index c : arc.MeshCells)
     {
-      Index& bound = arc.Type == Separatrix::Descending ? vertexBound : triangleBound;
+      Index& bound = arc.Type == OneCell::Descending ? vertexBound : triangleBound;
       bound = std::max(bound, c + 1);
     }
   }
@@ -374,9 +374,9 @@ void MorseSmaleComplexSimplification::BuildForests()
   };
   for (Index a = 0; a < nArcs; ++a)
   {
-    const Separatrix& arc = arcs[a];
+    const OneCell& arc = arcs[a];
     const Index n = static_cast<Index>(arc.MeshCells.size());
-    if (arc.Type == Separatrix::Descending)
+    if (arc.Type == OneCell::Descending)
     {
       Index previous = InvalidIndex;
       for (Index i = 0; i < n; ++i)
@@ -445,7 +445,7 @@ int MorseSmaleComplexSimplification::CellMerges(
   int n = 0;
   for (int k = 0; k < 2; ++k)
   {
-    if (minimum && this->SaddleArcs[saddle][2 + k] != InvalidIndex)
+    if (minimum && this->SaddleOneCells[saddle][2 + k] != InvalidIndex)
     {
       pairs[n++] = { corner[2 * side + k], corner[2 * (1 - side) + k] };
     }
@@ -474,7 +474,7 @@ std::vector<MorseSmaleComplexSimplification::PersistencePair> MorseSmaleComplexS
   std::vector<Index> saddles;
   for (Index s = 0; s < nCP; ++s)
   {
-    if (cps[s].MorseIndex == 1 && this->SaddleArcs[s][first + 1] != InvalidIndex)
+    if (cps[s].MorseIndex == 1 && this->SaddleOneCells[s][first + 1] != InvalidIndex)
     {
       saddles.push_back(s);
     }
@@ -488,8 +488,8 @@ std::vector<MorseSmaleComplexSimplification::PersistencePair> MorseSmaleComplexS
   std::vector<PersistencePair> pairs;
   for (Index s : saddles)
   {
-    const Index a = FindRepresentative(parent, this->ArcExtremum[this->SaddleArcs[s][first]]);
-    const Index b = FindRepresentative(parent, this->ArcExtremum[this->SaddleArcs[s][first + 1]]);
+    const Index a = FindRepresentative(parent, this->ArcExtremum[this->SaddleOneCells[s][first]]);
+    const Index b = FindRepresentative(parent, this->ArcExtremum[this->SaddleOneCells[s][first + 1]]);
     if (a == b)
     {
       continue;
@@ -559,7 +559,7 @@ void MorseSmaleComplexSimplification::ComputeSequence()
     }
     for (int k = 0; k < 2; ++k)
     {
-      const Index b = this->ArcExtremum[this->SaddleArcs[e][k]];
+      const Index b = this->ArcExtremum[this->SaddleOneCells[e][k]];
       if (this->OnBoundaryCurve[b])
       {
         pinnedBy[b].push_back(e);
@@ -621,7 +621,7 @@ void MorseSmaleComplexSimplification::ComputeSequence()
     {
       continue;
     }
-    for (Index a : this->SaddleArcs[s])
+    for (Index a : this->SaddleOneCells[s])
     {
       if (a != InvalidIndex)
       {
@@ -661,7 +661,7 @@ void MorseSmaleComplexSimplification::ComputeSequence()
     // The saddle's 1-cells of the extremum's kind, and how many of them reach it now.
     const bool minimum = cps[x].MorseIndex == 0;
     const int first = minimum ? 0 : 2;
-    const auto& slots = this->SaddleArcs[s];
+    const auto& slots = this->SaddleOneCells[s];
     if (slots[first + 1] == InvalidIndex)
     {
       // A boundary saddle has a single ascending 1-cell: no other maximum could take over.
@@ -856,7 +856,7 @@ bool MorseSmaleComplexSimplification::Simplify(
 
   const MorseSmaleComplex& in = this->Input;
   const auto& cps = in.CriticalPoints;
-  const auto& arcs = in.Separatrices;
+  const auto& arcs = in.OneCells;
   const Index nCP = static_cast<Index>(cps.size());
   const Index nArcs = static_cast<Index>(arcs.size());
   MorseSmaleComplex& out = output.Complex;
@@ -897,7 +897,7 @@ bool MorseSmaleComplexSimplification::Simplify(
   for (Index j = 0; j < performed; ++j)
   {
     const Step& step = this->Steps[j];
-    const auto& slots = this->SaddleArcs[step.Saddle];
+    const auto& slots = this->SaddleOneCells[step.Saddle];
     if (cps[step.Extremum].MorseIndex == 0)
     {
       for (int k = 0; k < 2; ++k)
@@ -957,8 +957,8 @@ bool MorseSmaleComplexSimplification::Simplify(
   std::vector<std::vector<Index>> fromExtremum;
   for (Index a = 0; a < nArcs; ++a)
   {
-    const Separatrix& arc = arcs[a];
-    const bool descending = arc.Type == Separatrix::Descending;
+    const OneCell& arc = arcs[a];
+    const bool descending = arc.Type == OneCell::Descending;
     const Index saddle = descending ? arc.Destination : arc.Source;
     if (!alive[saddle])
     {
@@ -989,9 +989,9 @@ bool MorseSmaleComplexSimplification::Simplify(
       path.push_back(this->ArcLastNode[a]);
     }
 
-    outputArc[a] = static_cast<Index>(out.Separatrices.size());
-    out.Separatrices.emplace_back();
-    Separatrix& merged = out.Separatrices.back();
+    outputArc[a] = static_cast<Index>(out.OneCells.size());
+    out.OneCells.emplace_back();
+    OneCell& merged = out.OneCells.back();
     merged.Type = arc.Type;
     merged.Source = descending ? position[extremum] : position[saddle];
     merged.Destination = descending ? position[saddle] : position[extremum];
@@ -1052,10 +1052,10 @@ bool MorseSmaleComplexSimplification::Simplify(
     std::vector<Index> junctionOfNode(n, InvalidIndex);
     for (int sweep = 0; sweep < 2; ++sweep)
     {
-      for (Index a = 0; a < static_cast<Index>(out.Separatrices.size()); ++a)
+      for (Index a = 0; a < static_cast<Index>(out.OneCells.size()); ++a)
       {
-        const Separatrix& arc = out.Separatrices[a];
-        if ((arc.Type == Separatrix::Descending) != descending)
+        const OneCell& arc = out.OneCells[a];
+        if ((arc.Type == OneCell::Descending) != descending)
         {
           continue;
         }
@@ -1107,7 +1107,7 @@ bool MorseSmaleComplexSimplification::Simplify(
             output.JunctionPoints.push_back(junction);
           }
           JunctionPoint& junction = output.JunctionPoints[junctionOfNode[u]];
-          junction.Separatrices.push_back(a);
+          junction.OneCells.push_back(a);
           if (descending && i + 1 == path.size())
           {
             junction.CriticalPoint = arc.Destination;
@@ -1171,7 +1171,7 @@ bool MorseSmaleComplexSimplification::Simplify(
     {
       if (cell.Saddles[k] != InvalidIndex && alive[cell.Saddles[k]])
       {
-        outputCorners[target].push_back({ cell.Saddles[k], cell.Arcs[2 * k], cell.Arcs[2 * k + 1] });
+        outputCorners[target].push_back({ cell.Saddles[k], cell.BoundaryOneCells[2 * k], cell.BoundaryOneCells[2 * k + 1] });
       }
     }
   }
@@ -1185,8 +1185,8 @@ bool MorseSmaleComplexSimplification::Simplify(
     {
       const bool present = k < static_cast<int>(list.size());
       cell.Saddles[k] = present ? position[list[k][0]] : InvalidIndex;
-      cell.Arcs[2 * k] = present ? outputArc[list[k][1]] : InvalidIndex;
-      cell.Arcs[2 * k + 1] = present ? outputArc[list[k][2]] : InvalidIndex;
+      cell.BoundaryOneCells[2 * k] = present ? outputArc[list[k][1]] : InvalidIndex;
+      cell.BoundaryOneCells[2 * k + 1] = present ? outputArc[list[k][2]] : InvalidIndex;
     }
     cell.Pouch = list.size() == 2 && cell.Saddles[0] == cell.Saddles[1];
     if (members[c] == 1)

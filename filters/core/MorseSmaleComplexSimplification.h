@@ -32,7 +32,7 @@
 #pragma once
 
 #include "CoreTypes.h"
-#include "MorseSmaleComplexExtraction.h"
+#include "MorseSmaleComplex.h"
 
 #include <array>
 #include <string>
@@ -48,22 +48,6 @@ struct Cancellation
   Index Survivor = InvalidIndex; // the extremum that inherits the cancelled extremum's region
   double Persistence = 0;        // |f(Upper) - f(Lower)|
   double Threshold = 0;          // performed for every absolute threshold strictly above this
-};
-
-// A vertex (descending 1-cells) or triangle (ascending 1-cells) where 1-cells that share an
-// extremum split apart when followed from the extremum towards their saddles (equivalently:
-// merge when followed from the saddles). Stage 3 cuts 1-cells into pieces at these points.
-struct JunctionPoint
-{
-  Separatrix::Kind Type = Separatrix::Descending; // Cell is a vertex (Descending) or a triangle
-  Index Extremum = InvalidIndex;      // position in the output CriticalPoints
-  Index Cell = InvalidIndex;
-  double Position[2] = { 0, 0 };      // the vertex, or the triangle's centroid
-  double Value = 0;                   // f at the vertex, or the mean of the triangle's values
-  // Position of a saddle sitting on this vertex whose descending 1-cell ends here while
-  // others go on (the junction is then also that critical point), else InvalidIndex.
-  Index CriticalPoint = InvalidIndex;
-  std::vector<Index> Separatrices;    // output 1-cells through it, ascending order
 };
 
 // Why an extremum whose persistence is below the threshold survives it: the last rule that
@@ -85,9 +69,9 @@ const char* BlockReasonName(BlockReason reason);
 struct SimplificationOutput
 {
   // The simplified complex, in the form stage 1 produces. Every reference to a critical
-  // point in it (Separatrix::Source/Destination, TwoCell::Minimum/Maximum/Saddles and the
+  // point in it (OneCell::Source/Destination, TwoCell::Minimum/Maximum/Saddles and the
   // per-vertex AscendingManifold/DescendingManifold) is a position in its CriticalPoints;
-  // CriticalPoints[i].Id is the stable id of the input. Separatrices and 2-cells keep the
+  // CriticalPoints[i].Id is the stable id of the input. OneCells and 2-cells keep the
   // relative order of the input ones they come from.
   MorseSmaleComplex Complex;
   std::vector<Cancellation> Cancellations; // performed, in hierarchy order
@@ -168,11 +152,11 @@ private:
 
   // Per critical point (position): for a saddle its descending 1-cells [0..1] and ascending
   // ones [2..3] (InvalidIndex when it has a single ascending one, on the boundary).
-  std::vector<std::array<Index, 4>> SaddleArcs;
+  std::vector<std::array<Index, 4>> SaddleOneCells;
   std::vector<Index> ArcExtremum; // per input 1-cell: its minimum or maximum (position)
   std::vector<unsigned char> OnBoundaryCurve; // per critical point: a cell of the boundary curve
   // Per saddle, the input 2-cell at each corner: [2 d + a] for its descending 1-cell d and
-  // ascending 1-cell a (0 or 1, in SaddleArcs order); InvalidIndex if the input has none.
+  // ascending 1-cell a (0 or 1, in SaddleOneCells order); InvalidIndex if the input has none.
   std::vector<std::array<Index, 4>> SaddleCorners;
 
   NodeSet DescendingNodes; // vertices

@@ -14,7 +14,7 @@ namespace topospline
 namespace
 {
 // Where along a 1-cell its mesh cell `cell` sits, as an index into its Points; -1 if absent.
-long PointIndexOfCell(const Separatrix& arc, Index cell)
+long PointIndexOfCell(const OneCell& arc, Index cell)
 {
   const auto it = std::find(arc.MeshCells.begin(), arc.MeshCells.end(), cell);
   if (it == arc.MeshCells.end())
@@ -22,7 +22,7 @@ long PointIndexOfCell(const Separatrix& arc, Index cell)
     return -1;
   }
   // Ascending 1-cells carry the saddle's vertex before their first triangle.
-  return static_cast<long>(it - arc.MeshCells.begin()) + (arc.Type == Separatrix::Ascending ? 1 : 0);
+  return static_cast<long>(it - arc.MeshCells.begin()) + (arc.Type == OneCell::Ascending ? 1 : 0);
 }
 
 struct Segment2
@@ -94,23 +94,23 @@ void CutIntoPieces(const MorseSmaleComplex& complex, const std::vector<JunctionP
   std::map<std::pair<double, double>, Index> cornerNode;
   const double corners[4][2] = { { domainBounds[0], domainBounds[2] }, { domainBounds[1], domainBounds[2] },
     { domainBounds[1], domainBounds[3] }, { domainBounds[0], domainBounds[3] } };
-  std::vector<std::vector<std::pair<long, Index>>> cuts(complex.Separatrices.size());
+  std::vector<std::vector<std::pair<long, Index>>> cuts(complex.OneCells.size());
   for (size_t j = 0; j < junctions.size(); ++j)
   {
-    for (Index a : junctions[j].Separatrices)
+    for (Index a : junctions[j].OneCells)
     {
-      const long at = PointIndexOfCell(complex.Separatrices[a], junctions[j].Cell);
-      if (at > 0 && at + 1 < static_cast<long>(complex.Separatrices[a].Values.size()))
+      const long at = PointIndexOfCell(complex.OneCells[a], junctions[j].Cell);
+      if (at > 0 && at + 1 < static_cast<long>(complex.OneCells[a].Values.size()))
       {
         cuts[a].push_back({ at, junctionNode[j] });
       }
     }
   }
   std::map<std::vector<double>, Index> pieceOfGeometry;
-  result.PiecesOfSeparatrix.resize(complex.Separatrices.size());
-  for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()); ++a)
+  result.PiecesOfOneCell.resize(complex.OneCells.size());
+  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
   {
-    const Separatrix& arc = complex.Separatrices[a];
+    const OneCell& arc = complex.OneCells[a];
     const long n = static_cast<long>(arc.Values.size());
     auto& at = cuts[a];
     for (long p = 1; p + 1 < n; ++p)
@@ -176,7 +176,7 @@ void CutIntoPieces(const MorseSmaleComplex& complex, const std::vector<JunctionP
         piece.EndNode = at[k + 1].second;
         piece.Points.assign(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
         piece.Values.assign(arc.Values.begin() + from, arc.Values.begin() + to + 1);
-        if (arc.Type == Separatrix::Ascending && to == n - 1 && piece.Values.size() > 2)
+        if (arc.Type == OneCell::Ascending && to == n - 1 && piece.Values.size() > 2)
         {
           // Every ascending 1-cell into a maximum ends "centroid of the maximum's triangle,
           // maximum's vertex": a segment they would all share. Go straight to the vertex.
@@ -186,8 +186,8 @@ void CutIntoPieces(const MorseSmaleComplex& complex, const std::vector<JunctionP
         found = pieceOfGeometry.insert({ key, static_cast<Index>(result.Pieces.size()) }).first;
         result.Pieces.push_back(std::move(piece));
       }
-      result.Pieces[found->second].Separatrices.push_back(a);
-      result.PiecesOfSeparatrix[a].push_back(found->second);
+      result.Pieces[found->second].OneCells.push_back(a);
+      result.PiecesOfOneCell[a].push_back(found->second);
     }
   }
   // Node positions: the ends of the pieces that meet there.
@@ -310,7 +310,7 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
       "], not " + std::to_string(this->Segments);
     return false;
   }
-  if (complex.Separatrices.empty())
+  if (complex.OneCells.empty())
   {
     error = "the complex has no 1-cells";
     return false;
@@ -386,7 +386,7 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
   {
     nodes.resize(nodesBeforeCorners);
     result.Pieces.clear();
-    result.PiecesOfSeparatrix.clear();
+    result.PiecesOfOneCell.clear();
     result.RisingCutsOnly = risingCutsOnly;
     CutIntoPieces(complex, junctions, junctionNode, domainBounds, risingCutsOnly, nodes, result);
     this->Hooks.Report(0.1);

@@ -7,7 +7,7 @@
 
 #include "CoreTypes.h"
 #include "MonotoneBSplineFit.h"
-#include "MorseSmaleComplexSimplification.h" // JunctionPoint
+#include "MorseSmaleComplex.h"
 
 #include <string>
 #include <vector>
@@ -33,10 +33,10 @@ struct SmoothingNode
 // One piece of 1-cell between two consecutive nodes; merged 1-cells share their pieces.
 struct SmoothedPiece
 {
-  Separatrix::Kind Type = Separatrix::Descending;
+  OneCell::Kind Type = OneCell::Descending;
   Index StartNode = InvalidIndex; // the lower end
   Index EndNode = InvalidIndex;   // the higher end
-  std::vector<Index> Separatrices; // 1-cells that run through it
+  std::vector<Index> OneCells; // 1-cells that run through it
   std::vector<double> Points;      // the jagged samples (x, y), start to end
   std::vector<double> Values;      // the field along them
   std::vector<double> Parameters;  // normalized arc length
@@ -52,7 +52,7 @@ struct OneCellSmoothingResult
 {
   std::vector<SmoothingNode> Nodes;
   std::vector<SmoothedPiece> Pieces;
-  std::vector<std::vector<Index>> PiecesOfSeparatrix; // per 1-cell, its pieces in order
+  std::vector<std::vector<Index>> PiecesOfOneCell; // per 1-cell, its pieces in order
   int AdaptedPieces = 0;       // pieces whose k was raised to remove crossings
   int RemainingCrossings = 0;  // pairs of pieces that still cross (0 is the goal)
   int PiecesOutsideDomain = 0; // pieces whose curve leaves the domain's bounding box

@@ -489,12 +489,12 @@ std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, cons
 {
   std::vector<SaddleOneCell> cells;
   constexpr int samplesPerSegment = 16;
-  for (Index a = 0; a < static_cast<Index>(complex.Separatrices.size()) &&
-       a < static_cast<Index>(smoothed.PiecesOfSeparatrix.size());
+  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()) &&
+       a < static_cast<Index>(smoothed.PiecesOfOneCell.size());
        ++a)
   {
-    const Separatrix& arc = complex.Separatrices[a];
-    const bool ascending = arc.Type == Separatrix::Ascending;
+    const OneCell& arc = complex.OneCells[a];
+    const bool ascending = arc.Type == OneCell::Ascending;
     SaddleOneCell cell;
     cell.Saddle = vertexAt(complex.CriticalPoints[ascending ? arc.Source : arc.Destination].Vertex);
     cell.Ascending = ascending;
@@ -504,7 +504,7 @@ std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, cons
     }
     // Pieces run from the lower end to the higher one: away from the saddle along an ascending
     // 1-cell, towards it along a descending one.
-    std::vector<Index> pieces = smoothed.PiecesOfSeparatrix[a];
+    std::vector<Index> pieces = smoothed.PiecesOfOneCell[a];
     if (!ascending)
     {
       std::reverse(pieces.begin(), pieces.end());

@@ -130,12 +130,12 @@ bool InsidePolygon(const std::vector<double>& polygon, const std::array<double, 
 // First and last point of a 1-cell's smoothed curve.
 std::array<double, 2> StartOf(const OneCellSmoothingResult& smoothed, Index arc)
 {
-  const SmoothedPiece& piece = smoothed.Pieces[smoothed.PiecesOfSeparatrix[arc].front()];
+  const SmoothedPiece& piece = smoothed.Pieces[smoothed.PiecesOfOneCell[arc].front()];
   return { { piece.Curve.ControlPoints[0], piece.Curve.ControlPoints[1] } };
 }
 std::array<double, 2> EndOf(const OneCellSmoothingResult& smoothed, Index arc)
 {
-  const SmoothedPiece& piece = smoothed.Pieces[smoothed.PiecesOfSeparatrix[arc].back()];
+  const SmoothedPiece& piece = smoothed.Pieces[smoothed.PiecesOfOneCell[arc].back()];
   const std::size_t n = piece.Curve.ControlPoints.size();
   return { { piece.Curve.ControlPoints[n - 2], piece.Curve.ControlPoints[n - 1] } };
 }
@@ -175,8 +175,8 @@ bool AssembleTwoCellSides(const TwoCell& cell, const OneCellSmoothingResult& smo
   std::string& error, bool mergeAtMinimum, bool mergeAtMaximum)
 {
   sides = TwoCellSides();
-  const Index arcs = static_cast<Index>(smoothed.PiecesOfSeparatrix.size());
-  for (Index a : cell.Arcs)
+  const Index arcs = static_cast<Index>(smoothed.PiecesOfOneCell.size());
+  for (Index a : cell.BoundaryOneCells)
   {
     if (a < 0 || a >= arcs)
     {
@@ -184,15 +184,15 @@ bool AssembleTwoCellSides(const TwoCell& cell, const OneCellSmoothingResult& smo
       return false;
     }
   }
-  const Index d0 = cell.Arcs[0], a0 = cell.Arcs[1], d1 = cell.Arcs[2], a1 = cell.Arcs[3];
+  const Index d0 = cell.BoundaryOneCells[0], a0 = cell.BoundaryOneCells[1], d1 = cell.BoundaryOneCells[2], a1 = cell.BoundaryOneCells[3];
   auto& bottom = sides.Pieces[TwoCellSides::Bottom];
   auto& right = sides.Pieces[TwoCellSides::Right];
   auto& top = sides.Pieces[TwoCellSides::Top];
   auto& left = sides.Pieces[TwoCellSides::Left];
-  bottom = smoothed.PiecesOfSeparatrix[d0];
-  right = smoothed.PiecesOfSeparatrix[a0];
-  left = smoothed.PiecesOfSeparatrix[d1];
-  top = smoothed.PiecesOfSeparatrix[a1];
+  bottom = smoothed.PiecesOfOneCell[d0];
+  right = smoothed.PiecesOfOneCell[a0];
+  left = smoothed.PiecesOfOneCell[d1];
+  top = smoothed.PiecesOfOneCell[a1];
 
   // Two different 1-cells that share their first pieces merge before the minimum: the cell's
   // boundary leaves them where they split, and that junction takes the minimum's corner.
@@ -447,7 +447,7 @@ bool TwoCellReconstruction::Reconstruct(
     error = "the number of boundary samples must be in [1, 1000], not " + std::to_string(this->BoundarySamples);
     return false;
   }
-  if (smoothed.PiecesOfSeparatrix.size() != complex.Separatrices.size())
+  if (smoothed.PiecesOfOneCell.size() != complex.OneCells.size())
   {
     error = "the smoothed 1-cells do not belong to this complex";
     return false;
@@ -490,8 +490,8 @@ bool TwoCellReconstruction::Reconstruct(
         continue;
       }
       const bool stemAtMinimum = cell.Sides.MinimumShifted, stemAtMaximum = cell.Sides.MaximumShifted;
-      std::array<bool, 2> merge = { { !(stemAtMinimum && InsidePolygon(walk, StartOf(smoothed, twoCell.Arcs[0]))),
-        !(stemAtMaximum && InsidePolygon(walk, EndOf(smoothed, twoCell.Arcs[1]))) } };
+      std::array<bool, 2> merge = { { !(stemAtMinimum && InsidePolygon(walk, StartOf(smoothed, twoCell.BoundaryOneCells[0]))),
+        !(stemAtMaximum && InsidePolygon(walk, EndOf(smoothed, twoCell.BoundaryOneCells[1]))) } };
       // The point-in-polygon test can be fooled by a walk that is not simple: if the
       // parameterization refuses the chosen assembly, the other choices for the stems follow.
       std::vector<std::array<bool, 2>> choices = { merge };

@@ -7,7 +7,7 @@
 // the number of threads.
 //
 // Corners of the square (the paper's section 5.1): minimum (0,0), maximum (1,1), the saddles of
-// Arcs[0..1] at (1,0) and of Arcs[2..3] at (0,1):
+// BoundaryOneCells[0..1] at (1,0) and of BoundaryOneCells[2..3] at (0,1):
 //   Bottom (0,0)->(1,0): the descending 1-cell of saddle 0, Right (1,0)->(1,1): its ascending one,
 //   Left (0,0)->(0,1): the descending 1-cell of saddle 1, Top (0,1)->(1,1): its ascending one.
 // Where the two descending 1-cells merge before the minimum (they share their first pieces),
@@ -18,7 +18,7 @@
 
 #include "CoreTypes.h"
 #include "MonotoneSibsonPatch.h"
-#include "MorseSmaleComplexExtraction.h"
+#include "MorseSmaleComplex.h"
 #include "OneCellSmoothing.h"
 #include "TwoCellParameterization.h"
 

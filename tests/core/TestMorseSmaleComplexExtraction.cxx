@@ -76,17 +76,17 @@ void CheckInvariants(const PlanarScalarField& field, const MorseSmaleComplex& c)
     CHECK_EQ(cps[i].Id, static_cast<Index>(i));
     CHECK_EQ(cps[i].Value, field.Values[cps[i].Vertex]);
   }
-  // Separatrices join critical points of consecutive indices; values increase along descending
+  // OneCells join critical points of consecutive indices; values increase along descending
   // ones (vertex paths) and their end values are the critical values.
-  for (const auto& arc : c.Separatrices)
+  for (const auto& arc : c.OneCells)
   {
-    const int lower = arc.Type == Separatrix::Descending ? 0 : 1;
+    const int lower = arc.Type == OneCell::Descending ? 0 : 1;
     CHECK_EQ(cps[arc.Source].MorseIndex, lower);
     CHECK_EQ(cps[arc.Destination].MorseIndex, lower + 1);
     CHECK_EQ(arc.Values.front(), cps[arc.Source].Value);
     CHECK_EQ(arc.Values.back(), cps[arc.Destination].Value);
     CHECK_EQ(arc.Points.size(), 2 * arc.Values.size());
-    if (arc.Type == Separatrix::Descending)
+    if (arc.Type == OneCell::Descending)
     {
       for (size_t k = 1; k < arc.MeshCells.size(); ++k)
       {
@@ -106,20 +106,20 @@ void CheckInvariants(const PlanarScalarField& field, const MorseSmaleComplex& c)
     for (int k = 0; k < 2; ++k)
     {
       CHECK_EQ(cps[cell.Saddles[k]].MorseIndex, 1);
-      const auto& down = c.Separatrices[cell.Arcs[2 * k]];
-      const auto& up = c.Separatrices[cell.Arcs[2 * k + 1]];
-      CHECK(down.Type == Separatrix::Descending && down.Destination == cell.Saddles[k] && down.Source == cell.Minimum);
-      CHECK(up.Type == Separatrix::Ascending && up.Source == cell.Saddles[k] && up.Destination == cell.Maximum);
+      const auto& down = c.OneCells[cell.BoundaryOneCells[2 * k]];
+      const auto& up = c.OneCells[cell.BoundaryOneCells[2 * k + 1]];
+      CHECK(down.Type == OneCell::Descending && down.Destination == cell.Saddles[k] && down.Source == cell.Minimum);
+      CHECK(up.Type == OneCell::Ascending && up.Source == cell.Saddles[k] && up.Destination == cell.Maximum);
     }
     CHECK_EQ(cell.Pouch, cell.Saddles[0] == cell.Saddles[1]);
   }
   // Every saddle corner belongs to exactly one cell: 4 per interior saddle, 2 per boundary one.
   size_t ascending = 0;
-  for (const auto& arc : c.Separatrices)
+  for (const auto& arc : c.OneCells)
   {
-    ascending += arc.Type == Separatrix::Ascending;
+    ascending += arc.Type == OneCell::Ascending;
   }
-  CHECK_EQ(sectors, 2 * ascending); // one sector on each side of every ascending separatrix
+  CHECK_EQ(sectors, 2 * ascending); // one sector on each side of every ascending 1-cell
   // Every vertex lies in exactly one 2-cell, and in the manifolds of that cell's extrema.
   CHECK_EQ(c.TwoCellId.size(), field.Values.size());
   size_t total = 0;
@@ -175,14 +175,14 @@ TEST_CASE(SequentialAndThreadedAgree)
   const auto a = Extract(field);
   const auto b = Extract(field, ThreadedFor);
   CHECK_EQ(a.CriticalPoints.size(), b.CriticalPoints.size());
-  CHECK_EQ(a.Separatrices.size(), b.Separatrices.size());
+  CHECK_EQ(a.OneCells.size(), b.OneCells.size());
   CHECK(a.TwoCellId == b.TwoCellId);
   CHECK(a.AscendingManifold == b.AscendingManifold);
   CHECK(a.DescendingManifold == b.DescendingManifold);
-  bool samePaths = a.Separatrices.size() == b.Separatrices.size();
-  for (size_t i = 0; samePaths && i < a.Separatrices.size(); ++i)
+  bool samePaths = a.OneCells.size() == b.OneCells.size();
+  for (size_t i = 0; samePaths && i < a.OneCells.size(); ++i)
   {
-    samePaths = a.Separatrices[i].MeshCells == b.Separatrices[i].MeshCells;
+    samePaths = a.OneCells[i].MeshCells == b.OneCells[i].MeshCells;
   }
   CHECK(samePaths);
 }
@@ -215,7 +215,7 @@ TEST_CASE(CriticalPointsOnlyWithAGivenMesh)
         a.Value == b.Value;
     }
     CHECK(same);
-    CHECK(only.Separatrices.empty());
+    CHECK(only.OneCells.empty());
     CHECK_EQ(extraction.Mesh.NumberOfVertices(), 0); // the given mesh was used, none built
   }
 }
@@ -340,13 +340,13 @@ TEST_CASE(PouchCellsLieInsideTheirLoop)
     CheckInvariants(field, c);
     for (const TwoCell& cell : c.TwoCells)
     {
-      if (!cell.Pouch || cell.Arcs[1] == cell.Arcs[3] || cell.Arcs[0] != cell.Arcs[2])
+      if (!cell.Pouch || cell.BoundaryOneCells[1] == cell.BoundaryOneCells[3] || cell.BoundaryOneCells[0] != cell.BoundaryOneCells[2])
       {
         continue; // only loops of ascending 1-cells (the descending kind is its mirror)
       }
       ++pouches;
-      std::vector<double> loop = c.Separatrices[cell.Arcs[1]].Points;
-      const auto& back = c.Separatrices[cell.Arcs[3]].Points;
+      std::vector<double> loop = c.OneCells[cell.BoundaryOneCells[1]].Points;
+      const auto& back = c.OneCells[cell.BoundaryOneCells[3]].Points;
       for (size_t i = back.size(); i >= 2; i -= 2)
       {
         loop.push_back(back[i - 2]);

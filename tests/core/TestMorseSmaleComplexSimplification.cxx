@@ -83,7 +83,7 @@ double Milliseconds(std::chrono::steady_clock::time_point start)
 
 bool SameComplex(const MorseSmaleComplex& a, const MorseSmaleComplex& b)
 {
-  if (a.CriticalPoints.size() != b.CriticalPoints.size() || a.Separatrices.size() != b.Separatrices.size() ||
+  if (a.CriticalPoints.size() != b.CriticalPoints.size() || a.OneCells.size() != b.OneCells.size() ||
     a.TwoCells.size() != b.TwoCells.size())
   {
     return false;
@@ -97,9 +97,9 @@ bool SameComplex(const MorseSmaleComplex& a, const MorseSmaleComplex& b)
       return false;
     }
   }
-  for (size_t i = 0; i < a.Separatrices.size(); ++i)
+  for (size_t i = 0; i < a.OneCells.size(); ++i)
   {
-    const Separatrix &p = a.Separatrices[i], &q = b.Separatrices[i];
+    const OneCell &p = a.OneCells[i], &q = b.OneCells[i];
     if (p.Type != q.Type || p.Source != q.Source || p.Destination != q.Destination || p.MeshCells != q.MeshCells ||
       p.Points != q.Points || p.Values != q.Values)
     {
@@ -109,7 +109,7 @@ bool SameComplex(const MorseSmaleComplex& a, const MorseSmaleComplex& b)
   for (size_t i = 0; i < a.TwoCells.size(); ++i)
   {
     const TwoCell &p = a.TwoCells[i], &q = b.TwoCells[i];
-    if (p.Minimum != q.Minimum || p.Maximum != q.Maximum || p.Saddles != q.Saddles || p.Arcs != q.Arcs ||
+    if (p.Minimum != q.Minimum || p.Maximum != q.Maximum || p.Saddles != q.Saddles || p.BoundaryOneCells != q.BoundaryOneCells ||
       p.Pouch != q.Pouch || p.NumberOfVertices != q.NumberOfVertices || p.Centroid[0] != q.Centroid[0] ||
       p.Centroid[1] != q.Centroid[1] || p.Sectors != q.Sectors)
     {
@@ -277,11 +277,11 @@ void CheckComplex(Failures& failures, const std::string& at, const PlanarScalarF
 
   // 1-cells: mesh paths from the right critical cells, with the field's points and values.
   std::vector<int> descending(nCP, 0), ascending(nCP, 0);
-  for (size_t a = 0; a < c.Separatrices.size(); ++a)
+  for (size_t a = 0; a < c.OneCells.size(); ++a)
   {
-    const Separatrix& arc = c.Separatrices[a];
+    const OneCell& arc = c.OneCells[a];
     const std::string where = at + ", 1-cell " + std::to_string(a);
-    const bool down = arc.Type == Separatrix::Descending;
+    const bool down = arc.Type == OneCell::Descending;
     const int lowerIndex = down ? 0 : 1;
     if (!failures.Check(arc.Source >= 0 && arc.Source < nCP && arc.Destination >= 0 && arc.Destination < nCP &&
           cps[arc.Source].MorseIndex == lowerIndex && cps[arc.Destination].MorseIndex == lowerIndex + 1 &&
@@ -356,12 +356,12 @@ void CheckComplex(Failures& failures, const std::string& at, const PlanarScalarF
     bool ok = cell.Sectors == 2 && cell.Pouch == (cell.Saddles[0] == cell.Saddles[1]);
     for (int s = 0; ok && s < 2; ++s)
     {
-      const Index down = cell.Arcs[2 * s], up = cell.Arcs[2 * s + 1];
-      const Index nArcs = static_cast<Index>(c.Separatrices.size());
+      const Index down = cell.BoundaryOneCells[2 * s], up = cell.BoundaryOneCells[2 * s + 1];
+      const Index nArcs = static_cast<Index>(c.OneCells.size());
       ok = down >= 0 && up >= 0 && down < nArcs && up < nArcs &&
-        c.Separatrices[down].Type == Separatrix::Descending && c.Separatrices[up].Type == Separatrix::Ascending &&
-        c.Separatrices[down].Source == cell.Minimum && c.Separatrices[down].Destination == cell.Saddles[s] &&
-        c.Separatrices[up].Source == cell.Saddles[s] && c.Separatrices[up].Destination == cell.Maximum;
+        c.OneCells[down].Type == OneCell::Descending && c.OneCells[up].Type == OneCell::Ascending &&
+        c.OneCells[down].Source == cell.Minimum && c.OneCells[down].Destination == cell.Saddles[s] &&
+        c.OneCells[up].Source == cell.Saddles[s] && c.OneCells[up].Destination == cell.Maximum;
     }
     if (!ok && cellsValid)
     {
@@ -397,13 +397,13 @@ void CheckComplex(Failures& failures, const std::string& at, const PlanarScalarF
   // saddle's vertex, encoded below zero. Wherever two 1-cells of one extremum part, the last
   // cell they share (other than the extremum's own) is a junction point; and at a junction
   // point the 1-cells through it do not all go on the same way.
-  std::vector<std::vector<Index>> fromExtremum(c.Separatrices.size());
-  for (size_t a = 0; a < c.Separatrices.size(); ++a)
+  std::vector<std::vector<Index>> fromExtremum(c.OneCells.size());
+  for (size_t a = 0; a < c.OneCells.size(); ++a)
   {
-    const Separatrix& arc = c.Separatrices[a];
+    const OneCell& arc = c.OneCells[a];
     auto& path = fromExtremum[a];
     path = arc.MeshCells;
-    if (arc.Type == Separatrix::Ascending)
+    if (arc.Type == OneCell::Ascending)
     {
       std::reverse(path.begin(), path.end());
       path.push_back(-2 - cps[arc.Source].Vertex);
@@ -414,14 +414,14 @@ void CheckComplex(Failures& failures, const std::string& at, const PlanarScalarF
   for (const JunctionPoint& j : result.JunctionPoints)
   {
     junctionAt.insert({ j.Type, j.Extremum, j.Cell });
-    bool ok = j.Separatrices.size() >= 2 && j.Extremum >= 0 && j.Extremum < nCP;
+    bool ok = j.OneCells.size() >= 2 && j.Extremum >= 0 && j.Extremum < nCP;
     std::set<Index> following;
-    for (Index a : j.Separatrices)
+    for (Index a : j.OneCells)
     {
-      const Separatrix& arc = c.Separatrices[a];
+      const OneCell& arc = c.OneCells[a];
       const auto& path = fromExtremum[a];
       const auto it = std::find(path.begin(), path.end(), j.Cell);
-      ok = ok && arc.Type == j.Type && (j.Type == Separatrix::Descending ? arc.Source : arc.Destination) == j.Extremum &&
+      ok = ok && arc.Type == j.Type && (j.Type == OneCell::Descending ? arc.Source : arc.Destination) == j.Extremum &&
         it != path.end();
       if (ok)
       {
@@ -432,10 +432,10 @@ void CheckComplex(Failures& failures, const std::string& at, const PlanarScalarF
   }
   failures.Check(junctionsValid, "junction points lie on 2+ 1-cells of their extremum that part there", at);
   std::map<std::pair<int, Index>, std::vector<Index>> arcsOfExtremum;
-  for (size_t a = 0; a < c.Separatrices.size(); ++a)
+  for (size_t a = 0; a < c.OneCells.size(); ++a)
   {
-    const Separatrix& arc = c.Separatrices[a];
-    arcsOfExtremum[{ arc.Type, arc.Type == Separatrix::Descending ? arc.Source : arc.Destination }].push_back(a);
+    const OneCell& arc = c.OneCells[a];
+    arcsOfExtremum[{ arc.Type, arc.Type == OneCell::Descending ? arc.Source : arc.Destination }].push_back(a);
   }
   bool junctionsComplete = true;
   for (const auto& entry : arcsOfExtremum)
@@ -659,16 +659,16 @@ TEST_CASE(BadInput)
     CHECK(!ok && !error.empty());
   };
   MorseSmaleComplex broken = input;
-  broken.Separatrices[0].Source = static_cast<Index>(broken.CriticalPoints.size());
+  broken.OneCells[0].Source = static_cast<Index>(broken.CriticalPoints.size());
   refused(broken, "1-cell with an out-of-range endpoint");
   broken = input;
-  broken.Separatrices.pop_back();
+  broken.OneCells.pop_back();
   refused(broken, "saddle missing a 1-cell");
   broken = input;
   broken.TwoCellId.pop_back();
   refused(broken, "short per-vertex array");
   broken = input;
-  broken.Separatrices[1].Values.pop_back();
+  broken.OneCells[1].Values.pop_back();
   refused(broken, "1-cell with one value missing");
 
   CHECK(simplification.ComputeHierarchy(input, error));

@@ -317,9 +317,9 @@ TEST_CASE(SideAssembly)
     piece.Curve.ControlPoints = { x, 0, x + 0.3, 0.3, x + 0.6, 0.6, x + 1, 1 };
     piece.Height.ControlPoints = { 0, 0, 1, 1 };
   }
-  smoothed.PiecesOfSeparatrix = { { 0, 1 }, { 2, 3 }, { 0, 4 }, { 5, 3 }, { 6 }, { 7 } };
+  smoothed.PiecesOfOneCell = { { 0, 1 }, { 2, 3 }, { 0, 4 }, { 5, 3 }, { 6 }, { 7 } };
   TwoCell cell;
-  cell.Arcs = { 0, 1, 2, 3 };
+  cell.BoundaryOneCells = { 0, 1, 2, 3 };
   TwoCellSides sides;
   std::string error;
   CHECK(AssembleTwoCellSides(cell, smoothed, sides, error));
@@ -330,18 +330,18 @@ TEST_CASE(SideAssembly)
   CHECK(sides.Pieces[TwoCellSides::Top] == std::vector<Index>({ 5 }));
 
   // A pouch: the same ascending 1-cell on both sides is a slit, kept whole.
-  cell.Arcs = { 4, 1, 5, 1 };
+  cell.BoundaryOneCells = { 4, 1, 5, 1 };
   CHECK(AssembleTwoCellSides(cell, smoothed, sides, error));
   CHECK(sides.Slit && !sides.MaximumShifted);
   CHECK(sides.Pieces[TwoCellSides::Right] == sides.Pieces[TwoCellSides::Top]);
 
   // A saddle on the other saddle's 1-cell: the bottom side is empty and takes the lower half
   // of the right side (2 segments: one each).
-  smoothed.PiecesOfSeparatrix[2] = { 0, 1, 6 };
+  smoothed.PiecesOfOneCell[2] = { 0, 1, 6 };
   smoothed.Pieces[2].Curve.Segments = smoothed.Pieces[2].Height.Segments = 2;
   smoothed.Pieces[2].Curve.ControlPoints = { 0, 0, 1, 0, 2, 0, 3, 0, 3, 0, 4, 0, 5, 0, 6, 0 };
   smoothed.Pieces[2].Height.ControlPoints = { 0, 0, 1, 2, 2, 3, 4, 4 };
-  cell.Arcs = { 0, 1, 2, 3 };
+  cell.BoundaryOneCells = { 0, 1, 2, 3 };
   CHECK(AssembleTwoCellSides(cell, smoothed, sides, error));
   CHECK(sides.Pieces[TwoCellSides::Bottom].empty());
   CHECK_EQ(sides.SplitSides[0], int(TwoCellSides::Right));
@@ -353,17 +353,17 @@ TEST_CASE(SideAssembly)
   CHECK(segments[TwoCellSides::Bottom].Curve[0][6] == 3 && segments[TwoCellSides::Right].Curve[0][0] == 3);
 
   // Both sides of a pair empty: 2 corners, refused.
-  smoothed.PiecesOfSeparatrix[1] = { 3 };
-  smoothed.PiecesOfSeparatrix[3] = { 3 };
-  smoothed.PiecesOfSeparatrix[2] = { 0, 1 };
-  cell.Arcs = { 0, 1, 2, 3 };
+  smoothed.PiecesOfOneCell[1] = { 3 };
+  smoothed.PiecesOfOneCell[3] = { 3 };
+  smoothed.PiecesOfOneCell[2] = { 0, 1 };
+  cell.BoundaryOneCells = { 0, 1, 2, 3 };
   CHECK(!AssembleTwoCellSides(cell, smoothed, sides, error));
 
   // Unknown 1-cells and pieces are refused.
-  cell.Arcs = { 0, 1, 2, 42 };
+  cell.BoundaryOneCells = { 0, 1, 2, 42 };
   CHECK(!AssembleTwoCellSides(cell, smoothed, sides, error));
-  smoothed.PiecesOfSeparatrix[3] = { 99 };
-  cell.Arcs = { 0, 1, 2, 3 };
+  smoothed.PiecesOfOneCell[3] = { 99 };
+  cell.BoundaryOneCells = { 0, 1, 2, 3 };
   CHECK(!AssembleTwoCellSides(cell, smoothed, sides, error));
 }
 
