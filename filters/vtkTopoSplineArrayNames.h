@@ -33,6 +33,7 @@ constexpr const char* CriticalIndex = "CriticalIndex";
 constexpr const char* CriticalValue = "CriticalValue";
 constexpr const char* VertexId = "VertexId";
 constexpr const char* IsOnBoundary = "IsOnBoundary";
+constexpr const char* CriticalCellId = "CriticalCellId"; // the critical vertex, edge or triangle
 
 // 1-cells (cell data of the "OneCells" block; point data: the scalar along the 1-cell).
 constexpr const char* SeparatrixId = "SeparatrixId";
@@ -61,16 +62,94 @@ constexpr const char* PieceId = "PieceId";
 constexpr const char* Height = "Height";
 constexpr const char* SeparatrixPieceOffsets = "SeparatrixPieceOffsets";
 constexpr const char* SeparatrixPieces = "SeparatrixPieces";
+constexpr const char* PieceSegments = "PieceSegments"; // cell data: cubic segments of the piece
+
+// Junction points (point data of the "JunctionPoints" block; also SeparatrixType, MeshCellId
+// and CriticalPointId, -1 where no saddle sits on the junction).
+constexpr const char* ExtremumId = "ExtremumId";
+constexpr const char* JunctionValue = "JunctionValue";
+constexpr const char* NumberOfSeparatrices = "NumberOfSeparatrices";
 
 // Reconstruction (point data of the input geometry).
 constexpr const char* ReconstructedField = "Reconstructed";
 constexpr const char* ReconstructionDifference = "Difference";
 // F o Phi at the vertices before topological sampling.
 constexpr const char* ExactReconstruction = "ReconstructedExact";
+constexpr const char* ReconstructionCellId = "ReconstructionCellId";
+// The resampled image: points that no reconstructed 2-cell covers are 0 here (VTK's name).
+constexpr const char* ValidPointMask = "vtkValidPointMask";
 
 // Field data of the complex: which input array it was computed from.
 constexpr const char* ScalarFieldName = "TopoSplineScalarField";
 // Field data of a simplified complex: vertices where boundary 1-cells turn inwards
 // (MorseSmaleComplex::BoundaryJunctions).
 constexpr const char* BoundaryJunctionVertexId = "BoundaryJunctionVertexId";
+
+// Field data of "Simplify Morse-Smale Complex".
+constexpr const char* CancelledLowerId = "CancelledLowerId";
+constexpr const char* CancelledUpperId = "CancelledUpperId";
+constexpr const char* SurvivorId = "SurvivorId";
+constexpr const char* CancellationPersistence = "CancellationPersistence";
+constexpr const char* AbsolutePersistenceThreshold = "AbsolutePersistenceThreshold";
+constexpr const char* MaximumPersistence = "MaximumPersistence";
+constexpr const char* BlockedCancellations = "BlockedCancellations";
+constexpr const char* BlockedLowerId = "BlockedLowerId";
+constexpr const char* BlockedUpperId = "BlockedUpperId";
+constexpr const char* BlockedPersistence = "BlockedPersistence";
+constexpr const char* BlockedReason = "BlockedReason";
+constexpr const char* PersistenceCurvePercent = "PersistenceCurvePercent";
+constexpr const char* PersistenceCurveCriticalPoints = "PersistenceCurveCriticalPoints";
+
+// Field data of "Smooth 1-Cells".
+constexpr const char* CurveSegments = "CurveSegments";
+constexpr const char* NumberOfPieces = "NumberOfPieces";
+constexpr const char* AdaptedPieces = "AdaptedPieces";
+constexpr const char* RemainingCrossings = "RemainingCrossings";
+constexpr const char* PiecesOutsideDomain = "PiecesOutsideDomain";
+constexpr const char* ClampedPieces = "ClampedPieces";
+constexpr const char* L1Error = "L1Error";
+constexpr const char* UnconstrainedL1Error = "UnconstrainedL1Error";
+constexpr const char* JunctionMargin = "JunctionMargin";
+constexpr const char* SpreadCriticalValues = "SpreadCriticalValues";
+constexpr const char* MaximumSpread = "MaximumSpread";
+
+// Field data of "Reconstruct 2-Cells" (on output port 0).
+constexpr const char* TwoCells = "TwoCells";
+constexpr const char* FailedTwoCells = "FailedTwoCells";
+constexpr const char* NegligibleTwoCells = "NegligibleTwoCells";
+constexpr const char* SlitTwoCells = "SlitTwoCells";
+constexpr const char* ShiftedCorners = "ShiftedCorners";
+constexpr const char* ViolatingPatches = "ViolatingPatches";
+constexpr const char* LinearizedDiagonals = "LinearizedDiagonals";
+constexpr const char* BezierTriangles = "BezierTriangles";
+constexpr const char* MeshTriangles = "MeshTriangles";
+constexpr const char* MaximumGridSize = "MaximumGridSize";
+constexpr const char* SnappedPoints = "SnappedPoints";
+constexpr const char* UnreconstructedPoints = "UnreconstructedPoints";
+constexpr const char* MaximumError = "MaximumError";
+constexpr const char* RMSError = "RMSError";
+constexpr const char* ValueRange = "ValueRange";
+constexpr const char* ParameterizationSeconds = "ParameterizationSeconds";
+constexpr const char* SurfaceSeconds = "SurfaceSeconds";
+constexpr const char* EvaluationSeconds = "EvaluationSeconds";
+constexpr const char* SamplingChangedVertices = "SamplingChangedVertices";
+constexpr const char* SamplingMaximumChange = "SamplingMaximumChange";
+constexpr const char* SamplingConverged = "SamplingConverged";
+constexpr const char* SamplingDisplacedSaddles = "SamplingDisplacedSaddles";
+// Topology verification: per sampling (the prefixes RawInput, Input, Resampled), the found
+// counts of minima, saddles, maxima and the largest distance of a matched point to its node.
+constexpr const char* RawInputSampling = "RawInput";
+constexpr const char* InputSampling = "Input";
+constexpr const char* ResampledSampling = "Resampled";
+constexpr const char* CriticalPointsSuffix = "CriticalPoints";
+constexpr const char* CriticalPointDistanceSuffix = "CriticalPointDistance";
+constexpr const char* ExpectedCriticalPoints = "ExpectedCriticalPoints";
+constexpr const char* TopologyVerified = "TopologyVerified";
+constexpr const char* SpuriousCriticalPoints = "SpuriousCriticalPoints"; // x, y, index, value
+constexpr const char* MissingCriticalPoints = "MissingCriticalPoints";   // x, y, index, value
+constexpr const char* VerificationSeconds = "VerificationSeconds";
+
+// Point arrays of the synthetic sources.
+constexpr const char* ShepardField = "Shepard";
+constexpr const char* TrigonometricField = "Trigonometric";
 }

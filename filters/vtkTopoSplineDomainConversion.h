@@ -1,15 +1,16 @@
-// Conversions between VTK data and the pure C++ core: input domains to PlanarScalarField,
-// MorseSmaleComplex to and from the multiblock that flows between the pipeline stages, and
-// vtkSMPTools as the core's ParallelFor.
+// Conversions between VTK data and the pure C++ core: input domains to PlanarScalarField, the
+// plane the domain lies in, vtkSMPTools as the core's ParallelFor, and small array helpers.
+// (The multiblock that flows between the stages is read and written in vtkTopoSplineWireFormat.)
 #pragma once
 
-#include "MorseSmaleComplexExtraction.h" // core
+#include "MorseSmaleComplex.h" // core
 
 #include <vtkSmartPointer.h>
 
 #include <initializer_list>
 #include <string>
 
+class vtkAbstractArray;
 class vtkDataArray;
 class vtkInformation;
 class vtkDataSet;
@@ -32,15 +33,6 @@ vtkDataArray* SelectedPointScalars(
 // vtkUnstructuredGrid and a point scalar array. Returns false with a user-facing message.
 bool ToPlanarScalarField(vtkDataSet* input, vtkDataArray* scalars, topospline::PlanarScalarField& field,
   std::string& error);
-
-// Writes the complex into `output` (blocks named in vtkTopoSplineArrayNames.h). `domain` is the
-// input geometry: it is shallow-copied into the "Segmentation" block with the per-vertex ids.
-void ToMultiBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* domain, const char* scalarName,
-  vtkMultiBlockDataSet* output);
-
-// Reads a complex written by ToMultiBlock back (for the later stages). Returns false with a
-// message when `input` is not such a complex.
-bool FromMultiBlock(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& complex, std::string& error);
 
 // The coordinate plane of a domain: which two axes span it (U, V: the (u, v) of
 // PlanarScalarField::Points) and where the third one (W) sits.
@@ -79,14 +71,14 @@ vtkSmartPointer<ArrayT> NewArray(const char* name, int components = 1, vtkIdType
   return array;
 }
 
-// The "Segmentation" block of a complex, or nullptr.
-vtkDataSet* SegmentationOf(vtkMultiBlockDataSet* input);
-
 // Input ports of the filters that take a field: 2D images and planar triangle meshes.
 void AcceptPlanarDomains(vtkInformation* inputPortInformation);
 
 // The complex is global: every process asks for the whole input (RequestUpdateExtent).
 void RequestWholeInput(vtkInformation* inputInformation);
+
+// Adds the arrays (smart pointers or raw) to `data` in the given order.
+void AddArrays(vtkFieldData* data, std::initializer_list<vtkAbstractArray*> arrays);
 
 // Field data: a double array `name` holding `values`.
 void AddFieldNumbers(vtkFieldData* fieldData, const char* name, std::initializer_list<double> values);

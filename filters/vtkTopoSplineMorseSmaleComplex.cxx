@@ -1,6 +1,7 @@
 #include "vtkTopoSplineMorseSmaleComplex.h"
 
 #include "vtkTopoSplineDomainConversion.h"
+#include "vtkTopoSplineWireFormat.h"
 
 #include "MorseSmaleComplexExtraction.h" // core
 
@@ -112,7 +113,7 @@ int vtkTopoSplineMorseSmaleComplex::RequestData(
                                        << complex.TwoCells.size() << " 2-cells");
   {
     vtkLogScopeF(TRACE, "build output");
-    vtkTopoSplineDomainConversion::ToMultiBlock(complex, input, scalars->GetName(), output);
+    vtkTopoSplineWireFormat::WriteComplex(complex, input, scalars->GetName(), output);
   }
   this->UpdateProgress(1.0);
   return 1;

@@ -3,9 +3,9 @@
 #include "vtkTopoSplineArrayNames.h"
 #include "vtkTopoSplineDomainConversion.h"
 
-#include "TopologicalSampling.h"    // core
-#include "TopologyVerification.h"   // core
-#include "TwoCellReconstruction.h"  // core
+#include "vtkTopoSplineWireFormat.h"
+
+#include "FieldReconstruction.h" // core
 
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
@@ -38,6 +38,7 @@
 
 namespace names = vtkTopoSplineArrayNames;
 namespace conversion = vtkTopoSplineDomainConversion;
+namespace wire = vtkTopoSplineWireFormat;
 using topospline::Index;
 
 vtkStandardNewMacro(vtkTopoSplineReconstructTwoCells);
@@ -86,133 +87,6 @@ vtkDataSet* EnsureGeometryOutput(vtkInformation* info, vtkDataSet* domain)
   return vtkDataSet::SafeDownCast(current);
 }
 
-// The smoothed pieces written by "Smooth 1-Cells" (Bezier curves with their heights, and the
-// pieces of every 1-cell), back into the core's form.
-bool ReadSmoothedPieces(vtkMultiBlockDataSet* input, const topospline::MorseSmaleComplex& complex,
-  const conversion::DomainPlane& plane, topospline::OneCellSmoothingResult& result, std::string& error)
-{
-  auto* block = input->GetNumberOfBlocks() > names::SmoothedOneCellsIndex
-    ? vtkUnstructuredGrid::SafeDownCast(input->GetBlock(names::SmoothedOneCellsIndex))
-    : nullptr;
-  vtkDataArray* piece = block ? block->GetCellData()->GetArray(names::PieceId) : nullptr;
-  vtkDataArray* height = block ? block->GetPointData()->GetArray(names::Height) : nullptr;
-  vtkDataArray* offsets = block ? block->GetFieldData()->GetArray(names::SeparatrixPieceOffsets) : nullptr;
-  vtkDataArray* list = block ? block->GetFieldData()->GetArray(names::SeparatrixPieces) : nullptr;
-  if (!piece || !height || !offsets || !list)
-  {
-    error = "the input has no smoothed 1-cells (expected the output of \"Smooth 1-Cells\")";
-    return false;
-  }
-  const vtkIdType arcs = offsets->GetNumberOfTuples() - 1;
-  if (arcs != static_cast<vtkIdType>(complex.OneCells.size()))
-  {
-    error = "the smoothed 1-cells do not match the complex";
-    return false;
-  }
-  Index pieces = 0;
-  for (vtkIdType c = 0; c < block->GetNumberOfCells(); ++c)
-  {
-    pieces = std::max(pieces, static_cast<Index>(piece->GetComponent(c, 0)) + 1);
-  }
-  result = topospline::OneCellSmoothingResult();
-  result.Pieces.resize(pieces);
-  for (auto& p : result.Pieces)
-  {
-    p.Curve.Dimension = 2;
-    p.Height.Dimension = 1;
-  }
-  vtkNew<vtkIdList> ids;
-  for (vtkIdType c = 0; c < block->GetNumberOfCells(); ++c)
-  {
-    block->GetCellPoints(c, ids);
-    const Index p = static_cast<Index>(piece->GetComponent(c, 0));
-    if (block->GetCellType(c) != VTK_BEZIER_CURVE || ids->GetNumberOfIds() != 4 || p < 0)
-    {
-      error = "the smoothed 1-cells are not cubic Bezier curves";
-      return false;
-    }
-    auto& smoothed = result.Pieces[p];
-    // VTK orders a curve's points as both ends first, then the interior ones.
-    const int order[4] = { 0, 2, 3, 1 };
-    for (int m = 0; m < 4; ++m)
-    {
-      const vtkIdType id = ids->GetId(order[m]);
-      double xyz[3], uv[2];
-      block->GetPoint(id, xyz);
-      plane.ToPlanar(xyz, uv);
-      smoothed.Curve.ControlPoints.insert(smoothed.Curve.ControlPoints.end(), uv, uv + 2);
-      smoothed.Height.ControlPoints.push_back(height->GetComponent(id, 0));
-    }
-    ++smoothed.Curve.Segments;
-    ++smoothed.Height.Segments;
-  }
-  result.PiecesOfOneCell.resize(arcs);
-  for (vtkIdType a = 0; a < arcs; ++a)
-  {
-    const vtkIdType begin = static_cast<vtkIdType>(offsets->GetComponent(a, 0));
-    const vtkIdType end = static_cast<vtkIdType>(offsets->GetComponent(a + 1, 0));
-    for (vtkIdType i = begin; i < end && i < list->GetNumberOfTuples(); ++i)
-    {
-      const Index p = static_cast<Index>(list->GetComponent(i, 0));
-      if (p < 0 || p >= pieces)
-      {
-        error = "the smoothed 1-cells list unknown pieces";
-        return false;
-      }
-      result.PiecesOfOneCell[a].push_back(p);
-    }
-  }
-  return true;
-}
-
-// Largest edge of the triangulation (images: the grid's diagonal): the distance within which
-// a critical point of a sampling of the reconstruction must sit from its node.
-double GridSpacing(vtkDataSet* domain, const topospline::PlanarScalarField& field)
-{
-  if (auto* image = vtkImageData::SafeDownCast(domain))
-  {
-    const auto plane = conversion::PlaneOf(domain);
-    const double* s = image->GetSpacing();
-    return std::hypot(s[plane.U], s[plane.V]);
-  }
-  double longest = 0;
-  const auto& p = field.Points;
-  for (std::size_t t = 0; t + 2 < field.Triangles.size(); t += 3)
-  {
-    for (int e = 0; e < 3; ++e)
-    {
-      const Index a = field.Triangles[t + e], b = field.Triangles[t + (e + 1) % 3];
-      longest = std::max(longest, std::hypot(p[2 * a] - p[2 * b], p[2 * a + 1] - p[2 * b + 1]));
-    }
-  }
-  return longest;
-}
-
-double MeanEdgeLength(const topospline::PlanarScalarField& field)
-{
-  if (field.IsGrid())
-  {
-    // The grid's triangles: both axes and the (i+1,j)-(i,j+1) diagonal.
-    const auto& p = field.Points;
-    const double dx = std::abs(p[2] - p[0]);
-    const double dy = std::abs(p[2 * field.GridDimensions[0] + 1] - p[1]);
-    return (dx + dy + std::hypot(dx, dy)) / 3;
-  }
-  double sum = 0;
-  std::size_t count = 0;
-  const auto& p = field.Points;
-  for (std::size_t t = 0; t + 2 < field.Triangles.size(); t += 3)
-  {
-    for (int e = 0; e < 3; ++e)
-    {
-      const Index a = field.Triangles[t + e], b = field.Triangles[t + (e + 1) % 3];
-      sum += std::hypot(p[2 * a] - p[2 * b], p[2 * a + 1] - p[2 * b + 1]);
-      ++count;
-    }
-  }
-  return count ? sum / count : 0;
-}
-
 // VTK_BEZIER_TRIANGLE point order for degree 3 (corners, edge points from each edge's first
 // corner, centre) as ordinate indices b_ijk, with A, B, C the VTK corners 0, 1, 2.
 constexpr int VtkBezierTriangleOrder[10] = { topospline::BezierOrdinateIndex(3, 0),
@@ -221,82 +95,13 @@ constexpr int VtkBezierTriangleOrder[10] = { topospline::BezierOrdinateIndex(3, 
   topospline::BezierOrdinateIndex(0, 2), topospline::BezierOrdinateIndex(0, 1),
   topospline::BezierOrdinateIndex(1, 0), topospline::BezierOrdinateIndex(2, 0),
   topospline::BezierOrdinateIndex(1, 1) };
-
-struct TopologyCheck
-{
-  topospline::TopologyComparison Comparison;
-  bool Ran = false;
-  std::string Error;
-};
-
-// Stage 1 on a sampling of the reconstruction, compared with the complex's critical points.
-TopologyCheck CheckTopology(vtkDataSet* sampling, vtkDataArray* values,
-  const std::vector<topospline::CriticalPointLocation>& expected, double tolerance)
-{
-  TopologyCheck check;
-  topospline::PlanarScalarField field;
-  topospline::MorseSmaleComplexExtraction extraction;
-  extraction.Parallel = conversion::SMPParallelFor();
-  extraction.CriticalPointsOnly = true;
-  topospline::MorseSmaleComplex found;
-  if (!conversion::ToPlanarScalarField(sampling, values, field, check.Error) ||
-    !extraction.Extract(field, found, check.Error))
-  {
-    return check;
-  }
-  check.Comparison =
-    topospline::CompareCriticalPoints(expected, topospline::CriticalPointLocations(found, field.Points), tolerance);
-  check.Ran = true;
-  return check;
-}
-
-// The mesh topology of a sampling (closed form for grids).
-void BuildTopology(const topospline::PlanarScalarField& field, topospline::TriangleMeshTopology& mesh, std::string& error)
-{
-  if (field.IsGrid())
-  {
-    mesh.BuildGrid(field.GridDimensions[0], field.GridDimensions[1], conversion::SMPParallelFor());
-  }
-  else
-  {
-    mesh.Build(static_cast<Index>(field.Points.size() / 2), field.Triangles, conversion::SMPParallelFor(), error);
-  }
-}
-
-// Topological sampling: the complex's critical points, placed on the sampling's vertices by
-// `vertexAt` (a vertex of the domain to one of the sampling), become the only extrema of the
-// sampled values (TopologicalSampling.h).
-topospline::TopologicalSamplingReport EnforceComplexTopology(const topospline::MorseSmaleComplex& complex,
-  const topospline::OneCellSmoothingResult& smoothed, const topospline::TriangleMeshTopology& domainMesh,
-  const std::vector<double>& domainPoints, const topospline::PlanarScalarField& sampling,
-  const topospline::TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, double spacing,
-  vtkDoubleArray* values, int& displacedSaddles)
-{
-  std::vector<double> sampled(values->GetPointer(0), values->GetPointer(0) + values->GetNumberOfTuples());
-  const auto report = topospline::SampleTopologically(complex, domainMesh, domainPoints, smoothed, sampling, mesh,
-    vertexAt, spacing, sampled, displacedSaddles, conversion::SMPParallelFor());
-  std::copy(sampled.begin(), sampled.end(), values->GetPointer(0));
-  return report;
-}
-
-void AddPoints(vtkFieldData* fd, const char* name, const std::vector<topospline::CriticalPointLocation>& points)
-{
-  // x, y, Morse index, value per point.
-  auto array = conversion::NewArray<vtkDoubleArray>(name, 4);
-  for (const auto& p : points)
-  {
-    const double tuple[4] = { p.Position[0], p.Position[1], static_cast<double>(p.MorseIndex), p.Value };
-    array->InsertNextTuple(tuple);
-  }
-  fd->AddArray(array);
-}
 } // namespace
 
 int vtkTopoSplineReconstructTwoCells::RequestDataObject(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   vtkMultiBlockDataSet* input = vtkMultiBlockDataSet::GetData(inputVector[0], 0);
-  EnsureGeometryOutput(outputVector->GetInformationObject(0), input ? conversion::SegmentationOf(input) : nullptr);
+  EnsureGeometryOutput(outputVector->GetInformationObject(0), input ? wire::SegmentationOf(input) : nullptr);
   for (int port = 1; port < 3; ++port)
   {
     vtkInformation* info = outputVector->GetInformationObject(port);
@@ -348,6 +153,171 @@ int vtkTopoSplineReconstructTwoCells::RequestInformation(
   return 1;
 }
 
+namespace
+{
+// Point data of the input geometry: the reconstruction, its difference to the input and the
+// 2-cell of each vertex (and F o Phi before topological sampling, when that ran).
+void WriteVertexValues(const topospline::FieldReconstructionReport& report, vtkDataSet* output)
+{
+  const auto n = static_cast<vtkIdType>(report.Values.size());
+  auto values = conversion::NewArray<vtkDoubleArray>(names::ReconstructedField, 1, n);
+  auto difference = conversion::NewArray<vtkDoubleArray>(names::ReconstructionDifference, 1, n);
+  auto cellIds = conversion::NewArray<vtkIntArray>(names::ReconstructionCellId, 1, n);
+  std::copy(report.Values.begin(), report.Values.end(), values->GetPointer(0));
+  std::copy(report.Difference.begin(), report.Difference.end(), difference->GetPointer(0));
+  std::copy(report.CellOfVertex.begin(), report.CellOfVertex.end(), cellIds->GetPointer(0));
+  if (report.Sampled)
+  {
+    auto exact = conversion::NewArray<vtkDoubleArray>(names::ExactReconstruction, 1, n);
+    std::copy(report.Exact.begin(), report.Exact.end(), exact->GetPointer(0));
+    output->GetPointData()->AddArray(exact);
+  }
+  conversion::AddArrays(output->GetPointData(), { values, difference, cellIds });
+  output->GetPointData()->SetActiveScalars(names::ReconstructedField);
+}
+
+// The Bezier triangles of every cell, in the plane of the input.
+void WritePatches(const topospline::FieldReconstructionReport& report, const conversion::DomainPlane& plane,
+  vtkUnstructuredGrid* patches)
+{
+  vtkIdType total = 0;
+  for (const auto& list : report.Patches)
+  {
+    total += static_cast<vtkIdType>(list.size());
+  }
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(10 * total);
+  auto height = conversion::NewArray<vtkDoubleArray>(names::Height, 1, 10 * total);
+  auto cellOf = conversion::NewArray<vtkIntArray>(names::TwoCellId, 1, total);
+  vtkNew<vtkCellArray> cells;
+  cells->AllocateExact(total, 10 * total);
+  vtkIdType next = 0, t = 0;
+  for (Index c = 0; c < static_cast<Index>(report.Patches.size()); ++c)
+  {
+    for (const auto& triangle : report.Patches[c])
+    {
+      vtkIdType ids[10];
+      for (int m = 0; m < 10; ++m)
+      {
+        const auto& control = triangle.Points[VtkBezierTriangleOrder[m]];
+        double xyz[3];
+        plane.To3D(control.data(), xyz);
+        points->SetPoint(next, xyz);
+        height->SetValue(next, control[2]);
+        ids[m] = next++;
+      }
+      cells->InsertNextCell(10, ids);
+      cellOf->SetValue(t++, c);
+    }
+  }
+  patches->Initialize();
+  patches->SetPoints(points);
+  patches->SetCells(VTK_BEZIER_TRIANGLE, cells);
+  patches->GetPointData()->AddArray(height);
+  patches->GetPointData()->SetActiveScalars(names::Height);
+  patches->GetCellData()->AddArray(cellOf);
+}
+
+// The finer grid as an image in the plane of the input (an image input keeps its third axis).
+void WriteResampled(const topospline::FieldReconstructionReport& report, vtkDataSet* domain,
+  const conversion::DomainPlane& plane, vtkImageData* resampled)
+{
+  int dims[3] = { 1, 1, 1 };
+  double origin[3], spacing[3] = { 1, 1, 1 };
+  if (auto* image = vtkImageData::SafeDownCast(domain))
+  {
+    image->GetSpacing(spacing);
+  }
+  plane.To3D(report.Finer.Origin, origin);
+  dims[plane.U] = report.Finer.Dimensions[0];
+  dims[plane.V] = report.Finer.Dimensions[1];
+  spacing[plane.U] = report.Finer.Spacing[0];
+  spacing[plane.V] = report.Finer.Spacing[1];
+  resampled->SetDimensions(dims);
+  resampled->SetOrigin(origin);
+  resampled->SetSpacing(spacing);
+  const auto m = static_cast<vtkIdType>(report.FinerValues.size());
+  auto values = conversion::NewArray<vtkDoubleArray>(names::ReconstructedField, 1, m);
+  auto valid = conversion::NewArray<vtkCharArray>(names::ValidPointMask, 1, m);
+  std::copy(report.FinerValues.begin(), report.FinerValues.end(), values->GetPointer(0));
+  std::copy(report.FinerValid.begin(), report.FinerValid.end(), valid->GetPointer(0));
+  conversion::AddArrays(resampled->GetPointData(), { values, valid });
+  resampled->GetPointData()->SetActiveScalars(names::ReconstructedField);
+}
+
+void AddPoints(vtkFieldData* fd, const char* name, const std::vector<topospline::CriticalPointLocation>& points)
+{
+  // x, y, Morse index, value per point.
+  auto array = conversion::NewArray<vtkDoubleArray>(name, 4);
+  for (const auto& p : points)
+  {
+    const double tuple[4] = { p.Position[0], p.Position[1], static_cast<double>(p.MorseIndex), p.Value };
+    array->InsertNextTuple(tuple);
+  }
+  fd->AddArray(array);
+}
+
+// Field data: what was done and how well.
+void WriteReport(const topospline::FieldReconstructionReport& report, vtkFieldData* fd)
+{
+  using conversion::AddFieldNumbers;
+  const auto& cells = report.Cells;
+  AddFieldNumbers(fd, names::TwoCells, { static_cast<double>(cells.Cells) });
+  AddFieldNumbers(fd, names::FailedTwoCells, { static_cast<double>(cells.FailedCells) });
+  AddFieldNumbers(fd, names::NegligibleTwoCells, { static_cast<double>(cells.NegligibleCells) });
+  AddFieldNumbers(fd, names::SlitTwoCells, { static_cast<double>(cells.SlitCells) });
+  AddFieldNumbers(fd, names::ShiftedCorners, { static_cast<double>(cells.ShiftedCorners) });
+  AddFieldNumbers(fd, names::ViolatingPatches, { static_cast<double>(cells.ViolatingPatches) });
+  AddFieldNumbers(fd, names::LinearizedDiagonals, { static_cast<double>(cells.LinearizedDiagonals) });
+  AddFieldNumbers(fd, names::BezierTriangles, { static_cast<double>(cells.BezierTriangles) });
+  AddFieldNumbers(fd, names::MeshTriangles, { static_cast<double>(cells.MeshTriangles) });
+  AddFieldNumbers(fd, names::MaximumGridSize, { static_cast<double>(cells.MaximumGridSize) });
+  AddFieldNumbers(fd, names::SnappedPoints, { static_cast<double>(report.SnappedPoints) });
+  AddFieldNumbers(fd, names::UnreconstructedPoints, { static_cast<double>(report.UnreconstructedPoints) });
+  AddFieldNumbers(fd, names::MaximumError, { report.MaximumError });
+  AddFieldNumbers(fd, names::RMSError, { report.RMSError });
+  AddFieldNumbers(fd, names::ValueRange, { report.ValueRange[0], report.ValueRange[1] });
+  AddFieldNumbers(fd, names::ParameterizationSeconds, { cells.ParameterizationSeconds });
+  AddFieldNumbers(fd, names::SurfaceSeconds, { cells.SurfaceSeconds });
+  AddFieldNumbers(fd, names::EvaluationSeconds, { report.EvaluationSeconds });
+  if (report.Sampled)
+  {
+    AddFieldNumbers(fd, names::SamplingChangedVertices, { static_cast<double>(report.Sampling.ChangedVertices) });
+    AddFieldNumbers(fd, names::SamplingMaximumChange, { report.Sampling.MaximumChange });
+    AddFieldNumbers(fd, names::SamplingConverged, { report.Sampling.Converged ? 1.0 : 0.0 });
+    AddFieldNumbers(fd, names::SamplingDisplacedSaddles, { static_cast<double>(report.DisplacedSaddles) });
+  }
+  if (!report.VerificationRan)
+  {
+    return;
+  }
+  for (const auto& [prefix, check] : { std::make_pair(names::RawInputSampling, &report.RawInput),
+         std::make_pair(names::InputSampling, &report.Input),
+         std::make_pair(names::ResampledSampling, &report.Resampled) })
+  {
+    if (check->Ran)
+    {
+      const auto& found = check->Comparison.Found;
+      const std::string p(prefix);
+      AddFieldNumbers(fd, (p + names::CriticalPointsSuffix).c_str(),
+        { static_cast<double>(found[0]), static_cast<double>(found[1]), static_cast<double>(found[2]) });
+      AddFieldNumbers(fd, (p + names::CriticalPointDistanceSuffix).c_str(), { check->Comparison.MaximumDistance });
+    }
+  }
+  double expected[3] = { 0, 0, 0 };
+  for (const auto& cp : report.Expected)
+  {
+    expected[cp.MorseIndex] += 1;
+  }
+  AddFieldNumbers(fd, names::ExpectedCriticalPoints, { expected[0], expected[1], expected[2] });
+  AddFieldNumbers(fd, names::TopologyVerified, { report.Verified ? 1.0 : 0.0 });
+  AddPoints(fd, names::SpuriousCriticalPoints, report.Spurious);
+  AddPoints(fd, names::MissingCriticalPoints, report.Missing);
+  AddFieldNumbers(fd, names::VerificationSeconds, { report.VerificationSeconds });
+}
+} // namespace
+
 int vtkTopoSplineReconstructTwoCells::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -378,71 +348,56 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
   }
   std::string error;
   topospline::MorseSmaleComplex complex;
-  if (!conversion::FromMultiBlock(input, complex, error))
-  {
-    vtkErrorMacro("Reconstruct 2-Cells: " << error << ".");
-    return 1;
-  }
-  vtkDataSet* domain = conversion::SegmentationOf(input);
-  const auto plane = conversion::PlaneOf(domain);
   topospline::OneCellSmoothingResult smoothed;
-  if (!ReadSmoothedPieces(input, complex, plane, smoothed, error))
+  if (!wire::ReadComplex(input, complex, error) || !wire::ReadSmoothedOneCells(input, complex, smoothed, error))
   {
     vtkErrorMacro("Reconstruct 2-Cells: " << error << ".");
     return 1;
   }
-  auto* nameArray = vtkStringArray::SafeDownCast(input->GetFieldData()->GetAbstractArray(names::ScalarFieldName));
-  const std::string scalarName = nameArray && nameArray->GetNumberOfValues() > 0 ? nameArray->GetValue(0) : "";
+  vtkDataSet* domain = wire::SegmentationOf(input);
+  const std::string scalarName = wire::ScalarFieldNameOf(input);
   vtkDataArray* original = domain->GetPointData()->GetArray(scalarName.c_str());
   if (!original || original->GetNumberOfComponents() != 1)
   {
     vtkErrorMacro("Reconstruct 2-Cells: the input field \"" << scalarName << "\" is missing from the complex.");
     return 1;
   }
-  topospline::PlanarScalarField domainField;
-  if (!conversion::ToPlanarScalarField(domain, original, domainField, error))
+  topospline::PlanarScalarField field;
+  if (!conversion::ToPlanarScalarField(domain, original, field, error))
   {
     vtkErrorMacro("Reconstruct 2-Cells: " << error << ".");
     return 1;
   }
   {
-    // Refused before anything is allocated, with the estimate. Measured: about 230 kB per
-    // 2-cell (its triangulation, parameterization, Sibson grid and Bezier patches; uniform
-    // noise 100 x 100 to 300 x 300 at 5 %: 1.5 to 10.7 GB for 5 000 to 45 000 cells), and
-    // about 200 bytes per vertex of the finer sampling (values, mask, its critical point check).
-    const double fineVertices =
-      static_cast<double>(domain->GetNumberOfPoints()) * this->OutputResolution * this->OutputResolution;
+    // Refused before anything is allocated, with the estimate.
+    const double f = this->OutputResolution;
+    const double finer = f > 1 ? static_cast<double>(domain->GetNumberOfPoints()) * f * f : 0.0;
     const double cells = static_cast<double>(complex.TwoCells.size());
-    const double needed = 230e3 * cells + (this->OutputResolution > 1 ? 260.0 * fineVertices : 0.0);
+    const double needed = topospline::FieldReconstruction::MemoryEstimate(cells, finer);
     vtksys::SystemInformation system;
     const double available = 1024.0 * static_cast<double>(system.GetAvailablePhysicalMemory()) * 1024.0;
     if (available > 0 && needed > 0.8 * available)
     {
-      vtkErrorMacro("Reconstruct 2-Cells: " << cells << " 2-cells"
-                    << (this->OutputResolution > 1 ? " and the finer sampling" : "") << " need about "
-                    << needed / 1e9 << " GB; this machine has " << available / 1e9
+      vtkErrorMacro("Reconstruct 2-Cells: " << cells << " 2-cells" << (f > 1 ? " and the finer sampling" : "")
+                    << " need about " << needed / 1e9 << " GB; this machine has " << available / 1e9
                     << " GB available. Simplify further (a higher Persistence Threshold)"
-                    << (this->OutputResolution > 1 ? " or choose a lower Output Resolution" : "") << ".");
+                    << (f > 1 ? " or choose a lower Output Resolution" : "") << ".");
       return 1;
     }
   }
 
-  // The 2-cells, in parallel.
-  topospline::TwoCellReconstruction reconstruction;
+  topospline::FieldReconstruction reconstruction;
   reconstruction.BoundarySamples = this->BoundarySamples;
-  // One grid spacing: how far a vertex may lie outside the smoothed cells, and how far a
-  // critical point of a sampling may lie from its node.
-  const double gridSpacing = GridSpacing(domain, domainField);
-  reconstruction.SnapDistance = gridSpacing;
-  const double edge = MeanEdgeLength(domainField);
-  reconstruction.MinimumMeshEdgeLength = 2 * edge;
-  reconstruction.NegligibleArea = edge * edge;
+  reconstruction.OutputResolution = this->OutputResolution;
+  reconstruction.TopologicalSampling = this->TopologicalSampling != 0;
+  reconstruction.VerifyTopology = this->VerifyTopology != 0;
   reconstruction.Parallel = conversion::SMPParallelFor();
-  reconstruction.Hooks.Progress = [this](double f) { this->UpdateProgress(0.6 * f); };
+  reconstruction.Hooks.Progress = [this](double f) { this->UpdateProgress(f); };
   reconstruction.Hooks.AbortRequested = [this]() { return this->GetAbortExecute() != 0; };
+  topospline::FieldReconstructionReport report;
   {
     vtkLogScopeF(TRACE, "reconstruct %d 2-cells", static_cast<int>(complex.TwoCells.size()));
-    if (!reconstruction.Reconstruct(complex, smoothed, error))
+    if (!reconstruction.Run(field, complex, smoothed, report, error))
     {
       if (error != "aborted")
       {
@@ -451,338 +406,50 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
       return 1;
     }
   }
-  const auto& report = reconstruction.Report();
-  if (report.FailedCells > 0)
+  for (const auto& [cell, why] : report.FailedCells)
   {
-    for (Index c = 0; c < reconstruction.NumberOfCells(); ++c)
-    {
-      if (!reconstruction.Cell(c).Valid && !reconstruction.Cell(c).Negligible)
-      {
-        vtkWarningMacro("Reconstruct 2-Cells: 2-cell " << c << " was not reconstructed: "
-                                                       << reconstruction.Cell(c).Error << ".");
-      }
-    }
+    vtkWarningMacro("Reconstruct 2-Cells: 2-cell " << cell << " was not reconstructed: " << why << ".");
   }
-
-  // F o Phi at every input vertex; the vertex's 2-cell of the jagged complex is the first guess.
-  vtkDataSet* output = EnsureGeometryOutput(outputVector->GetInformationObject(0), domain);
-  output->ShallowCopy(domain);
-  const vtkIdType n = domain->GetNumberOfPoints();
-  auto values = conversion::NewArray<vtkDoubleArray>(names::ReconstructedField, 1, n);
-  auto difference = conversion::NewArray<vtkDoubleArray>(names::ReconstructionDifference, 1, n);
-  auto cellIds = conversion::NewArray<vtkIntArray>("ReconstructionCellId", 1, n);
-  std::atomic<vtkIdType> snapped(0), missed(0);
-  const auto evaluationStart = std::chrono::steady_clock::now();
+  if (report.Cells.ViolatingPatches > 0)
   {
-    vtkLogScopeF(TRACE, "evaluate at %lld vertices", static_cast<long long>(n));
-    vtkDataArray* hints = domain->GetPointData()->GetArray(names::TwoCellId);
-    vtkSMPTools::For(0, n, [&](vtkIdType begin, vtkIdType end) {
-      vtkIdType localSnapped = 0, localMissed = 0;
-      for (vtkIdType v = begin; v < end; ++v)
-      {
-        const double* xy = &domainField.Points[2 * v];
-        const Index hint = hints ? static_cast<Index>(hints->GetComponent(v, 0)) : topospline::InvalidIndex;
-        const auto e = reconstruction.Evaluate(xy[0], xy[1], hint);
-        const double f = original->GetComponent(v, 0);
-        if (e.Cell == topospline::InvalidIndex)
-        {
-          // No reconstructed cell here (a failed cell): the input value, reported.
-          ++localMissed;
-          values->SetValue(v, f);
-        }
-        else
-        {
-          localSnapped += e.Inside ? 0 : 1;
-          values->SetValue(v, e.Value);
-        }
-        difference->SetValue(v, values->GetValue(v) - f);
-        cellIds->SetValue(v, e.Cell);
-      }
-      snapped += localSnapped;
-      missed += localMissed;
-    });
-  }
-  const double evaluationSeconds =
-    std::chrono::duration<double>(std::chrono::steady_clock::now() - evaluationStart).count();
-  // Topological sampling of the input geometry; the raw values are kept for the report.
-  topospline::TriangleMeshTopology domainMesh;
-  BuildTopology(domainField, domainMesh, error);
-  vtkSmartPointer<vtkDoubleArray> rawValues;
-  topospline::TopologicalSamplingReport sampling;
-  int displacedSaddles = 0;
-  if (this->TopologicalSampling)
-  {
-    vtkLogScopeF(TRACE, "topological sampling");
-    // F o Phi itself stays available (it interpolates the critical values exactly; the
-    // flooding may move a node's value when the node sits in a spurious pit or peak).
-    rawValues = vtkSmartPointer<vtkDoubleArray>::New();
-    rawValues->DeepCopy(values);
-    rawValues->SetName(names::ExactReconstruction);
-    output->GetPointData()->AddArray(rawValues);
-    sampling = EnforceComplexTopology(complex, smoothed, domainMesh, domainField.Points, domainField, domainMesh,
-      [](Index v) { return v; },
-      gridSpacing, values, displacedSaddles);
-    for (vtkIdType v = 0; v < n; ++v)
-    {
-      difference->SetValue(v, values->GetValue(v) - original->GetComponent(v, 0));
-    }
-  }
-  output->GetPointData()->AddArray(values);
-  output->GetPointData()->AddArray(difference);
-  output->GetPointData()->AddArray(cellIds);
-  output->GetPointData()->SetActiveScalars(names::ReconstructedField);
-  this->UpdateProgress(0.7);
-
-  double maximumError = 0, squares = 0, range[2];
-  original->GetRange(range, 0);
-  for (vtkIdType v = 0; v < n; ++v)
-  {
-    const double d = difference->GetValue(v);
-    maximumError = std::max(maximumError, std::abs(d));
-    squares += d * d;
-  }
-  const double rmsError = n ? std::sqrt(squares / n) : 0;
-
-  // The Bezier triangles of every cell, in the plane of the input.
-  {
-    vtkLogScopeF(TRACE, "Bezier triangles");
-    std::vector<std::vector<topospline::PlanarBezierTriangle>> perCell(reconstruction.NumberOfCells());
-    vtkSMPTools::For(0, reconstruction.NumberOfCells(), [&](vtkIdType begin, vtkIdType end) {
-      for (vtkIdType c = begin; c < end; ++c)
-      {
-        perCell[c] = reconstruction.PlanarBezierTriangles(static_cast<Index>(c));
-      }
-    });
-    vtkIdType total = 0;
-    for (const auto& list : perCell)
-    {
-      total += static_cast<vtkIdType>(list.size());
-    }
-    vtkNew<vtkPoints> points;
-    points->SetDataTypeToDouble();
-    points->SetNumberOfPoints(10 * total);
-    auto height = conversion::NewArray<vtkDoubleArray>(names::Height, 1, 10 * total);
-    auto cellOf = conversion::NewArray<vtkIntArray>(names::TwoCellId, 1, total);
-    vtkNew<vtkCellArray> cells;
-    cells->AllocateExact(total, 10 * total);
-    vtkIdType next = 0, t = 0;
-    for (Index c = 0; c < static_cast<Index>(perCell.size()); ++c)
-    {
-      for (const auto& triangle : perCell[c])
-      {
-        vtkIdType ids[10];
-        for (int m = 0; m < 10; ++m)
-        {
-          const auto& control = triangle.Points[VtkBezierTriangleOrder[m]];
-          double xyz[3];
-          plane.To3D(control.data(), xyz);
-          points->SetPoint(next, xyz);
-          height->SetValue(next, control[2]);
-          ids[m] = next++;
-        }
-        cells->InsertNextCell(10, ids);
-        cellOf->SetValue(t++, c);
-      }
-    }
-    patchesOutput->Initialize();
-    patchesOutput->SetPoints(points);
-    patchesOutput->SetCells(VTK_BEZIER_TRIANGLE, cells);
-    patchesOutput->GetPointData()->AddArray(height);
-    patchesOutput->GetPointData()->SetActiveScalars(names::Height);
-    patchesOutput->GetCellData()->AddArray(cellOf);
-  }
-  this->UpdateProgress(0.75);
-
-  // The resampled image.
-  resampledOutput->Initialize();
-  vtkSmartPointer<vtkDoubleArray> resampled;
-  if (this->OutputResolution > 1)
-  {
-    vtkLogScopeF(TRACE, "resample x%d", this->OutputResolution);
-    const int f = this->OutputResolution;
-    int dims[3] = { 1, 1, 1 };
-    double origin[3] = { 0, 0, 0 }, spacing[3] = { 1, 1, 1 };
-    if (auto* image = vtkImageData::SafeDownCast(domain))
-    {
-      // From the image's first point: its extent need not start at 0 (e.g. a cropped image).
-      image->GetDimensions(dims);
-      image->GetPoint(0, origin);
-      image->GetSpacing(spacing);
-      for (int axis : { plane.U, plane.V })
-      {
-        dims[axis] = (dims[axis] - 1) * f + 1;
-        spacing[axis] /= f;
-      }
-      // Direction matrices are not honoured by stage 1 either: axis-aligned images only.
-    }
-    else
-    {
-      double bounds[4];
-      conversion::PlanarBounds(domain, bounds);
-      const double h = std::max(MeanEdgeLength(domainField) / f, 1e-12 * (bounds[1] - bounds[0] + bounds[3] - bounds[2]));
-      origin[plane.U] = bounds[0];
-      origin[plane.V] = bounds[2];
-      origin[plane.W] = plane.WValue;
-      dims[plane.U] = std::max(2, static_cast<int>(std::ceil((bounds[1] - bounds[0]) / h)) + 1);
-      dims[plane.V] = std::max(2, static_cast<int>(std::ceil((bounds[3] - bounds[2]) / h)) + 1);
-      spacing[plane.U] = (bounds[1] - bounds[0]) / (dims[plane.U] - 1);
-      spacing[plane.V] = (bounds[3] - bounds[2]) / (dims[plane.V] - 1);
-    }
-    resampledOutput->SetDimensions(dims);
-    resampledOutput->SetOrigin(origin);
-    resampledOutput->SetSpacing(spacing);
-    const vtkIdType m = resampledOutput->GetNumberOfPoints();
-    resampled = conversion::NewArray<vtkDoubleArray>(names::ReconstructedField, 1, m);
-    auto valid = conversion::NewArray<vtkCharArray>("vtkValidPointMask", 1, m);
-    vtkSMPTools::For(0, m, [&](vtkIdType begin, vtkIdType end) {
-      for (vtkIdType p = begin; p < end; ++p)
-      {
-        double xyz[3], uv[2];
-        resampledOutput->GetPoint(p, xyz);
-        plane.ToPlanar(xyz, uv);
-        const auto e = reconstruction.Evaluate(uv[0], uv[1]);
-        resampled->SetValue(p, e.Cell == topospline::InvalidIndex ? 0.0 : e.Value);
-        valid->SetValue(p, e.Cell == topospline::InvalidIndex ? 0 : 1);
-      }
-    });
-    if (this->TopologicalSampling)
-    {
-      topospline::PlanarScalarField fine;
-      std::string ignored;
-      conversion::ToPlanarScalarField(resampledOutput, resampled, fine, ignored);
-      topospline::TriangleMeshTopology fineMesh;
-      BuildTopology(fine, fineMesh, ignored);
-      const double* o = resampledOutput->GetOrigin();
-      const double* h = resampledOutput->GetSpacing();
-      const int ni = dims[plane.U], nj = dims[plane.V];
-      int fineDisplaced = 0;
-      const auto fineReport = EnforceComplexTopology(complex, smoothed, domainMesh, domainField.Points, fine, fineMesh,
-        [&](Index v) {
-          const double* xy = &domainField.Points[2 * static_cast<std::size_t>(v)];
-          const int i = std::clamp(static_cast<int>(std::lround((xy[0] - o[plane.U]) / h[plane.U])), 0, ni - 1);
-          const int j = std::clamp(static_cast<int>(std::lround((xy[1] - o[plane.V]) / h[plane.V])), 0, nj - 1);
-          return static_cast<Index>(j * ni + i);
-        },
-        gridSpacing, resampled, fineDisplaced);
-      displacedSaddles += fineDisplaced;
-      sampling.ChangedVertices += fineReport.ChangedVertices;
-      sampling.MaximumChange = std::max(sampling.MaximumChange, fineReport.MaximumChange);
-      sampling.Converged = sampling.Converged && fineReport.Converged;
-    }
-    resampledOutput->GetPointData()->AddArray(resampled);
-    resampledOutput->GetPointData()->AddArray(valid);
-    resampledOutput->GetPointData()->SetActiveScalars(names::ReconstructedField);
-  }
-  this->UpdateProgress(0.85);
-
-  // Field data: what was done and how well.
-  vtkFieldData* fd = output->GetFieldData();
-  fd->PassData(input->GetFieldData());
-  conversion::AddFieldNumbers(fd, "TwoCells", { static_cast<double>(report.Cells) });
-  conversion::AddFieldNumbers(fd, "FailedTwoCells", { static_cast<double>(report.FailedCells) });
-  conversion::AddFieldNumbers(fd, "NegligibleTwoCells", { static_cast<double>(report.NegligibleCells) });
-  conversion::AddFieldNumbers(fd, "SlitTwoCells", { static_cast<double>(report.SlitCells) });
-  conversion::AddFieldNumbers(fd, "ShiftedCorners", { static_cast<double>(report.ShiftedCorners) });
-  conversion::AddFieldNumbers(fd, "ViolatingPatches", { static_cast<double>(report.ViolatingPatches) });
-  conversion::AddFieldNumbers(fd, "LinearizedDiagonals", { static_cast<double>(report.LinearizedDiagonals) });
-  conversion::AddFieldNumbers(fd, "BezierTriangles", { static_cast<double>(report.BezierTriangles) });
-  conversion::AddFieldNumbers(fd, "MeshTriangles", { static_cast<double>(report.MeshTriangles) });
-  conversion::AddFieldNumbers(fd, "MaximumGridSize", { static_cast<double>(report.MaximumGridSize) });
-  conversion::AddFieldNumbers(fd, "SnappedPoints", { static_cast<double>(snapped.load()) });
-  conversion::AddFieldNumbers(fd, "UnreconstructedPoints", { static_cast<double>(missed.load()) });
-  conversion::AddFieldNumbers(fd, "MaximumError", { maximumError });
-  conversion::AddFieldNumbers(fd, "RMSError", { rmsError });
-  conversion::AddFieldNumbers(fd, "ValueRange", { range[0], range[1] });
-  conversion::AddFieldNumbers(fd, "ParameterizationSeconds", { report.ParameterizationSeconds });
-  conversion::AddFieldNumbers(fd, "SurfaceSeconds", { report.SurfaceSeconds });
-  conversion::AddFieldNumbers(fd, "EvaluationSeconds", { evaluationSeconds });
-  if (this->TopologicalSampling)
-  {
-    conversion::AddFieldNumbers(fd, "SamplingChangedVertices", { static_cast<double>(sampling.ChangedVertices) });
-    conversion::AddFieldNumbers(fd, "SamplingMaximumChange", { sampling.MaximumChange });
-    conversion::AddFieldNumbers(fd, "SamplingConverged", { sampling.Converged ? 1.0 : 0.0 });
-    conversion::AddFieldNumbers(fd, "SamplingDisplacedSaddles", { static_cast<double>(displacedSaddles) });
-  }
-  if (report.ViolatingPatches > 0)
-  {
-    vtkWarningMacro("Reconstruct 2-Cells: " << report.ViolatingPatches
+    vtkWarningMacro("Reconstruct 2-Cells: " << report.Cells.ViolatingPatches
                                             << " Sibson grid cell(s) fail the monotonicity conditions.");
   }
-  if (missed > 0)
+  if (report.UnreconstructedPoints > 0)
   {
-    vtkWarningMacro("Reconstruct 2-Cells: " << missed.load()
+    vtkWarningMacro("Reconstruct 2-Cells: " << report.UnreconstructedPoints
                                             << " vertices lie in no reconstructed 2-cell and keep their input value.");
   }
-
-  if (this->VerifyTopology)
+  for (const auto& [prefix, check] : { std::make_pair("Input", &report.Input),
+         std::make_pair("Resampled", &report.Resampled) })
   {
-    vtkLogScopeF(TRACE, "verify topology");
-    const auto verifyStart = std::chrono::steady_clock::now();
-    const auto expected = topospline::CriticalPointLocations(complex, domainField.Points);
-    const double tolerance = gridSpacing * (1 + 1e-9);
-    // The verdict covers the whole reconstruction: a failed 2-cell or a vertex outside every
-    // reconstructed cell keeps input values, which no critical-point count can vouch for.
-    bool verified = report.FailedCells == 0 && missed == 0;
-    std::vector<topospline::CriticalPointLocation> spurious, missing;
-    // `judged`: the check is on an output (the raw sampling before topological sampling is
-    // only reported).
-    auto record = [&](const char* prefix, const TopologyCheck& check, bool judged) {
-      const std::string p(prefix);
-      if (!check.Ran && !judged)
-      {
-        return;
-      }
-      if (!check.Ran)
-      {
-        vtkWarningMacro("Reconstruct 2-Cells: topology check on the " << prefix << " sampling failed: " << check.Error);
-        verified = false;
-        return;
-      }
-      const auto& c = check.Comparison;
-      conversion::AddFieldNumbers(fd, (p + "CriticalPoints").c_str(),
-        { static_cast<double>(c.Found[0]), static_cast<double>(c.Found[1]), static_cast<double>(c.Found[2]) });
-      conversion::AddFieldNumbers(fd, (p + "CriticalPointDistance").c_str(), { c.MaximumDistance });
-      if (!judged)
-      {
-        return;
-      }
-      if (!c.Identical())
-      {
-        verified = false;
-        vtkWarningMacro("Reconstruct 2-Cells: the " << prefix << " sampling of the reconstruction has "
-                                                    << c.Spurious.size() << " spurious and " << c.Missing.size()
-                                                    << " missing critical point(s) (found " << c.Found[0] << "/"
-                                                    << c.Found[1] << "/" << c.Found[2] << ", expected "
-                                                    << c.Expected[0] << "/" << c.Expected[1] << "/" << c.Expected[2]
-                                                    << ").");
-      }
-      spurious.insert(spurious.end(), c.Spurious.begin(), c.Spurious.end());
-      missing.insert(missing.end(), c.Missing.begin(), c.Missing.end());
-    };
-    if (rawValues)
+    const bool judged = report.VerificationRan && (check == &report.Input || this->OutputResolution > 1);
+    const auto& c = check->Comparison;
+    if (judged && !check->Ran)
     {
-      record("RawInput", CheckTopology(output, rawValues, expected, tolerance), false);
+      vtkWarningMacro("Reconstruct 2-Cells: topology check on the " << prefix << " sampling failed: " << check->Error);
     }
-    record("Input", CheckTopology(output, values, expected, tolerance), true);
-    if (resampled)
+    else if (judged && !c.Identical())
     {
-      record("Resampled", CheckTopology(resampledOutput, resampled, expected, tolerance), true);
+      vtkWarningMacro("Reconstruct 2-Cells: the " << prefix << " sampling of the reconstruction has "
+                      << c.Spurious.size() << " spurious and " << c.Missing.size() << " missing critical point(s) (found "
+                      << c.Found[0] << "/" << c.Found[1] << "/" << c.Found[2] << ", expected " << c.Expected[0] << "/"
+                      << c.Expected[1] << "/" << c.Expected[2] << ").");
     }
-    conversion::AddFieldNumbers(fd, "ExpectedCriticalPoints", { 0, 0, 0 });
-    {
-      auto* e = vtkDoubleArray::SafeDownCast(fd->GetArray("ExpectedCriticalPoints"));
-      for (const auto& cp : expected)
-      {
-        e->SetValue(cp.MorseIndex, e->GetValue(cp.MorseIndex) + 1);
-      }
-    }
-    conversion::AddFieldNumbers(fd, "TopologyVerified", { verified ? 1.0 : 0.0 });
-    AddPoints(fd, "SpuriousCriticalPoints", spurious);
-    AddPoints(fd, "MissingCriticalPoints", missing);
-    conversion::AddFieldNumbers(fd, "VerificationSeconds",
-      { std::chrono::duration<double>(std::chrono::steady_clock::now() - verifyStart).count() });
   }
-  this->UpdateProgress(1.0);
+
+  const auto plane = conversion::PlaneOf(domain);
+  vtkDataSet* output = EnsureGeometryOutput(outputVector->GetInformationObject(0), domain);
+  output->ShallowCopy(domain);
+  WriteVertexValues(report, output);
+  WritePatches(report, plane, patchesOutput);
+  resampledOutput->Initialize();
+  if (this->OutputResolution > 1)
+  {
+    WriteResampled(report, domain, plane, resampledOutput);
+  }
+  output->GetFieldData()->PassData(input->GetFieldData());
+  WriteReport(report, output->GetFieldData());
   return 1;
 }
 

@@ -2,6 +2,7 @@
 
 #include "vtkTopoSplineArrayNames.h"
 #include "vtkTopoSplineDomainConversion.h"
+#include "vtkTopoSplineWireFormat.h"
 
 #include "MorseSmaleComplexSimplification.h" // core
 
@@ -50,54 +51,16 @@ int vtkTopoSplineSimplifyMorseSmaleComplex::FillInputPortInformation(int, vtkInf
 
 namespace
 {
-vtkSmartPointer<vtkPolyData> JunctionPointsBlock(
-  const topospline::SimplificationOutput& result, vtkDataSet* domain)
-{
-  const auto& cps = result.Complex.CriticalPoints;
-  const auto plane = vtkTopoSplineDomainConversion::PlaneOf(domain);
-  auto block = vtkSmartPointer<vtkPolyData>::New();
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  vtkNew<vtkCellArray> verts;
-  auto type = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::SeparatrixType);
-  auto extremum = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("ExtremumId");
-  auto cell = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::MeshCellId);
-  auto value = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>("JunctionValue");
-  auto critical = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::CriticalPointId);
-  auto count = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("NumberOfSeparatrices");
-  for (const auto& junction : result.JunctionPoints)
-  {
-    double xyz[3];
-    plane.To3D(junction.Position, xyz);
-    const vtkIdType id = points->InsertNextPoint(xyz);
-    verts->InsertNextCell(1, &id);
-    type->InsertNextValue(junction.Type);
-    extremum->InsertNextValue(cps[junction.Extremum].Id);
-    cell->InsertNextValue(junction.Cell);
-    value->InsertNextValue(junction.Value);
-    critical->InsertNextValue(
-      junction.CriticalPoint == topospline::InvalidIndex ? -1 : cps[junction.CriticalPoint].Id);
-    count->InsertNextValue(static_cast<int>(junction.OneCells.size()));
-  }
-  block->SetPoints(points);
-  block->SetVerts(verts);
-  for (vtkAbstractArray* a : std::initializer_list<vtkAbstractArray*>{ type, extremum, cell, value, critical, count })
-  {
-    block->GetPointData()->AddArray(a);
-  }
-  return block;
-}
-
 // The pairs below the threshold that the paper's rules kept, and why: users see what
 // survived although its persistence is small.
 void AddBlockedPairs(const topospline::SimplificationOutput& result, vtkFieldData* fd)
 {
-  auto count = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("BlockedCancellations");
+  auto count = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::BlockedCancellations);
   count->InsertNextValue(static_cast<int>(result.Blocked.size()));
-  auto lower = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("BlockedLowerId");
-  auto upper = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("BlockedUpperId");
-  auto persistence = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>("BlockedPersistence");
-  auto reason = vtkTopoSplineDomainConversion::NewArray<vtkStringArray>("BlockedReason");
+  auto lower = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::BlockedLowerId);
+  auto upper = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::BlockedUpperId);
+  auto persistence = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>(names::BlockedPersistence);
+  auto reason = vtkTopoSplineDomainConversion::NewArray<vtkStringArray>(names::BlockedReason);
   for (size_t i = 0; i < result.Blocked.size(); ++i)
   {
     lower->InsertNextValue(result.Blocked[i].Lower);
@@ -115,8 +78,8 @@ void AddBlockedPairs(const topospline::SimplificationOutput& result, vtkFieldDat
 // distinct threshold of the hierarchy (a step function, constant up to the next point).
 void AddPersistenceCurve(const topospline::MorseSmaleComplexSimplification& simplification, vtkFieldData* fd)
 {
-  auto percent = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>("PersistenceCurvePercent");
-  auto remaining = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("PersistenceCurveCriticalPoints");
+  auto percent = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>(names::PersistenceCurvePercent);
+  auto remaining = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::PersistenceCurveCriticalPoints);
   const auto& hierarchy = simplification.Hierarchy();
   const double maximum = simplification.MaximumPersistence();
   auto left = static_cast<int>(simplification.NumberOfInputCriticalPoints());
@@ -139,10 +102,10 @@ void AddPersistenceCurve(const topospline::MorseSmaleComplexSimplification& simp
 
 void AddCancellations(const topospline::SimplificationOutput& result, double maximumPersistence, vtkFieldData* fd)
 {
-  auto lower = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("CancelledLowerId");
-  auto upper = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("CancelledUpperId");
-  auto survivor = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>("SurvivorId");
-  auto persistence = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>("CancellationPersistence");
+  auto lower = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::CancelledLowerId);
+  auto upper = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::CancelledUpperId);
+  auto survivor = vtkTopoSplineDomainConversion::NewArray<vtkIntArray>(names::SurvivorId);
+  auto persistence = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>(names::CancellationPersistence);
   for (const auto& c : result.Cancellations)
   {
     lower->InsertNextValue(c.Lower);
@@ -150,9 +113,9 @@ void AddCancellations(const topospline::SimplificationOutput& result, double max
     survivor->InsertNextValue(c.Survivor);
     persistence->InsertNextValue(c.Persistence);
   }
-  auto absolute = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>("AbsolutePersistenceThreshold");
+  auto absolute = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>(names::AbsolutePersistenceThreshold);
   absolute->InsertNextValue(result.AbsoluteThreshold);
-  auto maximum = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>("MaximumPersistence");
+  auto maximum = vtkTopoSplineDomainConversion::NewArray<vtkDoubleArray>(names::MaximumPersistence);
   maximum->InsertNextValue(maximumPersistence);
   for (vtkAbstractArray* a : std::initializer_list<vtkAbstractArray*>{ lower, upper, survivor, persistence, absolute, maximum })
   {
@@ -185,14 +148,14 @@ int vtkTopoSplineSimplifyMorseSmaleComplex::RequestData(
       << this->PersistenceThreshold << ".");
     return 1;
   }
-  vtkDataSet* domain = vtkTopoSplineDomainConversion::SegmentationOf(input);
+  vtkDataSet* domain = vtkTopoSplineWireFormat::SegmentationOf(input);
   std::string error;
   Cache& cache = *this->Hierarchy;
   if (!cache.Simplification.HasHierarchy() || cache.InputObject != input || cache.InputTime != input->GetMTime())
   {
     vtkLogScopeF(TRACE, "compute cancellation hierarchy");
     topospline::MorseSmaleComplex complex;
-    if (!vtkTopoSplineDomainConversion::FromMultiBlock(input, complex, error))
+    if (!vtkTopoSplineWireFormat::ReadComplex(input, complex, error))
     {
       vtkErrorMacro("Simplify Morse-Smale Complex: " << error << ".");
       cache.InputObject = nullptr;
@@ -229,13 +192,9 @@ int vtkTopoSplineSimplifyMorseSmaleComplex::RequestData(
                                  << " pairs below the threshold blocked by the cancellation rules)");
   {
     vtkLogScopeF(TRACE, "build output");
-    auto* scalarName = vtkStringArray::SafeDownCast(input->GetFieldData()->GetAbstractArray(names::ScalarFieldName));
-    vtkTopoSplineDomainConversion::ToMultiBlock(result.Complex, domain,
-      scalarName && scalarName->GetNumberOfValues() ? scalarName->GetValue(0).c_str() : "", output);
-    output->SetNumberOfBlocks(names::NumberOfBlocks + 1);
-    output->SetBlock(names::JunctionPointsIndex, JunctionPointsBlock(result, domain));
-    output->GetMetaData(static_cast<unsigned int>(names::JunctionPointsIndex))
-      ->Set(vtkCompositeDataSet::NAME(), names::JunctionPointsBlock);
+    vtkTopoSplineWireFormat::WriteComplex(
+      result.Complex, domain, vtkTopoSplineWireFormat::ScalarFieldNameOf(input).c_str(), output);
+    vtkTopoSplineWireFormat::WriteJunctionPoints(result.Complex, result.JunctionPoints, output);
     AddCancellations(result, cache.Simplification.MaximumPersistence(), output->GetFieldData());
     AddBlockedPairs(result, output->GetFieldData());
     AddPersistenceCurve(cache.Simplification, output->GetFieldData());

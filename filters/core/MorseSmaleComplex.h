@@ -19,6 +19,8 @@ struct PlanarScalarField
   // For a grid (image data): nx, ny with vertex (i, j) = j * nx + i, triangulated as
   // GridTriangles(nx, ny) without spelling the triangles out. {0, 0} for a general mesh.
   int GridDimensions[2] = { 0, 0 };
+  // For a grid: the distance between neighbouring vertices along each axis.
+  double GridSpacing[2] = { 0, 0 };
   bool IsGrid() const { return this->GridDimensions[0] > 1 && this->GridDimensions[1] > 1; }
 };
 

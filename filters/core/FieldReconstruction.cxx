@@ -1,0 +1,383 @@
+#include "FieldReconstruction.h"
+
+#include "MorseSmaleComplexExtraction.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+namespace topospline
+{
+namespace
+{
+double SecondsSince(std::chrono::steady_clock::time_point start)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Stage 1 on `sampling`, compared with the complex's critical points.
+SamplingTopologyCheck CheckSampling(const PlanarScalarField& sampling,
+  const std::vector<CriticalPointLocation>& expected, double tolerance, const ParallelFor& parallel)
+{
+  SamplingTopologyCheck check;
+  MorseSmaleComplexExtraction extraction;
+  extraction.Parallel = parallel;
+  extraction.CriticalPointsOnly = true;
+  MorseSmaleComplex found;
+  if (!extraction.Extract(sampling, found, check.Error))
+  {
+    return check;
+  }
+  check.Comparison = CompareCriticalPoints(expected, CriticalPointLocations(found, sampling.Points), tolerance);
+  check.Ran = true;
+  return check;
+}
+
+// The field with other values at the same vertices.
+PlanarScalarField WithValues(const PlanarScalarField& field, const std::vector<double>& values)
+{
+  PlanarScalarField sampling;
+  sampling.Points = field.Points;
+  sampling.Triangles = field.Triangles;
+  sampling.Values = values;
+  sampling.GridDimensions[0] = field.GridDimensions[0];
+  sampling.GridDimensions[1] = field.GridDimensions[1];
+  sampling.GridSpacing[0] = field.GridSpacing[0];
+  sampling.GridSpacing[1] = field.GridSpacing[1];
+  return sampling;
+}
+} // namespace
+
+double LargestEdgeLength(const PlanarScalarField& field)
+{
+  if (field.IsGrid())
+  {
+    return std::hypot(field.GridSpacing[0], field.GridSpacing[1]);
+  }
+  double longest = 0;
+  const auto& p = field.Points;
+  for (std::size_t t = 0; t + 2 < field.Triangles.size(); t += 3)
+  {
+    for (int e = 0; e < 3; ++e)
+    {
+      const Index a = field.Triangles[t + e], b = field.Triangles[t + (e + 1) % 3];
+      longest = std::max(longest, std::hypot(p[2 * a] - p[2 * b], p[2 * a + 1] - p[2 * b + 1]));
+    }
+  }
+  return longest;
+}
+
+double MeanEdgeLength(const PlanarScalarField& field)
+{
+  const auto& p = field.Points;
+  if (field.IsGrid())
+  {
+    // The grid's triangles: both axes and the (i+1,j)-(i,j+1) diagonal.
+    const double dx = std::abs(p[2] - p[0]);
+    const double dy = std::abs(p[2 * field.GridDimensions[0] + 1] - p[1]);
+    return (dx + dy + std::hypot(dx, dy)) / 3;
+  }
+  double sum = 0;
+  std::size_t count = 0;
+  for (std::size_t t = 0; t + 2 < field.Triangles.size(); t += 3)
+  {
+    for (int e = 0; e < 3; ++e)
+    {
+      const Index a = field.Triangles[t + e], b = field.Triangles[t + (e + 1) % 3];
+      sum += std::hypot(p[2 * a] - p[2 * b], p[2 * a + 1] - p[2 * b + 1]);
+      ++count;
+    }
+  }
+  return count ? sum / count : 0;
+}
+
+bool BuildMesh(const PlanarScalarField& field, TriangleMeshTopology& mesh, const ParallelFor& parallel,
+  std::string& error)
+{
+  if (field.IsGrid())
+  {
+    mesh.BuildGrid(field.GridDimensions[0], field.GridDimensions[1], parallel);
+    return true;
+  }
+  return mesh.Build(static_cast<Index>(field.Points.size() / 2), field.Triangles, parallel, error);
+}
+
+double FieldReconstruction::MemoryEstimate(double cells, double finerPoints)
+{
+  return 230e3 * cells + 260.0 * finerPoints;
+}
+
+SamplingGrid FieldReconstruction::FinerGrid(const PlanarScalarField& field) const
+{
+  SamplingGrid grid;
+  const int f = this->OutputResolution;
+  if (field.IsGrid())
+  {
+    // From the grid's first point: an image's extent need not start at 0 (a cropped image).
+    for (int axis = 0; axis < 2; ++axis)
+    {
+      grid.Origin[axis] = field.Points[axis];
+      grid.Spacing[axis] = field.GridSpacing[axis] / f;
+      grid.Dimensions[axis] = (field.GridDimensions[axis] - 1) * f + 1;
+    }
+    return grid;
+  }
+  double bounds[4] = { field.Points[0], field.Points[0], field.Points[1], field.Points[1] };
+  for (std::size_t v = 0; 2 * v < field.Points.size(); ++v)
+  {
+    bounds[0] = std::min(bounds[0], field.Points[2 * v]);
+    bounds[1] = std::max(bounds[1], field.Points[2 * v]);
+    bounds[2] = std::min(bounds[2], field.Points[2 * v + 1]);
+    bounds[3] = std::max(bounds[3], field.Points[2 * v + 1]);
+  }
+  const double h = std::max(MeanEdgeLength(field) / f, 1e-12 * (bounds[1] - bounds[0] + bounds[3] - bounds[2]));
+  for (int axis = 0; axis < 2; ++axis)
+  {
+    const double low = bounds[2 * axis], high = bounds[2 * axis + 1];
+    grid.Origin[axis] = low;
+    grid.Dimensions[axis] = std::max(2, static_cast<int>(std::ceil((high - low) / h)) + 1);
+    grid.Spacing[axis] = (high - low) / (grid.Dimensions[axis] - 1);
+  }
+  return grid;
+}
+
+bool FieldReconstruction::Run(const PlanarScalarField& field, const MorseSmaleComplex& complex,
+  const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report, std::string& error)
+{
+  report = FieldReconstructionReport();
+  // One grid spacing: how far a vertex may lie outside the smoothed cells, and how far a
+  // critical point of a sampling may lie from its node.
+  this->Spacing = LargestEdgeLength(field);
+  this->Cells = TwoCellReconstruction();
+  this->Cells.BoundarySamples = this->BoundarySamples;
+  this->Cells.SnapDistance = this->Spacing;
+  const double edge = MeanEdgeLength(field);
+  this->Cells.MinimumMeshEdgeLength = 2 * edge;
+  this->Cells.NegligibleArea = edge * edge;
+  this->Cells.Parallel = this->Parallel;
+  this->Cells.Hooks.Progress = [this](double f) { this->Hooks.Report(0.6 * f); };
+  this->Cells.Hooks.AbortRequested = this->Hooks.AbortRequested;
+  if (!this->Cells.Reconstruct(complex, smoothed, error))
+  {
+    return false;
+  }
+  report.Cells = this->Cells.Report();
+  for (Index c = 0; c < this->Cells.NumberOfCells(); ++c)
+  {
+    if (!this->Cells.Cell(c).Valid && !this->Cells.Cell(c).Negligible)
+    {
+      report.FailedCells.emplace_back(c, this->Cells.Cell(c).Error);
+    }
+  }
+
+  this->EvaluateAtVertices(field, complex, report);
+  TriangleMeshTopology mesh;
+  std::string ignored; // the input's mesh was checked by stage 1
+  BuildMesh(field, mesh, this->Parallel, ignored);
+  if (this->TopologicalSampling)
+  {
+    this->SampleTopologicallyAtVertices(field, mesh, complex, smoothed, report);
+  }
+  this->Hooks.Report(0.7);
+  this->MeasureErrors(field, report);
+  this->CollectPatches(report);
+  this->Hooks.Report(0.75);
+  if (this->OutputResolution > 1)
+  {
+    this->Resample(field, mesh, complex, smoothed, report);
+  }
+  this->Hooks.Report(0.85);
+  if (this->VerifyTopology)
+  {
+    this->Verify(field, complex, report);
+  }
+  this->Hooks.Report(1.0);
+  return true;
+}
+
+// F o Phi at every input vertex; the vertex's 2-cell of the jagged complex is the first guess.
+void FieldReconstruction::EvaluateAtVertices(
+  const PlanarScalarField& field, const MorseSmaleComplex& complex, FieldReconstructionReport& report) const
+{
+  const auto start = std::chrono::steady_clock::now();
+  const Index n = static_cast<Index>(field.Values.size());
+  const bool hints = complex.TwoCellId.size() == field.Values.size();
+  report.Values.resize(n);
+  report.Difference.resize(n);
+  report.CellOfVertex.resize(n);
+  std::atomic<Index> snapped(0), missed(0);
+  this->Parallel(0, n, [&](Index begin, Index end) {
+    Index localSnapped = 0, localMissed = 0;
+    for (Index v = begin; v < end; ++v)
+    {
+      const double* xy = &field.Points[2 * static_cast<std::size_t>(v)];
+      const auto e = this->Cells.Evaluate(xy[0], xy[1], hints ? complex.TwoCellId[v] : InvalidIndex);
+      const double f = field.Values[v];
+      if (e.Cell == InvalidIndex)
+      {
+        // No reconstructed cell here (a failed cell): the input value, reported.
+        ++localMissed;
+        report.Values[v] = f;
+      }
+      else
+      {
+        localSnapped += e.Inside ? 0 : 1;
+        report.Values[v] = e.Value;
+      }
+      report.Difference[v] = report.Values[v] - f;
+      report.CellOfVertex[v] = e.Cell;
+    }
+    snapped += localSnapped;
+    missed += localMissed;
+  });
+  report.SnappedPoints = snapped.load();
+  report.UnreconstructedPoints = missed.load();
+  report.EvaluationSeconds = SecondsSince(start);
+}
+
+// F o Phi itself stays available as Exact (it interpolates the critical values exactly; the
+// flooding may move a node's value when the node sits in a spurious pit or peak).
+void FieldReconstruction::SampleTopologicallyAtVertices(const PlanarScalarField& field,
+  const TriangleMeshTopology& mesh, const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
+  FieldReconstructionReport& report) const
+{
+  report.Sampled = true;
+  report.Exact = report.Values;
+  report.Sampling = SampleTopologically(complex, mesh, field.Points, smoothed, field, mesh,
+    [](Index v) { return v; }, this->Spacing, report.Values, report.DisplacedSaddles, this->Parallel);
+  for (std::size_t v = 0; v < report.Values.size(); ++v)
+  {
+    report.Difference[v] = report.Values[v] - field.Values[v];
+  }
+}
+
+void FieldReconstruction::MeasureErrors(const PlanarScalarField& field, FieldReconstructionReport& report) const
+{
+  if (!field.Values.empty())
+  {
+    const auto range = std::minmax_element(field.Values.begin(), field.Values.end());
+    report.ValueRange[0] = *range.first;
+    report.ValueRange[1] = *range.second;
+  }
+  double squares = 0;
+  for (const double d : report.Difference)
+  {
+    report.MaximumError = std::max(report.MaximumError, std::abs(d));
+    squares += d * d;
+  }
+  const std::size_t n = report.Difference.size();
+  report.RMSError = n ? std::sqrt(squares / n) : 0;
+}
+
+void FieldReconstruction::CollectPatches(FieldReconstructionReport& report) const
+{
+  report.Patches.resize(this->Cells.NumberOfCells());
+  this->Parallel(0, this->Cells.NumberOfCells(), [&](Index begin, Index end) {
+    for (Index c = begin; c < end; ++c)
+    {
+      report.Patches[c] = this->Cells.PlanarBezierTriangles(c);
+    }
+  });
+}
+
+// F o Phi on the finer grid (0 where no cell covers a point), then its topological sampling,
+// with each node on the grid point nearest to it.
+void FieldReconstruction::Resample(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const
+{
+  const SamplingGrid grid = this->FinerGrid(field);
+  report.Finer = grid;
+  const int ni = grid.Dimensions[0], nj = grid.Dimensions[1];
+  PlanarScalarField fine;
+  fine.GridDimensions[0] = ni;
+  fine.GridDimensions[1] = nj;
+  fine.GridSpacing[0] = grid.Spacing[0];
+  fine.GridSpacing[1] = grid.Spacing[1];
+  const Index m = static_cast<Index>(grid.NumberOfPoints());
+  fine.Points.resize(2 * static_cast<std::size_t>(m));
+  fine.Values.resize(m);
+  report.FinerValid.resize(m);
+  this->Parallel(0, m, [&](Index begin, Index end) {
+    for (Index p = begin; p < end; ++p)
+    {
+      const int i = p % ni, j = p / ni;
+      const double u = grid.Origin[0] + i * grid.Spacing[0];
+      const double v = grid.Origin[1] + j * grid.Spacing[1];
+      fine.Points[2 * static_cast<std::size_t>(p)] = u;
+      fine.Points[2 * static_cast<std::size_t>(p) + 1] = v;
+      const auto e = this->Cells.Evaluate(u, v);
+      fine.Values[p] = e.Cell == InvalidIndex ? 0.0 : e.Value;
+      report.FinerValid[p] = e.Cell == InvalidIndex ? 0 : 1;
+    }
+  });
+  if (this->TopologicalSampling)
+  {
+    TriangleMeshTopology fineMesh;
+    fineMesh.BuildGrid(ni, nj, this->Parallel);
+    int fineDisplaced = 0;
+    const auto fineReport = SampleTopologically(complex, mesh, field.Points, smoothed, fine, fineMesh,
+      [&](Index v) {
+        const double* xy = &field.Points[2 * static_cast<std::size_t>(v)];
+        const int i = std::clamp(static_cast<int>(std::lround((xy[0] - grid.Origin[0]) / grid.Spacing[0])), 0, ni - 1);
+        const int j = std::clamp(static_cast<int>(std::lround((xy[1] - grid.Origin[1]) / grid.Spacing[1])), 0, nj - 1);
+        return static_cast<Index>(j * ni + i);
+      },
+      this->Spacing, fine.Values, fineDisplaced, this->Parallel);
+    report.DisplacedSaddles += fineDisplaced;
+    report.Sampling.ChangedVertices += fineReport.ChangedVertices;
+    report.Sampling.MaximumChange = std::max(report.Sampling.MaximumChange, fineReport.MaximumChange);
+    report.Sampling.Converged = report.Sampling.Converged && fineReport.Converged;
+  }
+  report.FinerValues = std::move(fine.Values);
+}
+
+// The verdict covers the whole reconstruction: a failed 2-cell or a vertex outside every
+// reconstructed cell keeps input values, which no critical-point count can vouch for. The raw
+// F o Phi before topological sampling is only reported.
+void FieldReconstruction::Verify(
+  const PlanarScalarField& field, const MorseSmaleComplex& complex, FieldReconstructionReport& report) const
+{
+  const auto start = std::chrono::steady_clock::now();
+  report.VerificationRan = true;
+  report.Expected = CriticalPointLocations(complex, field.Points);
+  const double tolerance = this->Spacing * (1 + 1e-9);
+  report.Verified = report.Cells.FailedCells == 0 && report.UnreconstructedPoints == 0;
+  const auto judge = [&](const SamplingTopologyCheck& check) {
+    if (!check.Ran)
+    {
+      report.Verified = false;
+      return;
+    }
+    const auto& c = check.Comparison;
+    report.Verified = report.Verified && c.Identical();
+    report.Spurious.insert(report.Spurious.end(), c.Spurious.begin(), c.Spurious.end());
+    report.Missing.insert(report.Missing.end(), c.Missing.begin(), c.Missing.end());
+  };
+  if (report.Sampled)
+  {
+    report.RawInput = CheckSampling(WithValues(field, report.Exact), report.Expected, tolerance, this->Parallel);
+  }
+  report.Input = CheckSampling(WithValues(field, report.Values), report.Expected, tolerance, this->Parallel);
+  judge(report.Input);
+  if (this->OutputResolution > 1)
+  {
+    PlanarScalarField fine;
+    fine.GridDimensions[0] = report.Finer.Dimensions[0];
+    fine.GridDimensions[1] = report.Finer.Dimensions[1];
+    fine.GridSpacing[0] = report.Finer.Spacing[0];
+    fine.GridSpacing[1] = report.Finer.Spacing[1];
+    fine.Values = report.FinerValues;
+    fine.Points.resize(2 * report.Finer.NumberOfPoints());
+    const int ni = report.Finer.Dimensions[0];
+    for (std::size_t p = 0; p < report.Finer.NumberOfPoints(); ++p)
+    {
+      fine.Points[2 * p] = report.Finer.Origin[0] + static_cast<int>(p % ni) * report.Finer.Spacing[0];
+      fine.Points[2 * p + 1] = report.Finer.Origin[1] + static_cast<int>(p / ni) * report.Finer.Spacing[1];
+    }
+    report.Resampled = CheckSampling(fine, report.Expected, tolerance, this->Parallel);
+    judge(report.Resampled);
+  }
+  report.VerificationSeconds = SecondsSince(start);
+}
+} // namespace topospline

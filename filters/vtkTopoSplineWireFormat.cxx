@@ -1,0 +1,701 @@
+#include "vtkTopoSplineWireFormat.h"
+
+#include "vtkTopoSplineArrayNames.h"
+#include "vtkTopoSplineDomainConversion.h"
+
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkCellType.h>
+#include <vtkCharArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkIdList.h>
+#include <vtkIdTypeArray.h>
+#include <vtkInformation.h>
+#include <vtkIntArray.h>
+#include <vtkMultiBlockDataSet.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkStringArray.h>
+#include <vtkUnstructuredGrid.h>
+
+#include <algorithm>
+#include <map>
+
+namespace names = vtkTopoSplineArrayNames;
+namespace conversion = vtkTopoSplineDomainConversion;
+using topospline::Index;
+
+namespace
+{
+vtkDataArray* RequireArray(vtkFieldData* data, const char* name, std::string& error)
+{
+  vtkDataArray* array = data ? data->GetArray(name) : nullptr;
+  if (!array && error.empty())
+  {
+    error = std::string("array \"") + name + "\" is missing";
+  }
+  return array;
+}
+
+// VTK orders the points of a VTK_BEZIER_CURVE as both ends first, then the interior ones:
+// VTK point m is control point CurvePointOfVtkPoint[m] of the cubic.
+constexpr int CurvePointOfVtkPoint[4] = { 0, 3, 1, 2 };
+} // namespace
+
+namespace vtkTopoSplineWireFormat
+{
+void WriteComplex(const topospline::MorseSmaleComplex& complex, vtkDataSet* domain, const char* scalarName,
+  vtkMultiBlockDataSet* output)
+{
+  const conversion::DomainPlane embedding = conversion::PlaneOf(domain);
+  const auto& cps = complex.CriticalPoints;
+
+  // Critical points.
+  vtkNew<vtkPolyData> critical;
+  {
+    const vtkIdType n = static_cast<vtkIdType>(cps.size());
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    points->SetNumberOfPoints(n);
+    vtkNew<vtkCellArray> verts;
+    auto id = conversion::NewArray<vtkIntArray>(names::CriticalPointId, 1, n);
+    auto index = conversion::NewArray<vtkIntArray>(names::CriticalIndex, 1, n);
+    auto value = conversion::NewArray<vtkDoubleArray>(names::CriticalValue, 1, n);
+    auto vertex = conversion::NewArray<vtkIdTypeArray>(names::VertexId, 1, n);
+    auto cell = conversion::NewArray<vtkIdTypeArray>(names::CriticalCellId, 1, n);
+    auto boundary = conversion::NewArray<vtkCharArray>(names::IsOnBoundary, 1, n);
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      points->SetPoint(i, domain->GetPoint(cps[i].Vertex));
+      verts->InsertNextCell(1, &i);
+      id->SetValue(i, cps[i].Id);
+      index->SetValue(i, cps[i].MorseIndex);
+      value->SetValue(i, cps[i].Value);
+      vertex->SetValue(i, cps[i].Vertex);
+      cell->SetValue(i, cps[i].Cell);
+      boundary->SetValue(i, cps[i].OnBoundary ? 1 : 0);
+    }
+    critical->SetPoints(points);
+    critical->SetVerts(verts);
+    conversion::AddArrays(critical->GetPointData(), { id, index, value, vertex, cell, boundary });
+    critical->GetPointData()->SetActiveScalars(names::CriticalIndex);
+  }
+
+  // 1-cells as polylines.
+  vtkNew<vtkPolyData> oneCells;
+  {
+    vtkIdType nPoints = 0;
+    for (const auto& arc : complex.OneCells)
+    {
+      nPoints += static_cast<vtkIdType>(arc.Values.size());
+    }
+    const vtkIdType n = static_cast<vtkIdType>(complex.OneCells.size());
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    points->SetNumberOfPoints(nPoints);
+    vtkNew<vtkCellArray> lines;
+    auto along = conversion::NewArray<vtkDoubleArray>(names::ScalarAlong, 1, nPoints);
+    auto meshCell = conversion::NewArray<vtkIdTypeArray>(names::MeshCellId, 1, nPoints);
+    auto id = conversion::NewArray<vtkIntArray>(names::SeparatrixId, 1, n);
+    auto source = conversion::NewArray<vtkIntArray>(names::SourceId, 1, n);
+    auto destination = conversion::NewArray<vtkIntArray>(names::DestinationId, 1, n);
+    auto type = conversion::NewArray<vtkIntArray>(names::SeparatrixType, 1, n);
+    vtkIdType next = 0;
+    std::vector<vtkIdType> ids;
+    for (vtkIdType a = 0; a < n; ++a)
+    {
+      const auto& arc = complex.OneCells[a];
+      const vtkIdType count = static_cast<vtkIdType>(arc.Values.size());
+      // Ascending arcs carry one more point at each end than mesh cells (saddle, maximum).
+      const vtkIdType offset = arc.Type == topospline::OneCell::Ascending ? 1 : 0;
+      ids.resize(count);
+      for (vtkIdType p = 0; p < count; ++p)
+      {
+        double xyz[3];
+        embedding.To3D(&arc.Points[2 * p], xyz);
+        points->SetPoint(next, xyz);
+        along->SetValue(next, arc.Values[p]);
+        const vtkIdType c = p - offset;
+        meshCell->SetValue(next, c >= 0 && c < static_cast<vtkIdType>(arc.MeshCells.size()) ? arc.MeshCells[c] : -1);
+        ids[p] = next++;
+      }
+      lines->InsertNextCell(count, ids.data());
+      id->SetValue(a, static_cast<int>(a));
+      source->SetValue(a, cps[arc.Source].Id);
+      destination->SetValue(a, cps[arc.Destination].Id);
+      type->SetValue(a, arc.Type);
+    }
+    oneCells->SetPoints(points);
+    oneCells->SetLines(lines);
+    oneCells->GetPointData()->AddArray(along);
+    oneCells->GetPointData()->AddArray(meshCell);
+    oneCells->GetPointData()->SetActiveScalars(names::ScalarAlong);
+    conversion::AddArrays(oneCells->GetCellData(), { id, source, destination, type });
+  }
+
+  // 2-cells: one point per cell at its centroid, carrying its corners and sides.
+  vtkNew<vtkPolyData> twoCells;
+  {
+    const vtkIdType n = static_cast<vtkIdType>(complex.TwoCells.size());
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    points->SetNumberOfPoints(n);
+    vtkNew<vtkCellArray> verts;
+    auto id = conversion::NewArray<vtkIntArray>(names::TwoCellId, 1, n);
+    auto minimum = conversion::NewArray<vtkIntArray>(names::MinimumId, 1, n);
+    auto maximum = conversion::NewArray<vtkIntArray>(names::MaximumId, 1, n);
+    auto saddles = conversion::NewArray<vtkIntArray>(names::SaddleIds, 2, n);
+    auto arcs = conversion::NewArray<vtkIntArray>(names::BoundarySeparatrices, 4, n);
+    auto pouch = conversion::NewArray<vtkCharArray>(names::IsPouch, 1, n);
+    auto size = conversion::NewArray<vtkIdTypeArray>(names::NumberOfVertices, 1, n);
+    auto stable = [&](Index cp) { return cp == topospline::InvalidIndex ? -1 : cps[cp].Id; };
+    for (vtkIdType c = 0; c < n; ++c)
+    {
+      const auto& cell = complex.TwoCells[c];
+      double xyz[3];
+      embedding.To3D(cell.Centroid, xyz);
+      points->SetPoint(c, xyz);
+      verts->InsertNextCell(1, &c);
+      id->SetValue(c, static_cast<int>(c));
+      minimum->SetValue(c, stable(cell.Minimum));
+      maximum->SetValue(c, stable(cell.Maximum));
+      saddles->SetTypedComponent(c, 0, stable(cell.Saddles[0]));
+      saddles->SetTypedComponent(c, 1, stable(cell.Saddles[1]));
+      for (int k = 0; k < 4; ++k)
+      {
+        arcs->SetTypedComponent(c, k, cell.BoundaryOneCells[k]);
+      }
+      pouch->SetValue(c, cell.Pouch ? 1 : 0);
+      size->SetValue(c, cell.NumberOfVertices);
+    }
+    twoCells->SetPoints(points);
+    twoCells->SetVerts(verts);
+    conversion::AddArrays(twoCells->GetPointData(), { id, minimum, maximum, saddles, arcs, pouch, size });
+  }
+
+  // The input geometry with the per-vertex segmentation.
+  vtkSmartPointer<vtkDataSet> segmentation = vtkSmartPointer<vtkDataSet>::Take(domain->NewInstance());
+  segmentation->ShallowCopy(domain);
+  {
+    const vtkIdType n = domain->GetNumberOfPoints();
+    auto ascending = conversion::NewArray<vtkIntArray>(names::AscendingManifoldId, 1, n);
+    auto descending = conversion::NewArray<vtkIntArray>(names::DescendingManifoldId, 1, n);
+    auto cell = conversion::NewArray<vtkIntArray>(names::TwoCellId, 1, n);
+    for (vtkIdType v = 0; v < n; ++v)
+    {
+      ascending->SetValue(v, cps[complex.AscendingManifold[v]].Id);
+      descending->SetValue(v, cps[complex.DescendingManifold[v]].Id);
+      cell->SetValue(v, complex.TwoCellId[v]);
+    }
+    segmentation->GetPointData()->AddArray(ascending);
+    segmentation->GetPointData()->AddArray(descending);
+    segmentation->GetPointData()->AddArray(cell);
+  }
+
+  output->SetNumberOfBlocks(names::NumberOfBlocks);
+  const std::pair<vtkDataObject*, const char*> blocks[] = { { critical, names::CriticalPointsBlock },
+    { oneCells, names::OneCellsBlock }, { twoCells, names::TwoCellsBlock },
+    { segmentation, names::SegmentationBlock } };
+  for (unsigned int b = 0; b < names::NumberOfBlocks; ++b)
+  {
+    output->SetBlock(b, blocks[b].first);
+    output->GetMetaData(b)->Set(vtkCompositeDataSet::NAME(), blocks[b].second);
+  }
+  vtkNew<vtkStringArray> scalarField;
+  scalarField->SetName(names::ScalarFieldName);
+  scalarField->InsertNextValue(scalarName ? scalarName : "");
+  output->GetFieldData()->AddArray(scalarField);
+  if (!complex.BoundaryJunctions.empty())
+  {
+    auto junctions = conversion::NewArray<vtkIntArray>(names::BoundaryJunctionVertexId);
+    for (Index v : complex.BoundaryJunctions)
+    {
+      junctions->InsertNextValue(v);
+    }
+    output->GetFieldData()->AddArray(junctions);
+  }
+}
+
+vtkDataSet* SegmentationOf(vtkMultiBlockDataSet* input)
+{
+  if (!input || input->GetNumberOfBlocks() < names::NumberOfBlocks)
+  {
+    return nullptr;
+  }
+  return vtkDataSet::SafeDownCast(input->GetBlock(names::SegmentationIndex));
+}
+
+bool ReadComplex(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& complex, std::string& error)
+{
+  complex = topospline::MorseSmaleComplex();
+  auto* critical = input ? vtkPolyData::SafeDownCast(input->GetBlock(names::CriticalPointsIndex)) : nullptr;
+  auto* oneCells = input ? vtkPolyData::SafeDownCast(input->GetBlock(names::OneCellsIndex)) : nullptr;
+  auto* twoCells = input ? vtkPolyData::SafeDownCast(input->GetBlock(names::TwoCellsIndex)) : nullptr;
+  vtkDataSet* segmentation = SegmentationOf(input);
+  if (!critical || !oneCells || !twoCells || !segmentation)
+  {
+    error = "the input is not a Morse-Smale complex (expected the output of the \"Morse-Smale Complex\" filter)";
+    return false;
+  }
+  const conversion::DomainPlane embedding = conversion::PlaneOf(segmentation);
+
+  auto* pd = critical->GetPointData();
+  vtkDataArray* id = RequireArray(pd, names::CriticalPointId, error);
+  vtkDataArray* index = RequireArray(pd, names::CriticalIndex, error);
+  vtkDataArray* value = RequireArray(pd, names::CriticalValue, error);
+  vtkDataArray* vertex = RequireArray(pd, names::VertexId, error);
+  vtkDataArray* cell = RequireArray(pd, names::CriticalCellId, error);
+  vtkDataArray* boundary = RequireArray(pd, names::IsOnBoundary, error);
+  auto* cd = oneCells->GetCellData();
+  vtkDataArray* source = RequireArray(cd, names::SourceId, error);
+  vtkDataArray* destination = RequireArray(cd, names::DestinationId, error);
+  vtkDataArray* type = RequireArray(cd, names::SeparatrixType, error);
+  vtkDataArray* along = RequireArray(oneCells->GetPointData(), names::ScalarAlong, error);
+  vtkDataArray* meshCell = RequireArray(oneCells->GetPointData(), names::MeshCellId, error);
+  auto* sd = segmentation->GetPointData();
+  vtkDataArray* ascending = RequireArray(sd, names::AscendingManifoldId, error);
+  vtkDataArray* descending = RequireArray(sd, names::DescendingManifoldId, error);
+  vtkDataArray* cellId = RequireArray(sd, names::TwoCellId, error);
+  auto* td = twoCells->GetPointData();
+  vtkDataArray* minimum = RequireArray(td, names::MinimumId, error);
+  vtkDataArray* maximum = RequireArray(td, names::MaximumId, error);
+  vtkDataArray* saddles = RequireArray(td, names::SaddleIds, error);
+  vtkDataArray* arcs = RequireArray(td, names::BoundarySeparatrices, error);
+  vtkDataArray* pouch = RequireArray(td, names::IsPouch, error);
+  vtkDataArray* size = RequireArray(td, names::NumberOfVertices, error);
+  if (!error.empty())
+  {
+    error = "the input is not a Morse-Smale complex: " + error;
+    return false;
+  }
+
+  // Stable id -> position in this complex.
+  std::vector<Index> position;
+  const vtkIdType nCP = critical->GetNumberOfPoints();
+  for (vtkIdType i = 0; i < nCP; ++i)
+  {
+    topospline::CriticalPoint cp;
+    cp.Id = static_cast<Index>(id->GetComponent(i, 0));
+    cp.MorseIndex = static_cast<int>(index->GetComponent(i, 0));
+    cp.Value = value->GetComponent(i, 0);
+    cp.Vertex = static_cast<Index>(vertex->GetComponent(i, 0));
+    cp.Cell = static_cast<Index>(cell->GetComponent(i, 0));
+    cp.OnBoundary = boundary->GetComponent(i, 0) != 0;
+    if (cp.Id < 0)
+    {
+      error = "the input is not a Morse-Smale complex: negative critical point id";
+      return false;
+    }
+    if (static_cast<size_t>(cp.Id) >= position.size())
+    {
+      position.resize(cp.Id + 1, topospline::InvalidIndex);
+    }
+    position[cp.Id] = static_cast<Index>(i);
+    complex.CriticalPoints.push_back(cp);
+  }
+  auto local = [&](double stableId) {
+    const auto s = static_cast<long long>(stableId);
+    return s >= 0 && s < static_cast<long long>(position.size()) ? position[s] : topospline::InvalidIndex;
+  };
+
+  vtkCellArray* lines = oneCells->GetLines();
+  vtkNew<vtkIdList> ids;
+  lines->InitTraversal();
+  for (vtkIdType a = 0; lines->GetNextCell(ids); ++a)
+  {
+    topospline::OneCell arc;
+    arc.Type = type->GetComponent(a, 0) == 0 ? topospline::OneCell::Descending : topospline::OneCell::Ascending;
+    arc.Source = local(source->GetComponent(a, 0));
+    arc.Destination = local(destination->GetComponent(a, 0));
+    for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k)
+    {
+      double xyz[3];
+      oneCells->GetPoint(ids->GetId(k), xyz);
+      arc.Points.push_back(xyz[embedding.U]);
+      arc.Points.push_back(xyz[embedding.V]);
+      arc.Values.push_back(along->GetComponent(ids->GetId(k), 0));
+      const auto c = static_cast<Index>(meshCell->GetComponent(ids->GetId(k), 0));
+      if (c >= 0)
+      {
+        arc.MeshCells.push_back(c);
+      }
+    }
+    if (arc.Source == topospline::InvalidIndex || arc.Destination == topospline::InvalidIndex)
+    {
+      error = "the input is not a Morse-Smale complex: a 1-cell refers to a missing critical point";
+      return false;
+    }
+    complex.OneCells.push_back(std::move(arc));
+  }
+
+  const vtkIdType nCells = twoCells->GetNumberOfPoints();
+  for (vtkIdType c = 0; c < nCells; ++c)
+  {
+    topospline::TwoCell twoCell;
+    twoCell.Minimum = local(minimum->GetComponent(c, 0));
+    twoCell.Maximum = local(maximum->GetComponent(c, 0));
+    twoCell.Saddles = { local(saddles->GetComponent(c, 0)), local(saddles->GetComponent(c, 1)) };
+    for (int k = 0; k < 4; ++k)
+    {
+      twoCell.BoundaryOneCells[k] = static_cast<Index>(arcs->GetComponent(c, k));
+    }
+    twoCell.Pouch = pouch->GetComponent(c, 0) != 0;
+    twoCell.NumberOfVertices = static_cast<Index>(size->GetComponent(c, 0));
+    double xyz[3];
+    twoCells->GetPoint(c, xyz);
+    twoCell.Centroid[0] = xyz[embedding.U];
+    twoCell.Centroid[1] = xyz[embedding.V];
+    twoCell.Sectors = twoCell.Saddles[1] == topospline::InvalidIndex ? 1 : 2;
+    complex.TwoCells.push_back(twoCell);
+  }
+
+  const vtkIdType nV = segmentation->GetNumberOfPoints();
+  complex.AscendingManifold.resize(nV);
+  complex.DescendingManifold.resize(nV);
+  complex.TwoCellId.resize(nV);
+  for (vtkIdType v = 0; v < nV; ++v)
+  {
+    complex.AscendingManifold[v] = local(ascending->GetComponent(v, 0));
+    complex.DescendingManifold[v] = local(descending->GetComponent(v, 0));
+    complex.TwoCellId[v] = static_cast<Index>(cellId->GetComponent(v, 0));
+  }
+  if (vtkDataArray* junctions = input->GetFieldData()->GetArray(names::BoundaryJunctionVertexId))
+  {
+    for (vtkIdType j = 0; j < junctions->GetNumberOfTuples(); ++j)
+    {
+      const auto v = static_cast<Index>(junctions->GetComponent(j, 0));
+      if (v < 0 || v >= nV)
+      {
+        error = "the input is not a Morse-Smale complex: a boundary junction names no vertex";
+        return false;
+      }
+      complex.BoundaryJunctions.push_back(v);
+    }
+  }
+  return true;
+}
+
+std::string ScalarFieldNameOf(vtkMultiBlockDataSet* input)
+{
+  auto* name = input ? vtkStringArray::SafeDownCast(input->GetFieldData()->GetAbstractArray(names::ScalarFieldName))
+                     : nullptr;
+  return name && name->GetNumberOfValues() > 0 ? name->GetValue(0) : std::string();
+}
+
+void PassBlocks(vtkMultiBlockDataSet* input, unsigned int count, vtkMultiBlockDataSet* output)
+{
+  for (unsigned int b = 0; b < input->GetNumberOfBlocks() && b < count; ++b)
+  {
+    output->SetBlock(b, input->GetBlock(b));
+    output->GetMetaData(b)->Set(vtkCompositeDataSet::NAME(), input->GetMetaData(b)->Get(vtkCompositeDataSet::NAME()));
+  }
+  output->GetFieldData()->PassData(input->GetFieldData());
+}
+
+void WriteJunctionPoints(const topospline::MorseSmaleComplex& complex,
+  const std::vector<topospline::JunctionPoint>& junctions, vtkMultiBlockDataSet* output)
+{
+  const auto& cps = complex.CriticalPoints;
+  const auto plane = conversion::PlaneOf(SegmentationOf(output));
+  vtkNew<vtkPolyData> block;
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  vtkNew<vtkCellArray> verts;
+  auto type = conversion::NewArray<vtkIntArray>(names::SeparatrixType);
+  auto extremum = conversion::NewArray<vtkIntArray>(names::ExtremumId);
+  auto cell = conversion::NewArray<vtkIntArray>(names::MeshCellId);
+  auto value = conversion::NewArray<vtkDoubleArray>(names::JunctionValue);
+  auto critical = conversion::NewArray<vtkIntArray>(names::CriticalPointId);
+  auto count = conversion::NewArray<vtkIntArray>(names::NumberOfSeparatrices);
+  for (const auto& junction : junctions)
+  {
+    double xyz[3];
+    plane.To3D(junction.Position, xyz);
+    const vtkIdType id = points->InsertNextPoint(xyz);
+    verts->InsertNextCell(1, &id);
+    type->InsertNextValue(junction.Type);
+    extremum->InsertNextValue(cps[junction.Extremum].Id);
+    cell->InsertNextValue(junction.Cell);
+    value->InsertNextValue(junction.Value);
+    critical->InsertNextValue(junction.CriticalPoint == topospline::InvalidIndex ? -1 : cps[junction.CriticalPoint].Id);
+    count->InsertNextValue(static_cast<int>(junction.OneCells.size()));
+  }
+  block->SetPoints(points);
+  block->SetVerts(verts);
+  conversion::AddArrays(block->GetPointData(), { type, extremum, cell, value, critical, count });
+  output->SetNumberOfBlocks(std::max<unsigned int>(output->GetNumberOfBlocks(), names::JunctionPointsIndex + 1));
+  output->SetBlock(names::JunctionPointsIndex, block);
+  output->GetMetaData(static_cast<unsigned int>(names::JunctionPointsIndex))
+    ->Set(vtkCompositeDataSet::NAME(), names::JunctionPointsBlock);
+}
+
+bool ReadJunctionPoints(vtkMultiBlockDataSet* input, const topospline::MorseSmaleComplex& complex,
+  std::vector<topospline::JunctionPoint>& junctions)
+{
+  auto* block = input->GetNumberOfBlocks() > names::JunctionPointsIndex
+    ? vtkPolyData::SafeDownCast(input->GetBlock(names::JunctionPointsIndex))
+    : nullptr;
+  if (!block)
+  {
+    return false;
+  }
+  auto* pd = block->GetPointData();
+  vtkDataArray* type = pd->GetArray(names::SeparatrixType);
+  vtkDataArray* extremum = pd->GetArray(names::ExtremumId);
+  vtkDataArray* cell = pd->GetArray(names::MeshCellId);
+  vtkDataArray* value = pd->GetArray(names::JunctionValue);
+  vtkDataArray* critical = pd->GetArray(names::CriticalPointId);
+  if (!type || !extremum || !cell || !value || !critical)
+  {
+    return false;
+  }
+  std::map<Index, Index> position; // stable id -> position
+  for (Index i = 0; i < static_cast<Index>(complex.CriticalPoints.size()); ++i)
+  {
+    position[complex.CriticalPoints[i].Id] = i;
+  }
+  std::map<Index, std::vector<Index>> oneCellsOfExtremum;
+  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
+  {
+    const auto& oneCell = complex.OneCells[a];
+    oneCellsOfExtremum[oneCell.Type == topospline::OneCell::Descending ? oneCell.Source : oneCell.Destination]
+      .push_back(a);
+  }
+  const auto plane = conversion::PlaneOf(SegmentationOf(input));
+  for (vtkIdType j = 0; j < block->GetNumberOfPoints(); ++j)
+  {
+    topospline::JunctionPoint junction;
+    junction.Type = type->GetComponent(j, 0) == 0 ? topospline::OneCell::Descending : topospline::OneCell::Ascending;
+    const auto ext = position.find(static_cast<Index>(extremum->GetComponent(j, 0)));
+    const auto cp = position.find(static_cast<Index>(critical->GetComponent(j, 0)));
+    if (ext == position.end())
+    {
+      return false;
+    }
+    junction.Extremum = ext->second;
+    junction.CriticalPoint = cp == position.end() ? topospline::InvalidIndex : cp->second;
+    junction.Cell = static_cast<Index>(cell->GetComponent(j, 0));
+    junction.Value = value->GetComponent(j, 0);
+    double xyz[3];
+    block->GetPoint(j, xyz);
+    plane.ToPlanar(xyz, junction.Position);
+    for (Index a : oneCellsOfExtremum[junction.Extremum])
+    {
+      const auto& oneCell = complex.OneCells[a];
+      if (oneCell.Type == junction.Type &&
+        std::find(oneCell.MeshCells.begin(), oneCell.MeshCells.end(), junction.Cell) != oneCell.MeshCells.end())
+      {
+        junction.OneCells.push_back(a);
+      }
+    }
+    junctions.push_back(std::move(junction));
+  }
+  return true;
+}
+
+namespace
+{
+vtkSmartPointer<vtkUnstructuredGrid> SmoothedOneCellsBlock(
+  const topospline::OneCellSmoothingResult& smoothed, const conversion::DomainPlane& plane)
+{
+  auto bezier = vtkSmartPointer<vtkUnstructuredGrid>::New();
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  auto height = conversion::NewArray<vtkDoubleArray>(names::Height);
+  auto piece = conversion::NewArray<vtkIntArray>(names::PieceId);
+  auto segments = conversion::NewArray<vtkIntArray>(names::PieceSegments);
+  auto type = conversion::NewArray<vtkIntArray>(names::SeparatrixType);
+  vtkNew<vtkCellArray> cells;
+  for (Index p = 0; p < static_cast<Index>(smoothed.Pieces.size()); ++p)
+  {
+    const auto& smoothedPiece = smoothed.Pieces[p];
+    for (int s = 0; s < smoothedPiece.Curve.Segments; ++s)
+    {
+      const double* curve = smoothedPiece.Curve.Segment(s);
+      const double* h = smoothedPiece.Height.Segment(s);
+      vtkIdType ids[4];
+      for (int m = 0; m < 4; ++m)
+      {
+        double xyz[3];
+        plane.To3D(curve + 2 * CurvePointOfVtkPoint[m], xyz);
+        ids[m] = points->InsertNextPoint(xyz);
+        height->InsertNextValue(h[CurvePointOfVtkPoint[m]]);
+      }
+      cells->InsertNextCell(4, ids);
+      piece->InsertNextValue(p);
+      segments->InsertNextValue(smoothedPiece.Segments);
+      type->InsertNextValue(smoothedPiece.Type);
+    }
+  }
+  bezier->SetPoints(points);
+  bezier->SetCells(VTK_BEZIER_CURVE, cells);
+  bezier->GetPointData()->AddArray(height);
+  bezier->GetPointData()->SetActiveScalars(names::Height);
+  conversion::AddArrays(bezier->GetCellData(), { piece, segments, type });
+  // Which pieces make up every 1-cell, in order from its source: stage 4 assembles the sides of
+  // the 2-cells from them. 1-cell a is SeparatrixPieces[offsets[a] .. offsets[a+1]).
+  auto offsets = conversion::NewArray<vtkIntArray>(names::SeparatrixPieceOffsets);
+  auto list = conversion::NewArray<vtkIntArray>(names::SeparatrixPieces);
+  offsets->InsertNextValue(0);
+  for (const auto& pieces : smoothed.PiecesOfOneCell)
+  {
+    for (Index p : pieces)
+    {
+      list->InsertNextValue(p);
+    }
+    offsets->InsertNextValue(static_cast<int>(list->GetNumberOfTuples()));
+  }
+  conversion::AddArrays(bezier->GetFieldData(), { offsets, list });
+  return bezier;
+}
+
+vtkSmartPointer<vtkPolyData> SampledOneCellsBlock(const topospline::MorseSmaleComplex& complex,
+  const topospline::OneCellSmoothingResult& smoothed, int samplesPerSegment, const conversion::DomainPlane& plane)
+{
+  auto sampled = vtkSmartPointer<vtkPolyData>::New();
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  vtkNew<vtkCellArray> lines;
+  auto height = conversion::NewArray<vtkDoubleArray>(names::Height);
+  auto id = conversion::NewArray<vtkIntArray>(names::SeparatrixId);
+  auto source = conversion::NewArray<vtkIntArray>(names::SourceId);
+  auto destination = conversion::NewArray<vtkIntArray>(names::DestinationId);
+  auto type = conversion::NewArray<vtkIntArray>(names::SeparatrixType);
+  std::vector<vtkIdType> ids;
+  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
+  {
+    ids.clear();
+    for (Index p : smoothed.PiecesOfOneCell[a])
+    {
+      const auto& piece = smoothed.Pieces[p];
+      const int count = piece.Curve.Segments * samplesPerSegment;
+      for (int s = ids.empty() ? 0 : 1; s <= count; ++s)
+      {
+        const double t = static_cast<double>(s) / count;
+        double uv[2], xyz[3];
+        piece.Curve.Evaluate(t, uv);
+        plane.To3D(uv, xyz);
+        ids.push_back(points->InsertNextPoint(xyz));
+        height->InsertNextValue(piece.Height.Value(t));
+      }
+    }
+    const auto& oneCell = complex.OneCells[a];
+    if (ids.empty())
+    {
+      // A 1-cell of one point (a saddle on its minimum's vertex, zero persistence).
+      double xyz[3];
+      plane.To3D(oneCell.Points.data(), xyz);
+      ids.push_back(points->InsertNextPoint(xyz));
+      height->InsertNextValue(oneCell.Values.front());
+    }
+    lines->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
+    id->InsertNextValue(a);
+    source->InsertNextValue(complex.CriticalPoints[oneCell.Source].Id);
+    destination->InsertNextValue(complex.CriticalPoints[oneCell.Destination].Id);
+    type->InsertNextValue(oneCell.Type);
+  }
+  sampled->SetPoints(points);
+  sampled->SetLines(lines);
+  sampled->GetPointData()->AddArray(height);
+  sampled->GetPointData()->SetActiveScalars(names::Height);
+  conversion::AddArrays(sampled->GetCellData(), { id, source, destination, type });
+  return sampled;
+}
+} // namespace
+
+void WriteSmoothedOneCells(const topospline::MorseSmaleComplex& complex,
+  const topospline::OneCellSmoothingResult& smoothed, int samplesPerSegment, vtkMultiBlockDataSet* output)
+{
+  const auto plane = conversion::PlaneOf(SegmentationOf(output));
+  output->SetNumberOfBlocks(std::max<unsigned int>(output->GetNumberOfBlocks(), names::SampledOneCellsIndex + 1));
+  output->SetBlock(names::SmoothedOneCellsIndex, SmoothedOneCellsBlock(smoothed, plane));
+  output->GetMetaData(static_cast<unsigned int>(names::SmoothedOneCellsIndex))
+    ->Set(vtkCompositeDataSet::NAME(), names::SmoothedOneCellsBlock);
+  output->SetBlock(names::SampledOneCellsIndex, SampledOneCellsBlock(complex, smoothed, samplesPerSegment, plane));
+  output->GetMetaData(static_cast<unsigned int>(names::SampledOneCellsIndex))
+    ->Set(vtkCompositeDataSet::NAME(), names::SampledOneCellsBlock);
+}
+
+bool ReadSmoothedOneCells(vtkMultiBlockDataSet* input, const topospline::MorseSmaleComplex& complex,
+  topospline::OneCellSmoothingResult& smoothed, std::string& error)
+{
+  auto* block = input->GetNumberOfBlocks() > names::SmoothedOneCellsIndex
+    ? vtkUnstructuredGrid::SafeDownCast(input->GetBlock(names::SmoothedOneCellsIndex))
+    : nullptr;
+  vtkDataArray* piece = block ? block->GetCellData()->GetArray(names::PieceId) : nullptr;
+  vtkDataArray* height = block ? block->GetPointData()->GetArray(names::Height) : nullptr;
+  vtkDataArray* offsets = block ? block->GetFieldData()->GetArray(names::SeparatrixPieceOffsets) : nullptr;
+  vtkDataArray* list = block ? block->GetFieldData()->GetArray(names::SeparatrixPieces) : nullptr;
+  if (!piece || !height || !offsets || !list)
+  {
+    error = "the input has no smoothed 1-cells (expected the output of \"Smooth 1-Cells\")";
+    return false;
+  }
+  const vtkIdType oneCells = offsets->GetNumberOfTuples() - 1;
+  if (oneCells != static_cast<vtkIdType>(complex.OneCells.size()))
+  {
+    error = "the smoothed 1-cells do not match the complex";
+    return false;
+  }
+  Index pieces = 0;
+  for (vtkIdType c = 0; c < block->GetNumberOfCells(); ++c)
+  {
+    pieces = std::max(pieces, static_cast<Index>(piece->GetComponent(c, 0)) + 1);
+  }
+  smoothed = topospline::OneCellSmoothingResult();
+  smoothed.Pieces.resize(pieces);
+  for (auto& p : smoothed.Pieces)
+  {
+    p.Curve.Dimension = 2;
+    p.Height.Dimension = 1;
+  }
+  const auto plane = conversion::PlaneOf(SegmentationOf(input));
+  vtkNew<vtkIdList> ids;
+  for (vtkIdType c = 0; c < block->GetNumberOfCells(); ++c)
+  {
+    block->GetCellPoints(c, ids);
+    const Index p = static_cast<Index>(piece->GetComponent(c, 0));
+    if (block->GetCellType(c) != VTK_BEZIER_CURVE || ids->GetNumberOfIds() != 4 || p < 0)
+    {
+      error = "the smoothed 1-cells are not cubic Bezier curves";
+      return false;
+    }
+    double uv[4][2], h[4];
+    for (int m = 0; m < 4; ++m)
+    {
+      double xyz[3];
+      block->GetPoint(ids->GetId(m), xyz);
+      plane.ToPlanar(xyz, uv[CurvePointOfVtkPoint[m]]);
+      h[CurvePointOfVtkPoint[m]] = height->GetComponent(ids->GetId(m), 0);
+    }
+    auto& smoothedPiece = smoothed.Pieces[p];
+    for (int k = 0; k < 4; ++k)
+    {
+      smoothedPiece.Curve.ControlPoints.insert(smoothedPiece.Curve.ControlPoints.end(), uv[k], uv[k] + 2);
+      smoothedPiece.Height.ControlPoints.push_back(h[k]);
+    }
+    ++smoothedPiece.Curve.Segments;
+    ++smoothedPiece.Height.Segments;
+  }
+  smoothed.PiecesOfOneCell.resize(oneCells);
+  for (vtkIdType a = 0; a < oneCells; ++a)
+  {
+    const vtkIdType begin = static_cast<vtkIdType>(offsets->GetComponent(a, 0));
+    const vtkIdType end = static_cast<vtkIdType>(offsets->GetComponent(a + 1, 0));
+    for (vtkIdType i = begin; i < end && i < list->GetNumberOfTuples(); ++i)
+    {
+      const Index p = static_cast<Index>(list->GetComponent(i, 0));
+      if (p < 0 || p >= pieces)
+      {
+        error = "the smoothed 1-cells list unknown pieces";
+        return false;
+      }
+      smoothed.PiecesOfOneCell[a].push_back(p);
+    }
+  }
+  return true;
+}
+} // namespace vtkTopoSplineWireFormat
