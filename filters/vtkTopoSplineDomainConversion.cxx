@@ -100,6 +100,134 @@ struct CopyToDouble
   }
 };
 
+// The points of a 2D image, placed by its origin, spacing and extent, as a grid field.
+bool ImageToField(vtkImageData* image, topospline::PlanarScalarField& field, std::string& error)
+{
+  int dims[3];
+  image->GetDimensions(dims);
+  int axes[2], nAxes = 0;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (dims[a] > 1)
+    {
+      if (nAxes == 2)
+      {
+        error = "the image is 3D (" + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
+          std::to_string(dims[2]) + "); TopoSpline works on 2D images (one layer): extract a slice first";
+        return false;
+      }
+      axes[nAxes++] = a;
+    }
+  }
+  if (nAxes < 2)
+  {
+    error = "the image has fewer than two dimensions with more than one point";
+    return false;
+  }
+  const int n0 = dims[axes[0]], n1 = dims[axes[1]];
+  double origin[3], spacing[3];
+  int extent[6];
+  image->GetOrigin(origin);
+  image->GetSpacing(spacing);
+  image->GetExtent(extent);
+  if (!image->GetDirectionMatrix()->IsIdentity())
+  {
+    // A rotated image is not in the coordinate plane the outputs are written in.
+    error = "the image's direction matrix is not the identity; TopoSpline needs an axis-aligned image "
+            "(resample it, e.g. with Resample To Image, or clear its direction)";
+    return false;
+  }
+  for (const int a : axes)
+  {
+    if (!std::isfinite(origin[a]) || !std::isfinite(spacing[a]) || !(spacing[a] > 0))
+    {
+      error = "the image's spacing (" + std::to_string(spacing[a]) + ") or origin (" + std::to_string(origin[a]) +
+        ") along axis " + std::to_string(a) + " is not a finite positive spacing and finite origin";
+      return false;
+    }
+    // Coordinates are subtracted all along the pipeline: with an origin 1e12 spacings away,
+    // differences of neighbouring points keep fewer than 4 significant digits.
+    const double farthest = std::max(std::abs(origin[a] + extent[2 * a] * spacing[a]),
+      std::abs(origin[a] + extent[2 * a + 1] * spacing[a]));
+    if (farthest > 1e12 * spacing[a])
+    {
+      error = "the image's coordinates along axis " + std::to_string(a) + " reach " + std::to_string(farthest) +
+        ", more than 1e12 spacings (" + std::to_string(spacing[a]) +
+        ") from 0: neighbouring points cannot be told apart precisely; shift the origin";
+      return false;
+    }
+  }
+  const double ratio = spacing[axes[0]] / spacing[axes[1]];
+  if (ratio > 1e4 || ratio < 1e-4)
+  {
+    error = "the image's spacings differ by a factor above 1e4 (" + std::to_string(spacing[axes[0]]) + " and " +
+      std::to_string(spacing[axes[1]]) + "); the reconstruction's geometry cannot be resolved; rescale one axis";
+    return false;
+  }
+  vtkSMPTools::For(0, n1, [&](vtkIdType begin, vtkIdType end) {
+    for (vtkIdType b = begin; b < end; ++b)
+    {
+      for (vtkIdType a = 0; a < n0; ++a)
+      {
+        const vtkIdType id = b * n0 + a;
+        // the extent need not start at 0
+        field.Points[2 * id] = origin[axes[0]] + (extent[2 * axes[0]] + a) * spacing[axes[0]];
+        field.Points[2 * id + 1] = origin[axes[1]] + (extent[2 * axes[1]] + b) * spacing[axes[1]];
+      }
+    }
+  });
+  // The quads are split along their (i+1,j)-(i,j+1) diagonal: GridTriangles(n0, n1).
+  field.GridDimensions[0] = n0;
+  field.GridDimensions[1] = n1;
+  field.GridSpacing[0] = spacing[axes[0]];
+  field.GridSpacing[1] = spacing[axes[1]];
+  return true;
+}
+
+// The points and triangles of a planar triangle mesh.
+bool MeshToField(vtkDataSet* input, topospline::PlanarScalarField& field, std::string& error)
+{
+  const vtkIdType nPoints = input->GetNumberOfPoints();
+  vtkTopoSplineDomainConversion::DomainPlane embedding;
+  if (!DetectEmbedding(input, embedding))
+  {
+    error = "the points do not lie in a coordinate plane (x, y or z constant); TopoSpline needs a planar "
+            "triangulation (use the mesh before any Warp By Scalar)";
+    return false;
+  }
+  for (vtkIdType id = 0; id < nPoints; ++id)
+  {
+    double p[3];
+    input->GetPoint(id, p);
+    field.Points[2 * id] = p[embedding.U];
+    field.Points[2 * id + 1] = p[embedding.V];
+  }
+  const vtkIdType nCells = input->GetNumberOfCells();
+  if (nCells == 0)
+  {
+    error = "the input has no cells; TopoSpline needs a triangulation";
+    return false;
+  }
+  field.Triangles.resize(3 * nCells);
+  vtkNew<vtkIdList> ids;
+  for (vtkIdType c = 0; c < nCells; ++c)
+  {
+    const int type = input->GetCellType(c);
+    if (type != VTK_TRIANGLE)
+    {
+      error = "cell " + std::to_string(c) + " is not a triangle (VTK cell type " + std::to_string(type) +
+        "); apply the Triangulate filter first";
+      return false;
+    }
+    input->GetCellPoints(c, ids);
+    for (int k = 0; k < 3; ++k)
+    {
+      field.Triangles[3 * c + k] = static_cast<Index>(ids->GetId(k));
+    }
+  }
+  return true;
+}
+
 } // namespace
 
 namespace vtkTopoSplineDomainConversion
@@ -182,125 +310,9 @@ bool ToPlanarScalarField(vtkDataSet* input, vtkDataArray* scalars, topospline::P
   field.Points.resize(2 * nPoints);
   if (auto* image = vtkImageData::SafeDownCast(input))
   {
-    int dims[3];
-    image->GetDimensions(dims);
-    int axes[2], nAxes = 0;
-    for (int a = 0; a < 3; ++a)
-    {
-      if (dims[a] > 1)
-      {
-        if (nAxes == 2)
-        {
-          error = "the image is 3D (" + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
-            std::to_string(dims[2]) + "); TopoSpline works on 2D images (one layer): extract a slice first";
-          return false;
-        }
-        axes[nAxes++] = a;
-      }
-    }
-    if (nAxes < 2)
-    {
-      error = "the image has fewer than two dimensions with more than one point";
-      return false;
-    }
-    const int n0 = dims[axes[0]], n1 = dims[axes[1]];
-    double origin[3], spacing[3];
-    int extent[6];
-    image->GetOrigin(origin);
-    image->GetSpacing(spacing);
-    image->GetExtent(extent);
-    if (!image->GetDirectionMatrix()->IsIdentity())
-    {
-      // A rotated image is not in the coordinate plane the outputs are written in.
-      error = "the image's direction matrix is not the identity; TopoSpline needs an axis-aligned image "
-              "(resample it, e.g. with Resample To Image, or clear its direction)";
-      return false;
-    }
-    for (const int a : axes)
-    {
-      if (!std::isfinite(origin[a]) || !std::isfinite(spacing[a]) || !(spacing[a] > 0))
-      {
-        error = "the image's spacing (" + std::to_string(spacing[a]) + ") or origin (" + std::to_string(origin[a]) +
-          ") along axis " + std::to_string(a) + " is not a finite positive spacing and finite origin";
-        return false;
-      }
-      // Coordinates are subtracted all along the pipeline: with an origin 1e12 spacings away,
-      // differences of neighbouring points keep fewer than 4 significant digits.
-      const double farthest = std::max(std::abs(origin[a] + extent[2 * a] * spacing[a]),
-        std::abs(origin[a] + extent[2 * a + 1] * spacing[a]));
-      if (farthest > 1e12 * spacing[a])
-      {
-        error = "the image's coordinates along axis " + std::to_string(a) + " reach " + std::to_string(farthest) +
-          ", more than 1e12 spacings (" + std::to_string(spacing[a]) +
-          ") from 0: neighbouring points cannot be told apart precisely; shift the origin";
-        return false;
-      }
-    }
-    const double ratio = spacing[axes[0]] / spacing[axes[1]];
-    if (ratio > 1e4 || ratio < 1e-4)
-    {
-      error = "the image's spacings differ by a factor above 1e4 (" + std::to_string(spacing[axes[0]]) + " and " +
-        std::to_string(spacing[axes[1]]) + "); the reconstruction's geometry cannot be resolved; rescale one axis";
-      return false;
-    }
-    vtkSMPTools::For(0, n1, [&](vtkIdType begin, vtkIdType end) {
-      for (vtkIdType b = begin; b < end; ++b)
-      {
-        for (vtkIdType a = 0; a < n0; ++a)
-        {
-          const vtkIdType id = b * n0 + a;
-          // the extent need not start at 0
-          field.Points[2 * id] = origin[axes[0]] + (extent[2 * axes[0]] + a) * spacing[axes[0]];
-          field.Points[2 * id + 1] = origin[axes[1]] + (extent[2 * axes[1]] + b) * spacing[axes[1]];
-        }
-      }
-    });
-    // The quads are split along their (i+1,j)-(i,j+1) diagonal: GridTriangles(n0, n1).
-    field.GridDimensions[0] = n0;
-    field.GridDimensions[1] = n1;
-    field.GridSpacing[0] = spacing[axes[0]];
-    field.GridSpacing[1] = spacing[axes[1]];
-    return true;
+    return ImageToField(image, field, error);
   }
-
-  vtkTopoSplineDomainConversion::DomainPlane embedding;
-  if (!DetectEmbedding(input, embedding))
-  {
-    error = "the points do not lie in a coordinate plane (x, y or z constant); TopoSpline needs a planar "
-            "triangulation (use the mesh before any Warp By Scalar)";
-    return false;
-  }
-  for (vtkIdType id = 0; id < nPoints; ++id)
-  {
-    double p[3];
-    input->GetPoint(id, p);
-    field.Points[2 * id] = p[embedding.U];
-    field.Points[2 * id + 1] = p[embedding.V];
-  }
-  const vtkIdType nCells = input->GetNumberOfCells();
-  if (nCells == 0)
-  {
-    error = "the input has no cells; TopoSpline needs a triangulation";
-    return false;
-  }
-  field.Triangles.resize(3 * nCells);
-  vtkNew<vtkIdList> ids;
-  for (vtkIdType c = 0; c < nCells; ++c)
-  {
-    const int type = input->GetCellType(c);
-    if (type != VTK_TRIANGLE)
-    {
-      error = "cell " + std::to_string(c) + " is not a triangle (VTK cell type " + std::to_string(type) +
-        "); apply the Triangulate filter first";
-      return false;
-    }
-    input->GetCellPoints(c, ids);
-    for (int k = 0; k < 3; ++k)
-    {
-      field.Triangles[3 * c + k] = static_cast<Index>(ids->GetId(k));
-    }
-  }
-  return true;
+  return MeshToField(input, field, error);
 }
 
 void PlanarBounds(vtkDataSet* domain, double bounds[4])

@@ -368,22 +368,9 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
     vtkErrorMacro("Reconstruct 2-Cells: " << error << ".");
     return 1;
   }
+  if (!this->FitsInMemory(domain->GetNumberOfPoints(), complex.TwoCells.size()))
   {
-    // Refused before anything is allocated, with the estimate.
-    const double f = this->OutputResolution;
-    const double finer = f > 1 ? static_cast<double>(domain->GetNumberOfPoints()) * f * f : 0.0;
-    const double cells = static_cast<double>(complex.TwoCells.size());
-    const double needed = topospline::FieldReconstruction::MemoryEstimate(cells, finer);
-    vtksys::SystemInformation system;
-    const double available = 1024.0 * static_cast<double>(system.GetAvailablePhysicalMemory()) * 1024.0;
-    if (available > 0 && needed > 0.8 * available)
-    {
-      vtkErrorMacro("Reconstruct 2-Cells: " << cells << " 2-cells" << (f > 1 ? " and the finer sampling" : "")
-                    << " need about " << needed / 1e9 << " GB; this machine has " << available / 1e9
-                    << " GB available. Simplify further (a higher Persistence Threshold)"
-                    << (f > 1 ? " or choose a lower Output Resolution" : "") << ".");
-      return 1;
-    }
+    return 1;
   }
 
   topospline::FieldReconstruction reconstruction;
@@ -406,6 +393,48 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
       return 1;
     }
   }
+  this->WarnAbout(report);
+
+  const auto plane = conversion::PlaneOf(domain);
+  vtkDataSet* output = EnsureGeometryOutput(outputVector->GetInformationObject(0), domain);
+  output->ShallowCopy(domain);
+  WriteVertexValues(report, output);
+  WritePatches(report, plane, patchesOutput);
+  resampledOutput->Initialize();
+  if (this->OutputResolution > 1)
+  {
+    WriteResampled(report, domain, plane, resampledOutput);
+  }
+  output->GetFieldData()->PassData(input->GetFieldData());
+  WriteReport(report, output->GetFieldData());
+  return 1;
+}
+
+// Refused before anything is allocated, with the estimate.
+bool vtkTopoSplineReconstructTwoCells::FitsInMemory(vtkIdType points, std::size_t twoCells)
+{
+  const double f = this->OutputResolution;
+  const double finer = f > 1 ? static_cast<double>(points) * f * f : 0.0;
+  const double cells = static_cast<double>(twoCells);
+  const double needed = topospline::FieldReconstruction::MemoryEstimate(cells, finer);
+  vtksys::SystemInformation system;
+  const double available = 1024.0 * static_cast<double>(system.GetAvailablePhysicalMemory()) * 1024.0;
+  if (available > 0 && needed > 0.8 * available)
+  {
+    vtkErrorMacro("Reconstruct 2-Cells: " << cells << " 2-cells" << (f > 1 ? " and the finer sampling" : "")
+                  << " need about " << needed / 1e9 << " GB; this machine has " << available / 1e9
+                  << " GB available. Simplify further (a higher Persistence Threshold)"
+                  << (f > 1 ? " or choose a lower Output Resolution" : "") << ".");
+    return false;
+  }
+  return true;
+}
+
+// What did not go as it should, as warnings: failed cells, patches that break the
+// monotonicity conditions, vertices left with their input value, samplings whose critical
+// points differ from the complex's.
+void vtkTopoSplineReconstructTwoCells::WarnAbout(const topospline::FieldReconstructionReport& report)
+{
   for (const auto& [cell, why] : report.FailedCells)
   {
     vtkWarningMacro("Reconstruct 2-Cells: 2-cell " << cell << " was not reconstructed: " << why << ".");
@@ -437,20 +466,6 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
                       << c.Expected[1] << "/" << c.Expected[2] << ").");
     }
   }
-
-  const auto plane = conversion::PlaneOf(domain);
-  vtkDataSet* output = EnsureGeometryOutput(outputVector->GetInformationObject(0), domain);
-  output->ShallowCopy(domain);
-  WriteVertexValues(report, output);
-  WritePatches(report, plane, patchesOutput);
-  resampledOutput->Initialize();
-  if (this->OutputResolution > 1)
-  {
-    WriteResampled(report, domain, plane, resampledOutput);
-  }
-  output->GetFieldData()->PassData(input->GetFieldData());
-  WriteReport(report, output->GetFieldData());
-  return 1;
 }
 
 void vtkTopoSplineReconstructTwoCells::PrintSelf(ostream& os, vtkIndent indent)

@@ -30,6 +30,10 @@
 #include <vtkDataObjectAlgorithm.h>
 
 class vtkDataSet;
+namespace topospline
+{
+struct FieldReconstructionReport;
+}
 
 class TOPOSPLINEFILTERS_EXPORT vtkTopoSplineReconstructTwoCells : public vtkDataObjectAlgorithm
 {
@@ -93,6 +97,10 @@ protected:
   bool TopologicalSampling = true;
 
 private:
+  // False, with an error naming the estimate, when the reconstruction would not fit in memory.
+  bool FitsInMemory(vtkIdType points, std::size_t twoCells);
+  void WarnAbout(const topospline::FieldReconstructionReport& report);
+
   vtkTopoSplineReconstructTwoCells(const vtkTopoSplineReconstructTwoCells&) = delete;
   void operator=(const vtkTopoSplineReconstructTwoCells&) = delete;
 };

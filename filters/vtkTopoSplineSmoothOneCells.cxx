@@ -39,6 +39,31 @@ int vtkTopoSplineSmoothOneCells::FillInputPortInformation(int, vtkInformation* i
   return 1;
 }
 
+namespace
+{
+void WriteSmoothingReport(const topospline::OneCellSmoothingResult& result, int curveSegments, vtkFieldData* fd)
+{
+  double l1 = 0, free = 0;
+  for (const auto& p : result.Pieces)
+  {
+    l1 += p.L1Error;
+    free += p.UnconstrainedL1Error;
+  }
+  using vtkTopoSplineDomainConversion::AddFieldNumbers;
+  AddFieldNumbers(fd, names::CurveSegments, { static_cast<double>(curveSegments) });
+  AddFieldNumbers(fd, names::NumberOfPieces, { static_cast<double>(result.Pieces.size()) });
+  AddFieldNumbers(fd, names::AdaptedPieces, { static_cast<double>(result.AdaptedPieces) });
+  AddFieldNumbers(fd, names::RemainingCrossings, { static_cast<double>(result.RemainingCrossings) });
+  AddFieldNumbers(fd, names::PiecesOutsideDomain, { static_cast<double>(result.PiecesOutsideDomain) });
+  AddFieldNumbers(fd, names::ClampedPieces, { static_cast<double>(result.ClampedPieces) });
+  AddFieldNumbers(fd, names::L1Error, { l1 });
+  AddFieldNumbers(fd, names::UnconstrainedL1Error, { free });
+  AddFieldNumbers(fd, names::JunctionMargin, { result.JunctionMargin });
+  AddFieldNumbers(fd, names::SpreadCriticalValues, { static_cast<double>(result.SpreadCriticalValues) });
+  AddFieldNumbers(fd, names::MaximumSpread, { result.MaximumSpread });
+}
+} // namespace
+
 int vtkTopoSplineSmoothOneCells::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -107,6 +132,22 @@ int vtkTopoSplineSmoothOneCells::RequestData(
       return 1;
     }
   }
+  this->ReportAdjustments(complex, result);
+
+  // The input's blocks pass through; the smoothed 1-cells are added.
+  output->SetNumberOfBlocks(names::SampledOneCellsIndex + 1);
+  vtkTopoSplineWireFormat::PassBlocks(input, names::SmoothedOneCellsIndex, output);
+  vtkTopoSplineWireFormat::WriteSmoothedOneCells(complex, result, this->SamplesPerSegment, output);
+
+  WriteSmoothingReport(result, this->CurveSegments, output->GetFieldData());
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+// Not errors, but changes a user should know of: critical values spread apart, crossings left.
+void vtkTopoSplineSmoothOneCells::ReportAdjustments(
+  const topospline::MorseSmaleComplex& complex, const topospline::OneCellSmoothingResult& result)
+{
   if (result.SpreadCriticalValues > 0)
   {
     // Not an error: equal or nearly equal critical values (a plateau, a constant field) that
@@ -126,33 +167,6 @@ int vtkTopoSplineSmoothOneCells::RequestData(
                                        << " pair(s) of smoothed 1-cells still cross after adapting "
                                        << result.AdaptedPieces << " piece(s).");
   }
-
-  // The input's blocks pass through; the smoothed 1-cells are added.
-  output->SetNumberOfBlocks(names::SampledOneCellsIndex + 1);
-  vtkTopoSplineWireFormat::PassBlocks(input, names::SmoothedOneCellsIndex, output);
-  vtkTopoSplineWireFormat::WriteSmoothedOneCells(complex, result, this->SamplesPerSegment, output);
-
-  double l1 = 0, free = 0;
-  for (const auto& p : result.Pieces)
-  {
-    l1 += p.L1Error;
-    free += p.UnconstrainedL1Error;
-  }
-  vtkFieldData* fd = output->GetFieldData();
-  using vtkTopoSplineDomainConversion::AddFieldNumbers;
-  AddFieldNumbers(fd, names::CurveSegments, { static_cast<double>(this->CurveSegments) });
-  AddFieldNumbers(fd, names::NumberOfPieces, { static_cast<double>(result.Pieces.size()) });
-  AddFieldNumbers(fd, names::AdaptedPieces, { static_cast<double>(result.AdaptedPieces) });
-  AddFieldNumbers(fd, names::RemainingCrossings, { static_cast<double>(result.RemainingCrossings) });
-  AddFieldNumbers(fd, names::PiecesOutsideDomain, { static_cast<double>(result.PiecesOutsideDomain) });
-  AddFieldNumbers(fd, names::ClampedPieces, { static_cast<double>(result.ClampedPieces) });
-  AddFieldNumbers(fd, names::L1Error, { l1 });
-  AddFieldNumbers(fd, names::UnconstrainedL1Error, { free });
-  AddFieldNumbers(fd, names::JunctionMargin, { result.JunctionMargin });
-  AddFieldNumbers(fd, names::SpreadCriticalValues, { static_cast<double>(result.SpreadCriticalValues) });
-  AddFieldNumbers(fd, names::MaximumSpread, { result.MaximumSpread });
-  this->UpdateProgress(1.0);
-  return 1;
 }
 
 void vtkTopoSplineSmoothOneCells::PrintSelf(ostream& os, vtkIndent indent)

@@ -22,6 +22,12 @@
 
 #include <vtkMultiBlockDataSetAlgorithm.h>
 
+namespace topospline
+{
+struct MorseSmaleComplex;
+struct OneCellSmoothingResult;
+}
+
 class TOPOSPLINEFILTERS_EXPORT vtkTopoSplineSmoothOneCells : public vtkMultiBlockDataSetAlgorithm
 {
 public:
@@ -52,6 +58,8 @@ protected:
   int SamplesPerSegment = 16;
 
 private:
+  void ReportAdjustments(const topospline::MorseSmaleComplex& complex, const topospline::OneCellSmoothingResult& result);
+
   vtkTopoSplineSmoothOneCells(const vtkTopoSplineSmoothOneCells&) = delete;
   void operator=(const vtkTopoSplineSmoothOneCells&) = delete;
 };

@@ -47,15 +47,13 @@ constexpr int CurvePointOfVtkPoint[4] = { 0, 3, 1, 2 };
 
 namespace vtkTopoSplineWireFormat
 {
-void WriteComplex(const topospline::MorseSmaleComplex& complex, vtkDataSet* domain, const char* scalarName,
-  vtkMultiBlockDataSet* output)
+namespace
 {
-  const conversion::DomainPlane embedding = conversion::PlaneOf(domain);
+// Block 0: one vertex per critical point, at its vertex of the domain.
+vtkSmartPointer<vtkPolyData> CriticalPointsBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* domain)
+{
   const auto& cps = complex.CriticalPoints;
-
-  // Critical points.
-  vtkNew<vtkPolyData> critical;
-  {
+  auto critical = vtkSmartPointer<vtkPolyData>::New();
     const vtkIdType n = static_cast<vtkIdType>(cps.size());
     vtkNew<vtkPoints> points;
     points->SetDataTypeToDouble();
@@ -82,11 +80,14 @@ void WriteComplex(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
     critical->SetVerts(verts);
     conversion::AddArrays(critical->GetPointData(), { id, index, value, vertex, cell, boundary });
     critical->GetPointData()->SetActiveScalars(names::CriticalIndex);
-  }
+  return critical;
+}
 
-  // 1-cells as polylines.
-  vtkNew<vtkPolyData> oneCells;
-  {
+// Block 1: the 1-cells as polylines, from source to destination.
+vtkSmartPointer<vtkPolyData> OneCellsBlock(const topospline::MorseSmaleComplex& complex, const conversion::DomainPlane& embedding)
+{
+  const auto& cps = complex.CriticalPoints;
+  auto oneCells = vtkSmartPointer<vtkPolyData>::New();
     vtkIdType nPoints = 0;
     for (const auto& arc : complex.OneCells)
     {
@@ -134,11 +135,14 @@ void WriteComplex(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
     oneCells->GetPointData()->AddArray(meshCell);
     oneCells->GetPointData()->SetActiveScalars(names::ScalarAlong);
     conversion::AddArrays(oneCells->GetCellData(), { id, source, destination, type });
-  }
+  return oneCells;
+}
 
-  // 2-cells: one point per cell at its centroid, carrying its corners and sides.
-  vtkNew<vtkPolyData> twoCells;
-  {
+// Block 2: one point per 2-cell at its centroid, carrying its corners and sides.
+vtkSmartPointer<vtkPolyData> TwoCellsBlock(const topospline::MorseSmaleComplex& complex, const conversion::DomainPlane& embedding)
+{
+  const auto& cps = complex.CriticalPoints;
+  auto twoCells = vtkSmartPointer<vtkPolyData>::New();
     const vtkIdType n = static_cast<vtkIdType>(complex.TwoCells.size());
     vtkNew<vtkPoints> points;
     points->SetDataTypeToDouble();
@@ -174,12 +178,15 @@ void WriteComplex(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
     twoCells->SetPoints(points);
     twoCells->SetVerts(verts);
     conversion::AddArrays(twoCells->GetPointData(), { id, minimum, maximum, saddles, arcs, pouch, size });
-  }
+  return twoCells;
+}
 
-  // The input geometry with the per-vertex segmentation.
+// Block 3: the input geometry with the per-vertex segmentation.
+vtkSmartPointer<vtkDataSet> SegmentationBlock(const topospline::MorseSmaleComplex& complex, vtkDataSet* domain)
+{
+  const auto& cps = complex.CriticalPoints;
   vtkSmartPointer<vtkDataSet> segmentation = vtkSmartPointer<vtkDataSet>::Take(domain->NewInstance());
   segmentation->ShallowCopy(domain);
-  {
     const vtkIdType n = domain->GetNumberOfPoints();
     auto ascending = conversion::NewArray<vtkIntArray>(names::AscendingManifoldId, 1, n);
     auto descending = conversion::NewArray<vtkIntArray>(names::DescendingManifoldId, 1, n);
@@ -193,12 +200,24 @@ void WriteComplex(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
     segmentation->GetPointData()->AddArray(ascending);
     segmentation->GetPointData()->AddArray(descending);
     segmentation->GetPointData()->AddArray(cell);
-  }
+  return segmentation;
+}
+
+} // namespace
+
+void WriteComplex(const topospline::MorseSmaleComplex& complex, vtkDataSet* domain, const char* scalarName,
+  vtkMultiBlockDataSet* output)
+{
+  const conversion::DomainPlane embedding = conversion::PlaneOf(domain);
+  const auto critical = CriticalPointsBlock(complex, domain);
+  const auto oneCells = OneCellsBlock(complex, embedding);
+  const auto twoCells = TwoCellsBlock(complex, embedding);
+  const auto segmentation = SegmentationBlock(complex, domain);
 
   output->SetNumberOfBlocks(names::NumberOfBlocks);
-  const std::pair<vtkDataObject*, const char*> blocks[] = { { critical, names::CriticalPointsBlock },
-    { oneCells, names::OneCellsBlock }, { twoCells, names::TwoCellsBlock },
-    { segmentation, names::SegmentationBlock } };
+  const std::pair<vtkDataObject*, const char*> blocks[] = { { critical.Get(), names::CriticalPointsBlock },
+    { oneCells.Get(), names::OneCellsBlock }, { twoCells.Get(), names::TwoCellsBlock },
+    { segmentation.Get(), names::SegmentationBlock } };
   for (unsigned int b = 0; b < names::NumberOfBlocks; ++b)
   {
     output->SetBlock(b, blocks[b].first);
@@ -228,141 +247,174 @@ vtkDataSet* SegmentationOf(vtkMultiBlockDataSet* input)
   return vtkDataSet::SafeDownCast(input->GetBlock(names::SegmentationIndex));
 }
 
-bool ReadComplex(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& complex, std::string& error)
+namespace
 {
-  complex = topospline::MorseSmaleComplex();
-  auto* critical = input ? vtkPolyData::SafeDownCast(input->GetBlock(names::CriticalPointsIndex)) : nullptr;
-  auto* oneCells = input ? vtkPolyData::SafeDownCast(input->GetBlock(names::OneCellsIndex)) : nullptr;
-  auto* twoCells = input ? vtkPolyData::SafeDownCast(input->GetBlock(names::TwoCellsIndex)) : nullptr;
-  vtkDataSet* segmentation = SegmentationOf(input);
-  if (!critical || !oneCells || !twoCells || !segmentation)
-  {
-    error = "the input is not a Morse-Smale complex (expected the output of the \"Morse-Smale Complex\" filter)";
-    return false;
-  }
-  const conversion::DomainPlane embedding = conversion::PlaneOf(segmentation);
+// The arrays of blocks 0-3, all looked up before any is read (the first missing one is named).
+struct ComplexArrays
+{
+  vtkPolyData* CriticalPoints = nullptr;
+  vtkPolyData* OneCells = nullptr;
+  vtkPolyData* TwoCells = nullptr;
+  vtkDataSet* Segmentation = nullptr;
+  vtkDataArray *Id, *Index, *Value, *Vertex, *Cell, *Boundary;       // critical points
+  vtkDataArray *Source, *Destination, *Type, *Along, *MeshCell;       // 1-cells
+  vtkDataArray *Ascending, *Descending, *TwoCellOfVertex;             // segmentation
+  vtkDataArray *Minimum, *Maximum, *Saddles, *Sides, *Pouch, *Size;   // 2-cells
 
-  auto* pd = critical->GetPointData();
-  vtkDataArray* id = RequireArray(pd, names::CriticalPointId, error);
-  vtkDataArray* index = RequireArray(pd, names::CriticalIndex, error);
-  vtkDataArray* value = RequireArray(pd, names::CriticalValue, error);
-  vtkDataArray* vertex = RequireArray(pd, names::VertexId, error);
-  vtkDataArray* cell = RequireArray(pd, names::CriticalCellId, error);
-  vtkDataArray* boundary = RequireArray(pd, names::IsOnBoundary, error);
-  auto* cd = oneCells->GetCellData();
-  vtkDataArray* source = RequireArray(cd, names::SourceId, error);
-  vtkDataArray* destination = RequireArray(cd, names::DestinationId, error);
-  vtkDataArray* type = RequireArray(cd, names::SeparatrixType, error);
-  vtkDataArray* along = RequireArray(oneCells->GetPointData(), names::ScalarAlong, error);
-  vtkDataArray* meshCell = RequireArray(oneCells->GetPointData(), names::MeshCellId, error);
-  auto* sd = segmentation->GetPointData();
-  vtkDataArray* ascending = RequireArray(sd, names::AscendingManifoldId, error);
-  vtkDataArray* descending = RequireArray(sd, names::DescendingManifoldId, error);
-  vtkDataArray* cellId = RequireArray(sd, names::TwoCellId, error);
-  auto* td = twoCells->GetPointData();
-  vtkDataArray* minimum = RequireArray(td, names::MinimumId, error);
-  vtkDataArray* maximum = RequireArray(td, names::MaximumId, error);
-  vtkDataArray* saddles = RequireArray(td, names::SaddleIds, error);
-  vtkDataArray* arcs = RequireArray(td, names::BoundarySeparatrices, error);
-  vtkDataArray* pouch = RequireArray(td, names::IsPouch, error);
-  vtkDataArray* size = RequireArray(td, names::NumberOfVertices, error);
-  if (!error.empty())
+  bool Find(std::string& error)
   {
-    error = "the input is not a Morse-Smale complex: " + error;
-    return false;
+    auto* pd = this->CriticalPoints->GetPointData();
+    this->Id = RequireArray(pd, names::CriticalPointId, error);
+    this->Index = RequireArray(pd, names::CriticalIndex, error);
+    this->Value = RequireArray(pd, names::CriticalValue, error);
+    this->Vertex = RequireArray(pd, names::VertexId, error);
+    this->Cell = RequireArray(pd, names::CriticalCellId, error);
+    this->Boundary = RequireArray(pd, names::IsOnBoundary, error);
+    auto* cd = this->OneCells->GetCellData();
+    this->Source = RequireArray(cd, names::SourceId, error);
+    this->Destination = RequireArray(cd, names::DestinationId, error);
+    this->Type = RequireArray(cd, names::SeparatrixType, error);
+    this->Along = RequireArray(this->OneCells->GetPointData(), names::ScalarAlong, error);
+    this->MeshCell = RequireArray(this->OneCells->GetPointData(), names::MeshCellId, error);
+    auto* sd = this->Segmentation->GetPointData();
+    this->Ascending = RequireArray(sd, names::AscendingManifoldId, error);
+    this->Descending = RequireArray(sd, names::DescendingManifoldId, error);
+    this->TwoCellOfVertex = RequireArray(sd, names::TwoCellId, error);
+    auto* td = this->TwoCells->GetPointData();
+    this->Minimum = RequireArray(td, names::MinimumId, error);
+    this->Maximum = RequireArray(td, names::MaximumId, error);
+    this->Saddles = RequireArray(td, names::SaddleIds, error);
+    this->Sides = RequireArray(td, names::BoundarySeparatrices, error);
+    this->Pouch = RequireArray(td, names::IsPouch, error);
+    this->Size = RequireArray(td, names::NumberOfVertices, error);
+    return error.empty();
+  }
+};
+
+// Stable critical point ids (which survive simplification) to positions in the complex read.
+class PositionOfId
+{
+public:
+  bool Add(Index id, Index position)
+  {
+    if (id < 0)
+    {
+      return false;
+    }
+    if (static_cast<size_t>(id) >= this->Positions.size())
+    {
+      this->Positions.resize(id + 1, topospline::InvalidIndex);
+    }
+    this->Positions[id] = position;
+    return true;
+  }
+  Index operator()(double stableId) const
+  {
+    const auto s = static_cast<long long>(stableId);
+    return s >= 0 && s < static_cast<long long>(this->Positions.size()) ? this->Positions[s] : topospline::InvalidIndex;
   }
 
-  // Stable id -> position in this complex.
-  std::vector<Index> position;
-  const vtkIdType nCP = critical->GetNumberOfPoints();
+private:
+  std::vector<Index> Positions;
+};
+
+bool ReadCriticalPoints(const ComplexArrays& in, topospline::MorseSmaleComplex& complex, PositionOfId& local,
+  std::string& error)
+{
+  const vtkIdType nCP = in.CriticalPoints->GetNumberOfPoints();
   for (vtkIdType i = 0; i < nCP; ++i)
   {
     topospline::CriticalPoint cp;
-    cp.Id = static_cast<Index>(id->GetComponent(i, 0));
-    cp.MorseIndex = static_cast<int>(index->GetComponent(i, 0));
-    cp.Value = value->GetComponent(i, 0);
-    cp.Vertex = static_cast<Index>(vertex->GetComponent(i, 0));
-    cp.Cell = static_cast<Index>(cell->GetComponent(i, 0));
-    cp.OnBoundary = boundary->GetComponent(i, 0) != 0;
-    if (cp.Id < 0)
+    cp.Id = static_cast<Index>(in.Id->GetComponent(i, 0));
+    cp.MorseIndex = static_cast<int>(in.Index->GetComponent(i, 0));
+    cp.Value = in.Value->GetComponent(i, 0);
+    cp.Vertex = static_cast<Index>(in.Vertex->GetComponent(i, 0));
+    cp.Cell = static_cast<Index>(in.Cell->GetComponent(i, 0));
+    cp.OnBoundary = in.Boundary->GetComponent(i, 0) != 0;
+    if (!local.Add(cp.Id, static_cast<Index>(i)))
     {
       error = "the input is not a Morse-Smale complex: negative critical point id";
       return false;
     }
-    if (static_cast<size_t>(cp.Id) >= position.size())
-    {
-      position.resize(cp.Id + 1, topospline::InvalidIndex);
-    }
-    position[cp.Id] = static_cast<Index>(i);
     complex.CriticalPoints.push_back(cp);
   }
-  auto local = [&](double stableId) {
-    const auto s = static_cast<long long>(stableId);
-    return s >= 0 && s < static_cast<long long>(position.size()) ? position[s] : topospline::InvalidIndex;
-  };
+  return true;
+}
 
-  vtkCellArray* lines = oneCells->GetLines();
+bool ReadOneCells(const ComplexArrays& in, const conversion::DomainPlane& embedding, const PositionOfId& local,
+  topospline::MorseSmaleComplex& complex, std::string& error)
+{
+  vtkCellArray* lines = in.OneCells->GetLines();
   vtkNew<vtkIdList> ids;
   lines->InitTraversal();
   for (vtkIdType a = 0; lines->GetNextCell(ids); ++a)
   {
-    topospline::OneCell arc;
-    arc.Type = type->GetComponent(a, 0) == 0 ? topospline::OneCell::Descending : topospline::OneCell::Ascending;
-    arc.Source = local(source->GetComponent(a, 0));
-    arc.Destination = local(destination->GetComponent(a, 0));
+    topospline::OneCell oneCell;
+    oneCell.Type = in.Type->GetComponent(a, 0) == 0 ? topospline::OneCell::Descending : topospline::OneCell::Ascending;
+    oneCell.Source = local(in.Source->GetComponent(a, 0));
+    oneCell.Destination = local(in.Destination->GetComponent(a, 0));
     for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k)
     {
       double xyz[3];
-      oneCells->GetPoint(ids->GetId(k), xyz);
-      arc.Points.push_back(xyz[embedding.U]);
-      arc.Points.push_back(xyz[embedding.V]);
-      arc.Values.push_back(along->GetComponent(ids->GetId(k), 0));
-      const auto c = static_cast<Index>(meshCell->GetComponent(ids->GetId(k), 0));
+      in.OneCells->GetPoint(ids->GetId(k), xyz);
+      oneCell.Points.push_back(xyz[embedding.U]);
+      oneCell.Points.push_back(xyz[embedding.V]);
+      oneCell.Values.push_back(in.Along->GetComponent(ids->GetId(k), 0));
+      const auto c = static_cast<Index>(in.MeshCell->GetComponent(ids->GetId(k), 0));
       if (c >= 0)
       {
-        arc.MeshCells.push_back(c);
+        oneCell.MeshCells.push_back(c);
       }
     }
-    if (arc.Source == topospline::InvalidIndex || arc.Destination == topospline::InvalidIndex)
+    if (oneCell.Source == topospline::InvalidIndex || oneCell.Destination == topospline::InvalidIndex)
     {
       error = "the input is not a Morse-Smale complex: a 1-cell refers to a missing critical point";
       return false;
     }
-    complex.OneCells.push_back(std::move(arc));
+    complex.OneCells.push_back(std::move(oneCell));
   }
+  return true;
+}
 
-  const vtkIdType nCells = twoCells->GetNumberOfPoints();
+void ReadTwoCells(const ComplexArrays& in, const conversion::DomainPlane& embedding, const PositionOfId& local,
+  topospline::MorseSmaleComplex& complex)
+{
+  const vtkIdType nCells = in.TwoCells->GetNumberOfPoints();
   for (vtkIdType c = 0; c < nCells; ++c)
   {
     topospline::TwoCell twoCell;
-    twoCell.Minimum = local(minimum->GetComponent(c, 0));
-    twoCell.Maximum = local(maximum->GetComponent(c, 0));
-    twoCell.Saddles = { local(saddles->GetComponent(c, 0)), local(saddles->GetComponent(c, 1)) };
+    twoCell.Minimum = local(in.Minimum->GetComponent(c, 0));
+    twoCell.Maximum = local(in.Maximum->GetComponent(c, 0));
+    twoCell.Saddles = { local(in.Saddles->GetComponent(c, 0)), local(in.Saddles->GetComponent(c, 1)) };
     for (int k = 0; k < 4; ++k)
     {
-      twoCell.BoundaryOneCells[k] = static_cast<Index>(arcs->GetComponent(c, k));
+      twoCell.BoundaryOneCells[k] = static_cast<Index>(in.Sides->GetComponent(c, k));
     }
-    twoCell.Pouch = pouch->GetComponent(c, 0) != 0;
-    twoCell.NumberOfVertices = static_cast<Index>(size->GetComponent(c, 0));
+    twoCell.Pouch = in.Pouch->GetComponent(c, 0) != 0;
+    twoCell.NumberOfVertices = static_cast<Index>(in.Size->GetComponent(c, 0));
     double xyz[3];
-    twoCells->GetPoint(c, xyz);
+    in.TwoCells->GetPoint(c, xyz);
     twoCell.Centroid[0] = xyz[embedding.U];
     twoCell.Centroid[1] = xyz[embedding.V];
     twoCell.Sectors = twoCell.Saddles[1] == topospline::InvalidIndex ? 1 : 2;
     complex.TwoCells.push_back(twoCell);
   }
+}
 
-  const vtkIdType nV = segmentation->GetNumberOfPoints();
+bool ReadSegmentation(const ComplexArrays& in, vtkFieldData* fieldData, const PositionOfId& local,
+  topospline::MorseSmaleComplex& complex, std::string& error)
+{
+  const vtkIdType nV = in.Segmentation->GetNumberOfPoints();
   complex.AscendingManifold.resize(nV);
   complex.DescendingManifold.resize(nV);
   complex.TwoCellId.resize(nV);
   for (vtkIdType v = 0; v < nV; ++v)
   {
-    complex.AscendingManifold[v] = local(ascending->GetComponent(v, 0));
-    complex.DescendingManifold[v] = local(descending->GetComponent(v, 0));
-    complex.TwoCellId[v] = static_cast<Index>(cellId->GetComponent(v, 0));
+    complex.AscendingManifold[v] = local(in.Ascending->GetComponent(v, 0));
+    complex.DescendingManifold[v] = local(in.Descending->GetComponent(v, 0));
+    complex.TwoCellId[v] = static_cast<Index>(in.TwoCellOfVertex->GetComponent(v, 0));
   }
-  if (vtkDataArray* junctions = input->GetFieldData()->GetArray(names::BoundaryJunctionVertexId))
+  if (vtkDataArray* junctions = fieldData->GetArray(names::BoundaryJunctionVertexId))
   {
     for (vtkIdType j = 0; j < junctions->GetNumberOfTuples(); ++j)
     {
@@ -376,6 +428,35 @@ bool ReadComplex(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& com
     }
   }
   return true;
+}
+} // namespace
+
+bool ReadComplex(vtkMultiBlockDataSet* input, topospline::MorseSmaleComplex& complex, std::string& error)
+{
+  complex = topospline::MorseSmaleComplex();
+  ComplexArrays in;
+  in.CriticalPoints = input ? vtkPolyData::SafeDownCast(input->GetBlock(names::CriticalPointsIndex)) : nullptr;
+  in.OneCells = input ? vtkPolyData::SafeDownCast(input->GetBlock(names::OneCellsIndex)) : nullptr;
+  in.TwoCells = input ? vtkPolyData::SafeDownCast(input->GetBlock(names::TwoCellsIndex)) : nullptr;
+  in.Segmentation = SegmentationOf(input);
+  if (!in.CriticalPoints || !in.OneCells || !in.TwoCells || !in.Segmentation)
+  {
+    error = "the input is not a Morse-Smale complex (expected the output of the \"Morse-Smale Complex\" filter)";
+    return false;
+  }
+  if (!in.Find(error))
+  {
+    error = "the input is not a Morse-Smale complex: " + error;
+    return false;
+  }
+  const conversion::DomainPlane embedding = conversion::PlaneOf(in.Segmentation);
+  PositionOfId local;
+  if (!ReadCriticalPoints(in, complex, local, error) || !ReadOneCells(in, embedding, local, complex, error))
+  {
+    return false;
+  }
+  ReadTwoCells(in, embedding, local, complex);
+  return ReadSegmentation(in, input->GetFieldData(), local, complex, error);
 }
 
 std::string ScalarFieldNameOf(vtkMultiBlockDataSet* input)
