@@ -286,7 +286,7 @@ void WriteReport(const topospline::FieldReconstructionReport& report, vtkFieldDa
     AddFieldNumbers(fd, names::SamplingChangedVertices, { static_cast<double>(report.Sampling.ChangedVertices) });
     AddFieldNumbers(fd, names::SamplingMaximumChange, { report.Sampling.MaximumChange });
     AddFieldNumbers(fd, names::SamplingConverged, { report.Sampling.Converged ? 1.0 : 0.0 });
-    AddFieldNumbers(fd, names::SamplingDisplacedSaddles, { static_cast<double>(report.DisplacedSaddles) });
+    AddFieldNumbers(fd, names::SamplingDisplacedSaddles, { static_cast<double>(report.Sampling.DisplacedSaddles) });
   }
   if (!report.VerificationRan)
   {

@@ -142,6 +142,15 @@ SamplingGrid FieldReconstruction::FinerGrid(const PlanarScalarField& field) cons
   return grid;
 }
 
+topospline::TopologicalSampling FieldReconstruction::SamplingOf(const MorseSmaleComplex& complex,
+  const TriangleMeshTopology& mesh, const PlanarScalarField& field, const OneCellSmoothingResult& smoothed) const
+{
+  topospline::TopologicalSampling sampling(complex, mesh, field.Points, smoothed);
+  sampling.Spacing = this->Spacing;
+  sampling.Parallel = this->Parallel;
+  return sampling;
+}
+
 bool FieldReconstruction::Run(const PlanarScalarField& field, const MorseSmaleComplex& complex,
   const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report, std::string& error)
 {
@@ -244,8 +253,7 @@ void FieldReconstruction::SampleTopologicallyAtVertices(const PlanarScalarField&
 {
   report.Sampled = true;
   report.Exact = report.Values;
-  report.Sampling = SampleTopologically(complex, mesh, field.Points, smoothed, field, mesh,
-    [](Index v) { return v; }, this->Spacing, report.Values, report.DisplacedSaddles, this->Parallel);
+  report.Sampling = this->SamplingOf(complex, mesh, field, smoothed).Apply(field, mesh, [](Index v) { return v; }, report.Values);
   for (std::size_t v = 0; v < report.Values.size(); ++v)
   {
     report.Difference[v] = report.Values[v] - field.Values[v];
@@ -315,16 +323,15 @@ void FieldReconstruction::Resample(const PlanarScalarField& field, const Triangl
   {
     TriangleMeshTopology fineMesh;
     fineMesh.BuildGrid(ni, nj, this->Parallel);
-    int fineDisplaced = 0;
-    const auto fineReport = SampleTopologically(complex, mesh, field.Points, smoothed, fine, fineMesh,
+    const auto fineReport = this->SamplingOf(complex, mesh, field, smoothed).Apply(fine, fineMesh,
       [&](Index v) {
         const double* xy = &field.Points[2 * static_cast<std::size_t>(v)];
         const int i = std::clamp(static_cast<int>(std::lround((xy[0] - grid.Origin[0]) / grid.Spacing[0])), 0, ni - 1);
         const int j = std::clamp(static_cast<int>(std::lround((xy[1] - grid.Origin[1]) / grid.Spacing[1])), 0, nj - 1);
         return static_cast<Index>(j * ni + i);
       },
-      this->Spacing, fine.Values, fineDisplaced, this->Parallel);
-    report.DisplacedSaddles += fineDisplaced;
+      fine.Values);
+    report.Sampling.DisplacedSaddles += fineReport.DisplacedSaddles;
     report.Sampling.ChangedVertices += fineReport.ChangedVertices;
     report.Sampling.MaximumChange = std::max(report.Sampling.MaximumChange, fineReport.MaximumChange);
     report.Sampling.Converged = report.Sampling.Converged && fineReport.Converged;

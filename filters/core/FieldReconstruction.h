@@ -69,7 +69,6 @@ struct FieldReconstructionReport
   // Topological sampling (both samplings summed).
   bool Sampled = false;
   TopologicalSamplingReport Sampling;
-  int DisplacedSaddles = 0;
 
   // Verification.
   bool Verified = false;
@@ -117,6 +116,9 @@ private:
   void Resample(const PlanarScalarField& field, const TriangleMeshTopology& mesh, const MorseSmaleComplex& complex,
     const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const;
   void Verify(const PlanarScalarField& field, const MorseSmaleComplex& complex, FieldReconstructionReport& report) const;
+
+  topospline::TopologicalSampling SamplingOf(const MorseSmaleComplex& complex, const TriangleMeshTopology& mesh,
+    const PlanarScalarField& field, const OneCellSmoothingResult& smoothed) const;
 
   TwoCellReconstruction Cells;
   double Spacing = 0; // the tolerance of every "near its node": one grid spacing

@@ -82,4 +82,24 @@ std::vector<Index> GridTriangles(int nx, int ny)
   }
   return triangles;
 }
+PlanarScalarField FieldOnGrid(const GridField& grid)
+{
+  PlanarScalarField field;
+  const int nx = grid.Dimensions[0], ny = grid.Dimensions[1];
+  field.GridDimensions[0] = nx;
+  field.GridDimensions[1] = ny;
+  field.GridSpacing[0] = grid.Spacing[0];
+  field.GridSpacing[1] = grid.Spacing[1];
+  field.Points.resize(2 * static_cast<std::size_t>(nx) * ny);
+  for (int j = 0; j < ny; ++j)
+  {
+    for (int i = 0; i < nx; ++i)
+    {
+      field.Points[2 * (static_cast<std::size_t>(j) * nx + i)] = grid.Origin[0] + i * grid.Spacing[0];
+      field.Points[2 * (static_cast<std::size_t>(j) * nx + i) + 1] = grid.Origin[1] + j * grid.Spacing[1];
+    }
+  }
+  field.Values = grid.Values;
+  return field;
+}
 } // namespace topospline

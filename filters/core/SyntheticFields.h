@@ -2,6 +2,7 @@
 #pragma once
 
 #include "CoreTypes.h"
+#include "MorseSmaleComplex.h"
 
 #include <cstdint>
 #include <vector>
@@ -26,6 +27,9 @@ GridField ShepardField(int sites, double power, int resolution, std::uint64_t se
 // a * sin(x/a) * sin(y/a) on a resolution x resolution grid of spacing 1 from (origin, origin).
 // The paper's example: a = 10, 100 samples from -49.
 GridField TrigonometricField(double amplitude, int resolution, double origin);
+
+// The grid as the field the stages take (vertex (i, j) at Origin + (i, j) * Spacing).
+PlanarScalarField FieldOnGrid(const GridField& grid);
 
 // Splits every grid quad along its (i+1,j)-(i,j+1) diagonal, the triangulation used for
 // image data throughout (and by the data catalog's critical-point counts).

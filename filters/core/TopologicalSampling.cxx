@@ -293,6 +293,49 @@ Index RaiseWayUp(const Graph& g, const TriangleMeshTopology& mesh, std::vector<d
 }
 } // namespace
 
+namespace
+{
+// Steps of TopologicalSampling::Apply.
+// Adds to `constraints` the smoothed 1-cells of the complex's saddles, sampled from each saddle
+// out to `radius` (`vertexAt` as for ComplexConstraints).
+void AddSaddleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
+  const std::function<Index(Index)>& vertexAt, double radius, SamplingConstraints& constraints);
+// Adds to constraints.OneCells every smoothed 1-cell of the complex, from its saddle to its
+// extremum, sampled at most `step` apart (a fraction of the grid spacing, so that a walk along
+// the samples follows the curve).
+void AddOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
+  const std::function<Index(Index)>& vertexAt, double step, SamplingConstraints& constraints);
+// Adds to `report` how many of `after` differ from `before`, and by how much at most.
+void CountChanges(const std::vector<double>& before, const std::vector<double>& after,
+  TopologicalSamplingReport& report);
+// After EnforceCriticalVertices the extrema are the wanted ones, but a saddle can sit a few
+// vertices from its node in a nearly flat pass. Each round extracts the complex of `field`
+// with `values`; for every wanted saddle (constraints.Saddles) with no saddle within `tolerance`, the nearest
+// unmatched saddle within `reach` is moved past the wanted saddle's value (raised if it is
+// lower: the pass then lies elsewhere along the ridge; lowered if higher), and the extrema are
+// enforced again. A round is kept only if it leaves fewer unmatched saddles. Nothing is tried
+// when more than `maximumMissing` are unmatched. Returns the number of unmatched wanted saddles
+// left.
+// With constraints.SaddleOneCells, the unmatched saddles' 1-cells are first carved into the
+// sampling (CarveSaddleOneCells, within `reach`; one extraction, whatever the number
+// unmatched): where a 1-cell runs between two rows of vertices, as next to the domain
+// boundary, the ridge or valley it follows is seen by no vertex and the saddle slides along
+// it; carving gives it vertices.
+int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, double tolerance, double reach, std::vector<double>& values,
+  int maximumRounds = 3, int maximumMissing = 10, const ParallelFor& parallel = SequentialFor);
+// Makes the wanted saddle `saddle` a saddle of the sampling with its own 1-cells
+// (constraints.SaddleOneCells): each 1-cell gets a vertex of the saddle's link, in the order
+// in which they leave it, raised above the saddle's value for an ascending 1-cell and lowered
+// below it for a descending one; from there a chain of vertices along the 1-cell, within
+// `radius`, rises (falls) with the 1-cell's heights until the values go on that way by
+// themselves. Vertices of the domain boundary serve only 1-cells that run through them (in the
+// link, unless there is no other choice).
+// Returns the number of changed vertices.
+Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, Index saddle, double radius, std::vector<double>& values);
+} // namespace
+
 TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds)
 {
@@ -543,6 +586,8 @@ std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, cons
 }
 } // namespace
 
+namespace
+{
 void AddSaddleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
   const std::function<Index(Index)>& vertexAt, double radius, SamplingConstraints& constraints)
 {
@@ -550,7 +595,10 @@ void AddSaddleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingR
     SampleOneCells(complex, smoothed, vertexAt, radius, std::numeric_limits<double>::infinity());
   std::move(cells.begin(), cells.end(), std::back_inserter(constraints.SaddleOneCells));
 }
+} // namespace
 
+namespace
+{
 void AddOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
   const std::function<Index(Index)>& vertexAt, double step, SamplingConstraints& constraints)
 {
@@ -558,6 +606,7 @@ void AddOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult&
     SampleOneCells(complex, smoothed, vertexAt, std::numeric_limits<double>::infinity(), step);
   std::move(cells.begin(), cells.end(), std::back_inserter(constraints.OneCells));
 }
+} // namespace
 
 namespace
 {
@@ -621,24 +670,22 @@ std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, cons
 }
 } // namespace
 
-TopologicalSamplingReport SampleTopologically(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
-  const std::vector<double>& complexPoints, const OneCellSmoothingResult& smoothed, const PlanarScalarField& sampling,
-  const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, double spacing,
-  std::vector<double>& values, int& displacedSaddles, const ParallelFor& parallel)
+TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sampling,
+  const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, std::vector<double>& values) const
 {
   // How far from its node a saddle is looked for and carved back.
-  const double reach = 8 * spacing;
-  SamplingConstraints constraints = ComplexConstraints(complex, complexMesh, mesh, vertexAt);
-  AddSaddleOneCells(complex, smoothed, vertexAt, reach, constraints);
-  AddOneCells(complex, smoothed, vertexAt, 0.25 * spacing, constraints);
+  const double reach = 8 * this->Spacing;
+  SamplingConstraints constraints = ComplexConstraints(this->Complex, this->ComplexMesh, mesh, vertexAt);
+  AddSaddleOneCells(this->Complex, this->Smoothed, vertexAt, reach, constraints);
+  AddOneCells(this->Complex, this->Smoothed, vertexAt, 0.25 * this->Spacing, constraints);
   const std::vector<double> before = values;
-  for (const CriticalPoint& cp : complex.CriticalPoints)
+  for (const CriticalPoint& cp : this->Complex.CriticalPoints)
   {
     const Index v = vertexAt(cp.Vertex);
     const std::size_t node = 2 * static_cast<std::size_t>(cp.Vertex);
-    if (v >= 0 && v < mesh.NumberOfVertices() && node + 1 < complexPoints.size() &&
-      std::hypot(sampling.Points[2 * v] - complexPoints[node], sampling.Points[2 * v + 1] - complexPoints[node + 1]) >
-        1e-6 * spacing)
+    if (v >= 0 && v < mesh.NumberOfVertices() && node + 1 < this->ComplexPoints.size() &&
+      std::hypot(sampling.Points[2 * v] - this->ComplexPoints[node],
+        sampling.Points[2 * v + 1] - this->ComplexPoints[node + 1]) > 1e-6 * this->Spacing)
     {
       values[v] = cp.Value;
     }
@@ -660,20 +707,24 @@ TopologicalSamplingReport SampleTopologically(const MorseSmaleComplex& complex, 
       }
     }
   }
-  CarveOneCells(sampling, mesh, constraints, spacing, values);
-  for (Index v : PlaceBoundaryJunctions(complex, sampling, mesh, vertexAt, BoundaryJunctionReach * spacing, values))
+  CarveOneCells(sampling, mesh, constraints, this->Spacing, values);
+  const double junctionReach = BoundaryJunctionReach * this->Spacing;
+  for (Index v : PlaceBoundaryJunctions(this->Complex, sampling, mesh, vertexAt, junctionReach, values))
   {
     constraints.BoundaryMinima.push_back(v);
     constraints.Saddles.push_back(v);
   }
   TopologicalSamplingReport report = EnforceCriticalVertices(mesh, constraints, values);
-  displacedSaddles = RelocateSaddles(sampling, mesh, constraints, spacing * (1 + 1e-9), reach, values, 3, 10, parallel);
+  report.DisplacedSaddles =
+    RelocateSaddles(sampling, mesh, constraints, this->Spacing * (1 + 1e-9), reach, values, 3, 10, this->Parallel);
   report.ChangedVertices = 0;
   report.MaximumChange = 0;
   CountChanges(before, values, report);
   return report;
 }
 
+namespace
+{
 void CountChanges(const std::vector<double>& before, const std::vector<double>& after,
   TopologicalSamplingReport& report)
 {
@@ -686,7 +737,10 @@ void CountChanges(const std::vector<double>& before, const std::vector<double>& 
     }
   }
 }
+} // namespace
 
+namespace
+{
 int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, double tolerance, double reach, std::vector<double>& values,
   int maximumRounds, int maximumMissing, const ParallelFor& parallel)
@@ -816,7 +870,10 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
   }
   return static_cast<int>(missing.size());
 }
+} // namespace
 
+namespace
+{
 Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, Index saddle, double radius, std::vector<double>& values)
 {
@@ -990,6 +1047,7 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
   }
   return changed;
 }
+} // namespace
 
 Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, double spacing, std::vector<double>& values)

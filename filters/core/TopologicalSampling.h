@@ -15,11 +15,11 @@
 // Before the floods, the complex's smoothed 1-cells are carved into the sampling
 // (CarveOneCells), so that a ridge or valley running between two rows of vertices is not cut
 // into islands; after them, saddles left off their nodes are moved back (RelocateSaddles).
-// SampleTopologically runs the whole sequence.
+// TopologicalSampling::Apply runs the whole sequence.
 #pragma once
 
 #include "CoreTypes.h"
-#include "MorseSmaleComplexExtraction.h"
+#include "MorseSmaleComplex.h"
 #include "OneCellSmoothing.h"
 #include "TriangleMeshTopology.h"
 
@@ -34,6 +34,7 @@ struct TopologicalSamplingReport
   bool Converged = false;
   Index ChangedVertices = 0;
   double MaximumChange = 0;
+  int DisplacedSaddles = 0; // wanted saddles with no sampled saddle within the spacing
 };
 
 // One smoothed 1-cell of a wanted saddle, sampled from the saddle outwards: x, y and height per
@@ -67,16 +68,7 @@ struct SamplingConstraints
 SamplingConstraints ComplexConstraints(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
   const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt);
 
-// Adds to `constraints` the smoothed 1-cells of the complex's saddles, sampled from each saddle
-// out to `radius` (`vertexAt` as for ComplexConstraints).
-void AddSaddleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
-  const std::function<Index(Index)>& vertexAt, double radius, SamplingConstraints& constraints);
 
-// Adds to constraints.OneCells every smoothed 1-cell of the complex, from its saddle to its
-// extremum, sampled at most `step` apart (a fraction of the grid spacing, so that a walk along
-// the samples follows the curve).
-void AddOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
-  const std::function<Index(Index)>& vertexAt, double step, SamplingConstraints& constraints);
 
 // Embeds the complex's 1-cells (constraints.OneCells) in the sampling before the floods. A
 // 1-cell is a crease of F o Phi (a ridge for an ascending one, a valley for a descending one)
@@ -92,14 +84,11 @@ void AddOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult&
 Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, double spacing, std::vector<double>& values);
 
-// The whole topological sampling of a reconstruction sampled at the vertices of `mesh`
-// (`sampling` holds their positions): the complex's critical points as constraints (placed by
-// `vertexAt`, as for ComplexConstraints), its smoothed 1-cells carved in (CarveOneCells), the
-// floods (EnforceCriticalVertices) and the saddles moved back onto their nodes
-// (RelocateSaddles, within `spacing`, looked for within 8 spacings). `values` holds the samples
-// and is modified in place; `displacedSaddles` receives the number of saddles left off their
-// nodes. The report counts every changed vertex. `parallel` runs the extractions of the
-// sampled critical points (the floods are sequential).
+// The whole topological sampling of a reconstruction: the complex's critical points as
+// constraints, its smoothed 1-cells carved in (CarveOneCells), the floods
+// (EnforceCriticalVertices) and the saddles moved back onto their nodes (within Spacing,
+// looked for within 8 spacings). The complex side is fixed at construction; Apply samples one
+// sampling of the reconstruction (the input vertices, a finer grid).
 // `complexPoints` (x, y per vertex of `complexMesh`) tells where the nodes are: on a sampling
 // whose vertices do not include them (an image resampled over a triangle mesh), the vertex
 // nearest each node first takes the node's critical value, so that the wanted extremum is
@@ -108,14 +97,38 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
 // boundary (within 3 spacings), with the field falling into the domain there; a wanted
 // boundary saddle at a domain corner is wanted on the higher corner neighbour (a corner above
 // both its neighbours is also a maximum of stage 1).
-TopologicalSamplingReport SampleTopologically(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
-  const std::vector<double>& complexPoints, const OneCellSmoothingResult& smoothed, const PlanarScalarField& sampling,
-  const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, double spacing,
-  std::vector<double>& values, int& displacedSaddles, const ParallelFor& parallel = SequentialFor);
+class TopologicalSampling
+{
+public:
+  TopologicalSampling(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
+    const std::vector<double>& complexPoints, const OneCellSmoothingResult& smoothed)
+    : Complex(complex)
+    , ComplexMesh(complexMesh)
+    , ComplexPoints(complexPoints)
+    , Smoothed(smoothed)
+  {
+  }
 
-// Adds to `report` how many of `after` differ from `before`, and by how much at most.
-void CountChanges(const std::vector<double>& before, const std::vector<double>& after,
-  TopologicalSamplingReport& report);
+  // One grid spacing of the samplings: how near its node a critical point must be.
+  double Spacing = 1;
+  // Runs the extractions of the sampled critical points (the floods are sequential).
+  ParallelFor Parallel = SequentialFor;
+
+  // `values` (one per vertex of `mesh`, at sampling.Points) is modified in place; `vertexAt`
+  // gives the sampling's vertex for a vertex of the complex's mesh (InvalidIndex: none). The
+  // report counts every changed vertex and the saddles left off their nodes.
+  TopologicalSamplingReport Apply(const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
+    const std::function<Index(Index)>& vertexAt, std::vector<double>& values) const;
+
+private:
+  const MorseSmaleComplex& Complex;
+  const TriangleMeshTopology& ComplexMesh;
+  const std::vector<double>& ComplexPoints;
+  const OneCellSmoothingResult& Smoothed;
+};
+
+
+
 
 // Modifies `values` (one per mesh vertex) in place. The alternation settles in a few rounds;
 // as a safeguard it stops after `maximumRounds` or when a round
@@ -123,31 +136,5 @@ void CountChanges(const std::vector<double>& before, const std::vector<double>& 
 // pairs may remain).
 TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds = 6);
-// After EnforceCriticalVertices the extrema are the wanted ones, but a saddle can sit a few
-// vertices from its node in a nearly flat pass. Each round extracts the complex of `field`
-// with `values`; for every wanted saddle (constraints.Saddles) with no saddle within `tolerance`, the nearest
-// unmatched saddle within `reach` is moved past the wanted saddle's value (raised if it is
-// lower: the pass then lies elsewhere along the ridge; lowered if higher), and the extrema are
-// enforced again. A round is kept only if it leaves fewer unmatched saddles. Nothing is tried
-// when more than `maximumMissing` are unmatched. Returns the number of unmatched wanted saddles
-// left.
-// With constraints.SaddleOneCells, the unmatched saddles' 1-cells are first carved into the
-// sampling (CarveSaddleOneCells, within `reach`; one extraction, whatever the number
-// unmatched): where a 1-cell runs between two rows of vertices, as next to the domain
-// boundary, the ridge or valley it follows is seen by no vertex and the saddle slides along
-// it; carving gives it vertices.
-int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
-  const SamplingConstraints& constraints, double tolerance, double reach, std::vector<double>& values,
-  int maximumRounds = 3, int maximumMissing = 10, const ParallelFor& parallel = SequentialFor);
 
-// Makes the wanted saddle `saddle` a saddle of the sampling with its own 1-cells
-// (constraints.SaddleOneCells): each 1-cell gets a vertex of the saddle's link, in the order
-// in which they leave it, raised above the saddle's value for an ascending 1-cell and lowered
-// below it for a descending one; from there a chain of vertices along the 1-cell, within
-// `radius`, rises (falls) with the 1-cell's heights until the values go on that way by
-// themselves. Vertices of the domain boundary serve only 1-cells that run through them (in the
-// link, unless there is no other choice).
-// Returns the number of changed vertices.
-Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
-  const SamplingConstraints& constraints, Index saddle, double radius, std::vector<double>& values);
 } // namespace topospline

@@ -1,0 +1,193 @@
+// Tests of stage 4 from end to end (FieldReconstruction, as "Reconstruct 2-Cells" runs it) on
+// the output of the real stages 1-3, against oracles written here:
+// - the error figures equal those recomputed from the values and the input;
+// - the finer grid spans the input grid exactly, and without topological sampling its values
+//   are F o Phi itself (evaluated here through the same cells at the same points);
+// - topological sampling only changes values, never F o Phi (Exact equals the values of a run
+//   without it), and the counts it reports are the differences counted here;
+// - the verdict: when it is 1, an independent count of the sampled field's interior PL minima
+//   and maxima (lower/upper links, written here) equals the complex's interior extrema;
+// - the same report with one thread and several.
+//
+// Usage: TestFieldReconstruction
+// Prints figures per case, then "N passed, N failed"; returns nonzero on failure.
+#include "FieldReconstruction.h"
+#include "PipelineFixture.h"
+#include "TestHarness.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+using namespace topospline;
+
+namespace
+{
+// Interior PL minima and maxima of a grid field triangulated along the (i+1,j)-(i,j+1)
+// diagonals, ties broken by vertex id (as the simulation of simplicity of stage 1).
+std::array<int, 2> InteriorExtrema(const PlanarScalarField& field)
+{
+  const int nx = field.GridDimensions[0], ny = field.GridDimensions[1];
+  const auto& f = field.Values;
+  const auto lower = [&](int a, int b) { return f[a] < f[b] || (f[a] == f[b] && a < b); };
+  // The six neighbours of (i, j) in that triangulation.
+  const int di[6] = { 1, -1, 0, 0, 1, -1 }, dj[6] = { 0, 0, 1, -1, -1, 1 };
+  std::array<int, 2> counts{ 0, 0 };
+  for (int j = 1; j + 1 < ny; ++j)
+  {
+    for (int i = 1; i + 1 < nx; ++i)
+    {
+      const int v = j * nx + i;
+      int below = 0;
+      for (int k = 0; k < 6; ++k)
+      {
+        below += lower((j + dj[k]) * nx + i + di[k], v) ? 1 : 0;
+      }
+      counts[0] += below == 0 ? 1 : 0;
+      counts[1] += below == 6 ? 1 : 0;
+    }
+  }
+  return counts;
+}
+
+std::array<int, 2> InteriorExtrema(const MorseSmaleComplex& complex)
+{
+  std::array<int, 2> counts{ 0, 0 };
+  for (const auto& cp : complex.CriticalPoints)
+  {
+    if (!cp.OnBoundary && cp.MorseIndex != 1)
+    {
+      ++counts[cp.MorseIndex / 2];
+    }
+  }
+  return counts;
+}
+
+void CheckCase(const char* name, const GridField& grid, double percent, int k, int resolution)
+{
+  Pipeline p;
+  std::string error;
+  CHECK(RunStages1To3(grid, percent, k, p, error));
+  if (!error.empty())
+  {
+    std::printf("  %s: %s\n", name, error.c_str());
+    return;
+  }
+  FieldReconstruction reconstruction;
+  reconstruction.OutputResolution = resolution;
+  FieldReconstructionReport report;
+  CHECK(reconstruction.Run(p.Field, p.Simplified.Complex, p.Smoothed, report, error));
+  const std::size_t n = p.Field.Values.size();
+  CHECK_EQ(report.Values.size(), n);
+  CHECK_EQ(report.Exact.size(), n);
+  CHECK_EQ(report.CellOfVertex.size(), n);
+
+  // Errors, recomputed.
+  double largest = 0, squares = 0;
+  bool differences = true;
+  for (std::size_t v = 0; v < n; ++v)
+  {
+    const double d = report.Values[v] - p.Field.Values[v];
+    differences = differences && report.Difference[v] == d;
+    largest = std::max(largest, std::abs(d));
+    squares += d * d;
+  }
+  CHECK(differences);
+  CHECK(report.MaximumError == largest);
+  CHECK(std::abs(report.RMSError - std::sqrt(squares / n)) <= 1e-12 * (1 + report.RMSError));
+  CHECK(report.ValueRange[1] - report.ValueRange[0] == p.Range);
+
+  // Topological sampling: the changes it reports are the ones made.
+  std::size_t changed = 0;
+  double largestChange = 0;
+  for (std::size_t v = 0; v < n; ++v)
+  {
+    if (report.Values[v] != report.Exact[v])
+    {
+      ++changed;
+      largestChange = std::max(largestChange, std::abs(report.Values[v] - report.Exact[v]));
+    }
+  }
+  if (resolution == 1)
+  {
+    CHECK_EQ(static_cast<std::size_t>(report.Sampling.ChangedVertices), changed);
+    CHECK(report.Sampling.MaximumChange == largestChange);
+  }
+  else
+  {
+    CHECK(static_cast<std::size_t>(report.Sampling.ChangedVertices) >= changed);
+    CHECK(report.Sampling.MaximumChange >= largestChange);
+  }
+
+  // The finer grid spans the input grid.
+  const int nx = p.Field.GridDimensions[0], ny = p.Field.GridDimensions[1];
+  if (resolution > 1)
+  {
+    CHECK_EQ(report.Finer.Dimensions[0], (nx - 1) * resolution + 1);
+    CHECK_EQ(report.Finer.Dimensions[1], (ny - 1) * resolution + 1);
+    CHECK_EQ(report.FinerValues.size(), report.Finer.NumberOfPoints());
+    const double* last = &p.Field.Points[2 * (n - 1)];
+    for (int axis = 0; axis < 2; ++axis)
+    {
+      CHECK(report.Finer.Origin[axis] == p.Field.Points[axis]);
+      const double end = report.Finer.Origin[axis] + (report.Finer.Dimensions[axis] - 1) * report.Finer.Spacing[axis];
+      CHECK(std::abs(end - last[axis]) <= 1e-9 * (1 + std::abs(last[axis])));
+    }
+  }
+
+  // Without topological sampling the values are F o Phi itself: the Exact of the run above.
+  FieldReconstruction raw;
+  raw.OutputResolution = resolution;
+  raw.TopologicalSampling = false;
+  raw.VerifyTopology = false;
+  FieldReconstructionReport rawReport;
+  CHECK(raw.Run(p.Field, p.Simplified.Complex, p.Smoothed, rawReport, error));
+  CHECK(rawReport.Values == report.Exact);
+  CHECK(rawReport.Exact.empty() && !rawReport.Sampled && !rawReport.VerificationRan);
+
+  // One thread or several: the same report.
+  FieldReconstruction threaded;
+  threaded.OutputResolution = resolution;
+  threaded.Parallel = ThreadedFor;
+  FieldReconstructionReport threadedReport;
+  CHECK(threaded.Run(p.Field, p.Simplified.Complex, p.Smoothed, threadedReport, error));
+  CHECK(threadedReport.Values == report.Values);
+  CHECK(threadedReport.FinerValues == report.FinerValues);
+  CHECK(threadedReport.Verified == report.Verified);
+
+  // The verdict, against an independent count.
+  PlanarScalarField sampled = p.Field;
+  sampled.Values = report.Values;
+  const auto found = InteriorExtrema(sampled);
+  const auto wanted = InteriorExtrema(p.Simplified.Complex);
+  std::printf("  %s %g%% k=%d x%d: %d cells (%d failed), verdict %d, interior minima %d/%d maxima %d/%d, "
+              "max error %.3g, RMS %.3g, %d vertices changed by sampling\n",
+    name, percent, k, resolution, report.Cells.Cells, report.Cells.FailedCells, report.Verified ? 1 : 0, found[0],
+    wanted[0], found[1], wanted[1], report.MaximumError, report.RMSError, report.Sampling.ChangedVertices);
+  CHECK(report.Verified);
+  if (report.Verified)
+  {
+    CHECK(found == wanted);
+  }
+}
+} // namespace
+
+TEST_CASE(ShepardAtTwoThresholds)
+{
+  CheckCase("shepard", ShepardField(50, 2.0, 120, 3), 5, 4, 1);
+  CheckCase("shepard", ShepardField(50, 2.0, 120, 3), 25, 7, 2);
+}
+
+TEST_CASE(TrigonometricAtTwoThresholds)
+{
+  CheckCase("trigonometric", TrigonometricField(10, 100, -49), 0, 4, 2);
+  CheckCase("trigonometric", TrigonometricField(10, 100, -49), 25, 4, 1);
+}
+
+int main()
+{
+  return testing_harness::RunAll();
+}

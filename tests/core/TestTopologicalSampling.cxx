@@ -1,0 +1,266 @@
+// Tests of topological sampling's own mechanisms on made-up fields: the floods remove the
+// extrema noise adds and settle on plateaus, a dented boundary saddle gets a way up, and a
+// ridge running between two rows of vertices is carved in. Each sampled result is checked by
+// extracting its critical points again (stage 1) against the wanted complex. (The whole
+// sequence on real reconstructions is tested in TestFieldReconstruction.)
+//
+// Usage: TestTopologicalSampling
+// Prints figures per case, then "N passed, N failed"; returns nonzero on failure.
+#include "MorseSmaleComplexExtraction.h"
+#include "SyntheticFields.h"
+#include "TestHarness.h"
+#include "TopologicalSampling.h"
+#include "TopologyVerification.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+using namespace topospline;
+
+namespace
+{
+// A smooth trigonometric field on an 80 x 80 grid, its complex (the wanted one) and the
+// sampling constraints it gives.
+struct SamplingCase
+{
+  PlanarScalarField Field;
+  MorseSmaleComplex Wanted;
+  TriangleMeshTopology Mesh;
+  SamplingConstraints Constraints;
+};
+
+SamplingCase TrigonometricSamplingCase()
+{
+  SamplingCase c;
+  const GridField smooth = TrigonometricField(10, 80, -40);
+  c.Field = FieldOnGrid(smooth);
+  MorseSmaleComplexExtraction extraction;
+  std::string error;
+  CHECK(extraction.Extract(c.Field, c.Wanted, error));
+  c.Mesh.BuildGrid(smooth.Dimensions[0], smooth.Dimensions[1], SequentialFor);
+  c.Constraints = ComplexConstraints(c.Wanted, c.Mesh, c.Mesh, [](Index v) { return v; });
+  return c;
+}
+} // namespace
+
+TEST_CASE(TopologicalSamplingRemovesNoiseExtrema)
+{
+  // A smooth field's complex is the wanted one; noise adds hundreds of small extrema, which
+  // the flooding must remove, leaving exactly the smooth field's critical points, with values
+  // moved by less than the noise amplitude.
+  const SamplingCase smooth = TrigonometricSamplingCase();
+  const PlanarScalarField& field = smooth.Field;
+  const MorseSmaleComplex& wanted = smooth.Wanted;
+  const TriangleMeshTopology& mesh = smooth.Mesh;
+  const SamplingConstraints& constraints = smooth.Constraints;
+  MorseSmaleComplexExtraction extraction;
+  std::string error;
+  for (int seed : { 1, 2, 3 })
+  {
+    std::mt19937_64 random(seed);
+    std::uniform_real_distribution<double> noise(-0.5, 0.5);
+    PlanarScalarField noisy = field;
+    for (double& v : noisy.Values)
+    {
+      v += noise(random);
+    }
+    MorseSmaleComplex before;
+    CHECK(extraction.Extract(noisy, before, error));
+    const auto report = EnforceCriticalVertices(mesh, constraints, noisy.Values);
+    MorseSmaleComplex after;
+    CHECK(extraction.Extract(noisy, after, error));
+    const auto comparison = CompareCriticalPoints(CriticalPointLocations(wanted, field.Points),
+      CriticalPointLocations(after, noisy.Points), 3.0);
+    std::printf("  seed %d: %zu critical points, %zu with noise, %zu after (%d rounds, %d vertices moved, at most "
+                "%.3g); %zu spurious, %zu missing within 3 spacings\n",
+      seed, wanted.CriticalPoints.size(), before.CriticalPoints.size(), after.CriticalPoints.size(), report.Rounds,
+      report.ChangedVertices, report.MaximumChange, comparison.Spurious.size(), comparison.Missing.size());
+    CHECK(before.CriticalPoints.size() > 2 * wanted.CriticalPoints.size());
+    CHECK(report.Converged);
+    CHECK(comparison.Expected == comparison.Found);
+    CHECK(report.MaximumChange <= 1.0 + 1e-12); // at most the noise range
+  }
+}
+
+TEST_CASE(BoundarySaddleAboveItsLinkGetsAWayUp)
+{
+  // A wanted boundary saddle (a maximum of the boundary curve) whose interior neighbours all
+  // lie below it is a maximum of the sampling. Cutting it made it a pit of the boundary curve,
+  // which the boundary pass filled again: the passes undid each other and never converged.
+  // It must keep its value and get a rising path into the domain instead.
+  const SamplingCase smooth = TrigonometricSamplingCase();
+  const PlanarScalarField& field = smooth.Field;
+  const TriangleMeshTopology& mesh = smooth.Mesh;
+  const SamplingConstraints& constraints = smooth.Constraints;
+  MorseSmaleComplexExtraction extraction;
+  std::string error;
+  CHECK(!constraints.BoundaryMaxima.empty());
+  int tried = 0;
+  for (Index saddle : constraints.BoundaryMaxima)
+  {
+    PlanarScalarField dented = field;
+    for (Index i = mesh.VertexTriangleBegin(saddle); i < mesh.VertexTriangleEnd(saddle); ++i)
+    {
+      for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
+      {
+        if (!mesh.IsBoundaryVertex(w))
+        {
+          dented.Values[w] = std::min(dented.Values[w], field.Values[saddle] - 0.25);
+        }
+      }
+    }
+    const auto report = EnforceCriticalVertices(mesh, constraints, dented.Values);
+    MorseSmaleComplex after;
+    CHECK(extraction.Extract(dented, after, error));
+    CHECK(report.Converged);
+    CHECK(after.CountByIndex() == smooth.Wanted.CountByIndex());
+    CHECK_EQ(dented.Values[saddle], field.Values[saddle]);
+    ++tried;
+  }
+  std::printf("  %d boundary saddles dented, each converged with the wanted counts\n", tried);
+}
+
+TEST_CASE(TopologicalSamplingSettlesOnPlateaus)
+{
+  // Flat areas (terraces, lakes: thousands of vertices of one value) with pits and peaks in
+  // them: filling a pit to just above the plateau made it a peak of the plateau, cutting that
+  // made a pit again, by a few ulps per round, without end. The sweeps must settle and leave
+  // exactly the wanted critical points.
+  const SamplingCase smooth = TrigonometricSamplingCase();
+  const PlanarScalarField& field = smooth.Field;
+  const TriangleMeshTopology& mesh = smooth.Mesh;
+  MorseSmaleComplexExtraction extraction;
+  std::string error;
+  const int nx = field.GridDimensions[0], ny = field.GridDimensions[1];
+  int settled = 0, cases = 0;
+  for (int seed : { 1, 2, 3, 4, 5, 6 })
+  {
+    std::mt19937_64 random(seed);
+    PlanarScalarField terraced = field;
+    std::uniform_int_distribution<int> centre(8, std::min(nx, ny) - 9);
+    for (int disk = 0; disk < 6; ++disk)
+    {
+      const int ci = centre(random), cj = centre(random);
+      const Index c = static_cast<Index>(cj) * nx + ci;
+      // Far from wanted critical points, so that the flat area only adds spurious ones.
+      bool nearWanted = false;
+      for (const CriticalPoint& cp : smooth.Wanted.CriticalPoints)
+      {
+        nearWanted = nearWanted || std::hypot(field.Points[2 * cp.Vertex] - field.Points[2 * c],
+                                     field.Points[2 * cp.Vertex + 1] - field.Points[2 * c + 1]) < 8;
+      }
+      if (nearWanted)
+      {
+        continue;
+      }
+      const double level = field.Values[c];
+      for (int j = cj - 5; j <= cj + 5; ++j)
+      {
+        for (int i = ci - 5; i <= ci + 5; ++i)
+        {
+          if ((i - ci) * (i - ci) + (j - cj) * (j - cj) <= 25)
+          {
+            terraced.Values[static_cast<Index>(j) * nx + i] = level;
+          }
+        }
+      }
+      terraced.Values[c + 1] = level - 0.1; // a pit
+      terraced.Values[c - 2 * nx] = level - 0.1;
+      terraced.Values[c + 2 * nx] = level + 0.1; // a peak
+    }
+    const auto report = EnforceCriticalVertices(mesh, smooth.Constraints, terraced.Values);
+    MorseSmaleComplex after;
+    CHECK(extraction.Extract(terraced, after, error));
+    const bool exact = after.CountByIndex() == smooth.Wanted.CountByIndex();
+    std::printf("  seed %d: %d rounds, converged %d, counts %s\n", seed, report.Rounds, report.Converged ? 1 : 0,
+      exact ? "exact" : "wrong");
+    CHECK(report.Converged);
+    CHECK(exact);
+    settled += report.Converged && exact ? 1 : 0;
+    ++cases;
+  }
+  std::printf("  %d of %d terraced fields settled with the wanted counts\n", settled, cases);
+}
+
+TEST_CASE(NarrowRidgeBetweenRowsIsCarvedIn)
+{
+  // A ridge (an ascending 1-cell) rising slowly along x while it wanders between two rows of
+  // vertices: every vertex lies on a flank, at a distance from the crest that changes from
+  // column to column, so the sampled ridge breaks into islands, each a spurious maximum that
+  // the floods would cut down. Carving the 1-cell in must leave one rising chain of vertices
+  // along it: no maximum on the way, values changed by less than the ridge's relief there.
+  const int nx = 60, ny = 11;
+  const double startX = 5, endX = 50;
+  auto crest = [](double x) { return 5 + 0.45 * std::sin(0.7 * x); };
+  auto height = [&](double x) { return 0.01 * std::min(x, endX) - 0.05 * std::max(0.0, x - endX); };
+  PlanarScalarField field;
+  field.GridDimensions[0] = nx;
+  field.GridDimensions[1] = ny;
+  for (int j = 0; j < ny; ++j)
+  {
+    for (int i = 0; i < nx; ++i)
+    {
+      field.Points.insert(field.Points.end(), { double(i), double(j) });
+      field.Values.push_back(height(i) - 10 * std::abs(j - crest(i)));
+    }
+  }
+  TriangleMeshTopology mesh;
+  mesh.BuildGrid(nx, ny, SequentialFor);
+  auto vertexNear = [&](double x, double y) { return static_cast<Index>(std::lround(y)) * nx + std::lround(x); };
+  SamplingConstraints constraints;
+  SaddleOneCell ridge;
+  ridge.Saddle = vertexNear(startX, crest(startX));
+  ridge.Ascending = true;
+  for (double x = startX; x <= endX + 1e-9; x += 0.125)
+  {
+    ridge.Points.insert(ridge.Points.end(), { x, crest(x), height(x) });
+  }
+  constraints.OneCells.push_back(ridge);
+  constraints.Saddles.push_back(ridge.Saddle);
+  constraints.Maxima.push_back(vertexNear(endX, crest(endX)));
+  // Interior maxima along the ridge, away from its two ends.
+  auto maximaOnTheWay = [&](const std::vector<double>& values) {
+    int count = 0;
+    for (int j = 1; j + 1 < ny; ++j)
+    {
+      for (int i = static_cast<int>(startX) + 2; i <= static_cast<int>(endX) - 2; ++i)
+      {
+        const Index v = static_cast<Index>(j) * nx + i;
+        bool highest = true;
+        for (Index i2 = mesh.VertexTriangleBegin(v); i2 < mesh.VertexTriangleEnd(v); ++i2)
+        {
+          for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i2)])
+          {
+            highest = highest && (w == v || values[w] < values[v] || (values[w] == values[v] && w < v));
+          }
+        }
+        count += highest ? 1 : 0;
+      }
+    }
+    return count;
+  };
+  std::vector<double> carved = field.Values;
+  const int before = maximaOnTheWay(carved);
+  const Index changed = CarveOneCells(field, mesh, constraints, 1.0, carved);
+  const int after = maximaOnTheWay(carved);
+  double largestChange = 0;
+  for (std::size_t v = 0; v < carved.size(); ++v)
+  {
+    largestChange = std::max(largestChange, std::abs(carved[v] - field.Values[v]));
+  }
+  std::printf("  %d maxima along the ridge before carving, %d after; %d vertices raised, by at most %.3g\n", before,
+    after, changed, largestChange);
+  CHECK(before >= 5);
+  CHECK_EQ(after, 0);
+  CHECK(largestChange <= 10 * 0.5 + 1e-9); // at most the fall from the crest to a vertex half a row away
+  CHECK_EQ(carved[ridge.Saddle], field.Values[ridge.Saddle]);
+}
+
+int main()
+{
+  return testing_harness::RunAll();
+}
