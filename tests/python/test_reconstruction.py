@@ -123,8 +123,9 @@ for name, source in inputs:
     source.UpdatePipeline()
     points = source.GetDataInformation().GetNumberOfPoints()
     # 4x finer: the topology must hold on a finer sampling too. The 2000 x 2000 terrain at 4x
-    # is 64M vertices: measured 16.3 GB at peak (about 200 bytes per fine vertex on top of the 4M-vertex pipeline), so
-    # on a machine with less memory the check falls back to 2x, and says so.
+    # is 64M vertices: measured 16.3 GB at peak (about 200 bytes per fine vertex on top of the
+    # 4M-vertex pipeline), so on a machine with less memory the check falls back to 2x, and
+    # says so.
     resolution = 4
     needed = 3e9 + 260 * 16 * points
     if needed > tt.physical_memory():
