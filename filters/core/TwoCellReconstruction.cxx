@@ -437,6 +437,60 @@ std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const
   return result;
 }
 
+namespace
+{
+// Twice the signed area of a closed walk (x, y per point).
+double DoubleSignedArea(const std::vector<double>& walk)
+{
+  double area = 0;
+  for (std::size_t i = 0, count = walk.size() / 2; i < count; ++i)
+  {
+    const std::size_t j = (i + 1) % count;
+    area += walk[2 * i] * walk[2 * j + 1] - walk[2 * j] * walk[2 * i + 1];
+  }
+  return area;
+}
+
+// The mean distance between consecutive points of a closed walk.
+double MeanSampleSpacing(const std::vector<double>& walk)
+{
+  double perimeter = 0;
+  const std::size_t samples = walk.size() / 2;
+  for (std::size_t i = 0; i < samples; ++i)
+  {
+    const std::size_t j = (i + 1) % samples;
+    perimeter += std::hypot(walk[2 * j] - walk[2 * i], walk[2 * j + 1] - walk[2 * i + 1]);
+  }
+  return perimeter / std::max<std::size_t>(samples, 1);
+}
+
+// Where merged 1-cells leave a stem at the minimum (maximum) inside the cell, the stem stays
+// on the boundary as a slit (merge = false) rather than the junction taking the corner. The
+// first choice follows a point-in-polygon test; as that test can be fooled by a walk that is
+// not simple, the other choices follow.
+std::vector<std::array<bool, 2>> StemChoices(const TwoCell& twoCell, const TwoCellSides& sides,
+  const OneCellSmoothingResult& smoothed, const std::vector<double>& walk)
+{
+  const bool stemAtMinimum = sides.MinimumShifted, stemAtMaximum = sides.MaximumShifted;
+  const std::array<bool, 2> merge = { { !(stemAtMinimum && InsidePolygon(walk, StartOf(smoothed, twoCell.BoundaryOneCells[0]))),
+    !(stemAtMaximum && InsidePolygon(walk, EndOf(smoothed, twoCell.BoundaryOneCells[1]))) } };
+  std::vector<std::array<bool, 2>> choices = { merge };
+  if (stemAtMinimum)
+  {
+    choices.push_back({ { !merge[0], merge[1] } });
+  }
+  if (stemAtMaximum)
+  {
+    choices.push_back({ { merge[0], !merge[1] } });
+  }
+  if (stemAtMinimum && stemAtMaximum)
+  {
+    choices.push_back({ { !merge[0], !merge[1] } });
+  }
+  return choices;
+}
+} // namespace
+
 bool TwoCellReconstruction::Reconstruct(
   const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed, std::string& error)
 {
@@ -465,105 +519,7 @@ bool TwoCellReconstruction::Reconstruct(
   this->Parallel(0, n, [&](Index begin, Index end) {
     for (Index c = begin; c < end && !this->Hooks.Aborted(); ++c)
     {
-      ReconstructedTwoCell& cell = *this->Cells[c];
-      std::string message;
-      const TwoCell& twoCell = complex.TwoCells[c];
-      std::vector<double> walk, parameters;
-      auto assemble = [&](bool mergeAtMinimum, bool mergeAtMaximum) {
-        if (!AssembleTwoCellSides(twoCell, smoothed, cell.Sides, message, mergeAtMinimum, mergeAtMaximum))
-        {
-          return false;
-        }
-        if (!BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed), this->BoundarySamples,
-              this->MaximumGridSize, walk, parameters, boundaries[c]))
-        {
-          message = "its sides need more than " + std::to_string(this->MaximumGridSize) + " segments each";
-          return false;
-        }
-        return true;
-      };
-      // The paper's rule first (merged 1-cells: the junction takes the corner); a stem that
-      // ends inside the resulting walk is the cell's own, and stays on its boundary as a slit.
-      if (!assemble(true, true))
-      {
-        cell.Error = message;
-        continue;
-      }
-      const bool stemAtMinimum = cell.Sides.MinimumShifted, stemAtMaximum = cell.Sides.MaximumShifted;
-      std::array<bool, 2> merge = { { !(stemAtMinimum && InsidePolygon(walk, StartOf(smoothed, twoCell.BoundaryOneCells[0]))),
-        !(stemAtMaximum && InsidePolygon(walk, EndOf(smoothed, twoCell.BoundaryOneCells[1]))) } };
-      // The point-in-polygon test can be fooled by a walk that is not simple: if the
-      // parameterization refuses the chosen assembly, the other choices for the stems follow.
-      std::vector<std::array<bool, 2>> choices = { merge };
-      if (stemAtMinimum)
-      {
-        choices.push_back({ { !merge[0], merge[1] } });
-      }
-      if (stemAtMaximum)
-      {
-        choices.push_back({ { merge[0], !merge[1] } });
-      }
-      if (stemAtMinimum && stemAtMaximum)
-      {
-        choices.push_back({ { !merge[0], !merge[1] } });
-      }
-      std::string firstError;
-      for (const auto& choice : choices)
-      {
-        if (!assemble(choice[0], choice[1]))
-        {
-          firstError = firstError.empty() ? message : firstError;
-          continue;
-        }
-        // Cells of (almost) no area, e.g. a zero-persistence pair on the domain boundary whose
-        // 1-cells run on top of each other, hold no vertex: they are skipped, and counted.
-        double area = 0;
-        for (std::size_t i = 0, count = walk.size() / 2; i < count; ++i)
-        {
-          const std::size_t j = (i + 1) % count;
-          area += walk[2 * i] * walk[2 * j + 1] - walk[2 * j] * walk[2 * i + 1];
-        }
-        if (std::abs(0.5 * area) <= this->NegligibleArea)
-        {
-          cell.Negligible = true;
-          break;
-        }
-        cell.Bounds[0] = cell.Bounds[2] = std::numeric_limits<double>::infinity();
-        cell.Bounds[1] = cell.Bounds[3] = -std::numeric_limits<double>::infinity();
-        for (std::size_t i = 0; i < walk.size(); i += 2)
-        {
-          cell.Bounds[0] = std::min(cell.Bounds[0], walk[i]);
-          cell.Bounds[1] = std::max(cell.Bounds[1], walk[i]);
-          cell.Bounds[2] = std::min(cell.Bounds[2], walk[i + 1]);
-          cell.Bounds[3] = std::max(cell.Bounds[3], walk[i + 1]);
-        }
-        // The paper's interior triangle size is the mean boundary sample spacing; dense samples
-        // on short 1-cells (large k) would make it far finer than the input grid, which only
-        // costs time: it is kept at least MinimumMeshEdgeLength.
-        double perimeter = 0;
-        const std::size_t samples = walk.size() / 2;
-        for (std::size_t i = 0; i < samples; ++i)
-        {
-          const std::size_t j = (i + 1) % samples;
-          perimeter += std::hypot(walk[2 * j] - walk[2 * i], walk[2 * j + 1] - walk[2 * i + 1]);
-        }
-        const double spacing = perimeter / std::max<std::size_t>(samples, 1);
-        cell.Parameterization.TargetEdgeLength = std::max(spacing, this->MinimumMeshEdgeLength);
-        if (cell.Parameterization.Parameterize(walk, parameters, message))
-        {
-          cell.Valid = true;
-          break;
-        }
-        firstError = firstError.empty() ? "parameterization: " + message : firstError;
-      }
-      if (cell.Negligible)
-      {
-        cell.Error = "it has no area";
-      }
-      else if (!cell.Valid)
-      {
-        cell.Error = firstError;
-      }
+      this->ParameterizeCell(complex.TwoCells[c], smoothed, *this->Cells[c], boundaries[c]);
     }
   });
   if (this->Hooks.Aborted())
@@ -579,37 +535,120 @@ bool TwoCellReconstruction::Reconstruct(
   this->Parallel(0, n, [&](Index begin, Index end) {
     for (Index c = begin; c < end; ++c)
     {
-      ReconstructedTwoCell& cell = *this->Cells[c];
-      if (!cell.Valid)
-      {
-        continue;
-      }
-      const MonotoneSurfaceBoundary& subdivided = boundaries[c]; // already at the grid layout
-      const int count = static_cast<int>(subdivided.Bottom.size());
-      std::string message;
-      MonotoneSurfaceOptions options;
-      // Subdivision and the B-spline conversion round the segment joins by ~1e-12 relative to
-      // the values, which can exceed 1e-9 of a small cell's own range.
-      options.ConsistencyTolerance = 1e-7;
-      // A flat valley floor or ridge top along the 1-cells (see MonotoneSurfaceOptions).
-      options.FlatAcrossBoundary = true;
-      // False also when the conditions are infeasible somewhere: the surface is then built
-      // anyway and its violating cells are counted (Surface.Report()).
-      cell.Surface.Build(subdivided, message, options);
-      if (cell.Surface.GetGridSize() != count)
-      {
-        // Malformed boundary data (not merely infeasible conditions): no surface at all.
-        cell.Valid = false;
-        cell.Error = "surface: " + message;
-        continue;
-      }
-      cell.GridSize = count;
+      BuildSurface(*this->Cells[c], boundaries[c]);
     }
   });
   this->Summary.SurfaceSeconds = Seconds(start);
+  this->Summarize();
+  this->BuildCellLocator();
+  this->Hooks.Report(1.0);
+  return true;
+}
 
+// The cell's sides assembled, sampled into a closed walk, triangulated and mapped onto the
+// unit square; `boundary` receives its sides' Bezier segments at the grid layout.
+void TwoCellReconstruction::ParameterizeCell(const TwoCell& twoCell, const OneCellSmoothingResult& smoothed,
+  ReconstructedTwoCell& cell, MonotoneSurfaceBoundary& boundary) const
+{
+  std::string message;
+  std::vector<double> walk, parameters;
+  auto assemble = [&](bool mergeAtMinimum, bool mergeAtMaximum) {
+    if (!AssembleTwoCellSides(twoCell, smoothed, cell.Sides, message, mergeAtMinimum, mergeAtMaximum))
+    {
+      return false;
+    }
+    if (!BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed), this->BoundarySamples, this->MaximumGridSize,
+          walk, parameters, boundary))
+    {
+      message = "its sides need more than " + std::to_string(this->MaximumGridSize) + " segments each";
+      return false;
+    }
+    return true;
+  };
+  // The paper's rule first (merged 1-cells: the junction takes the corner); a stem that ends
+  // inside the resulting walk is the cell's own, and stays on its boundary as a slit.
+  if (!assemble(true, true))
+  {
+    cell.Error = message;
+    return;
+  }
+  std::string firstError;
+  for (const auto& choice : StemChoices(twoCell, cell.Sides, smoothed, walk))
+  {
+    if (!assemble(choice[0], choice[1]))
+    {
+      firstError = firstError.empty() ? message : firstError;
+      continue;
+    }
+    // Cells of (almost) no area, e.g. a zero-persistence pair on the domain boundary whose
+    // 1-cells run on top of each other, hold no vertex: they are skipped, and counted.
+    if (std::abs(0.5 * DoubleSignedArea(walk)) <= this->NegligibleArea)
+    {
+      cell.Negligible = true;
+      break;
+    }
+    cell.Bounds[0] = cell.Bounds[2] = std::numeric_limits<double>::infinity();
+    cell.Bounds[1] = cell.Bounds[3] = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < walk.size(); i += 2)
+    {
+      cell.Bounds[0] = std::min(cell.Bounds[0], walk[i]);
+      cell.Bounds[1] = std::max(cell.Bounds[1], walk[i]);
+      cell.Bounds[2] = std::min(cell.Bounds[2], walk[i + 1]);
+      cell.Bounds[3] = std::max(cell.Bounds[3], walk[i + 1]);
+    }
+    // The paper's interior triangle size is the mean boundary sample spacing; dense samples on
+    // short 1-cells (large k) would make it far finer than the input grid, which only costs
+    // time: it is kept at least MinimumMeshEdgeLength.
+    cell.Parameterization.TargetEdgeLength = std::max(MeanSampleSpacing(walk), this->MinimumMeshEdgeLength);
+    if (cell.Parameterization.Parameterize(walk, parameters, message))
+    {
+      cell.Valid = true;
+      break;
+    }
+    firstError = firstError.empty() ? "parameterization: " + message : firstError;
+  }
+  if (cell.Negligible)
+  {
+    cell.Error = "it has no area";
+  }
+  else if (!cell.Valid)
+  {
+    cell.Error = firstError;
+  }
+}
+
+// The monotone Sibson surface on the square from the cell's subdivided sides.
+void TwoCellReconstruction::BuildSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided)
+{
+  if (!cell.Valid)
+  {
+    return;
+  }
+  const int count = static_cast<int>(subdivided.Bottom.size());
+  std::string message;
+  MonotoneSurfaceOptions options;
+  // Subdivision and the B-spline conversion round the segment joins by ~1e-12 relative to the
+  // values, which can exceed 1e-9 of a small cell's own range.
+  options.ConsistencyTolerance = 1e-7;
+  // A flat valley floor or ridge top along the 1-cells (see MonotoneSurfaceOptions).
+  options.FlatAcrossBoundary = true;
+  // False also when the conditions are infeasible somewhere: the surface is then built anyway
+  // and its violating cells are counted (Surface.Report()).
+  cell.Surface.Build(subdivided, message, options);
+  if (cell.Surface.GetGridSize() != count)
+  {
+    // Malformed boundary data (not merely infeasible conditions): no surface at all.
+    cell.Valid = false;
+    cell.Error = "surface: " + message;
+    return;
+  }
+  cell.GridSize = count;
+}
+
+void TwoCellReconstruction::Summarize()
+{
   auto& s = this->Summary;
-  s.Cells = n;
+  s.Cells = static_cast<Index>(this->Cells.size());
   for (const auto& cell : this->Cells)
   {
     if (!cell->Valid)
@@ -627,9 +666,6 @@ bool TwoCellReconstruction::Reconstruct(
     s.BezierTriangles += 4 * cell->GridSize * cell->GridSize;
     s.MaximumGridSize = std::max(s.MaximumGridSize, cell->GridSize);
   }
-  this->BuildCellLocator();
-  this->Hooks.Report(1.0);
-  return true;
 }
 
 void TwoCellReconstruction::BuildCellLocator()

@@ -169,7 +169,10 @@ public:
   std::vector<PlanarBezierTriangle> PlanarBezierTriangles(Index c) const;
 
 private:
-  void ReconstructCell(Index c, const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed);
+  void ParameterizeCell(const TwoCell& twoCell, const OneCellSmoothingResult& smoothed, ReconstructedTwoCell& cell,
+    MonotoneSurfaceBoundary& boundary) const;
+  static void BuildSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided);
+  void Summarize();
   void BuildCellLocator();
   bool EvaluateInCell(Index c, double x, double y, double& value) const;
 
