@@ -336,139 +336,186 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
   const SamplingConstraints& constraints, Index saddle, double radius, std::vector<double>& values);
 } // namespace
 
+namespace
+{
+// Vertex adjacency of a mesh: along all edges, and along boundary edges only (the boundary curve).
+struct VertexGraphs
+{
+  Graph All, Boundary;
+
+  explicit VertexGraphs(const TriangleMeshTopology& mesh)
+  {
+    const Index n = mesh.NumberOfVertices();
+    this->All.Start.assign(n + 1, 0);
+    this->Boundary.Start.assign(n + 1, 0);
+    for (Index e = 0; e < mesh.NumberOfEdges(); ++e)
+    {
+      for (Index v : mesh.EdgeVertices[e])
+      {
+        ++this->All.Start[v + 1];
+        this->Boundary.Start[v + 1] += mesh.IsBoundaryEdge(e) ? 1 : 0;
+      }
+    }
+    for (Index v = 0; v < n; ++v)
+    {
+      this->All.Start[v + 1] += this->All.Start[v];
+      this->Boundary.Start[v + 1] += this->Boundary.Start[v];
+    }
+    this->All.Adjacent.resize(this->All.Start[n]);
+    this->Boundary.Adjacent.resize(this->Boundary.Start[n]);
+    std::vector<Index> fill(this->All.Start.begin(), this->All.Start.end() - 1);
+    std::vector<Index> boundaryFill(this->Boundary.Start.begin(), this->Boundary.Start.end() - 1);
+    for (Index e = 0; e < mesh.NumberOfEdges(); ++e)
+    {
+      const Index a = mesh.EdgeVertices[e][0], b = mesh.EdgeVertices[e][1];
+      this->All.Adjacent[fill[a]++] = b;
+      this->All.Adjacent[fill[b]++] = a;
+      if (mesh.IsBoundaryEdge(e))
+      {
+        this->Boundary.Adjacent[boundaryFill[a]++] = b;
+        this->Boundary.Adjacent[boundaryFill[b]++] = a;
+      }
+    }
+  }
+};
+
+// One sweep of the floods: every unwanted extremum of one kind (pits when ascending, peaks
+// otherwise) along the boundary curve or over whole links is filled (cut), or a wanted boundary
+// saddle above its whole link gets a way up.
+class FloodPass
+{
+public:
+  // Bits of Wanted: which constraint wants a vertex as an extremum.
+  enum : unsigned char
+  {
+    WantedMinimum = 1,
+    WantedMaximum = 2,
+    WantedBoundaryMinimum = 4,
+    WantedBoundaryMaximum = 8
+  };
+
+  FloodPass(const TriangleMeshTopology& mesh, const SamplingConstraints& constraints)
+    : Mesh(mesh)
+    , Graphs(mesh)
+    , Wanted(mesh.NumberOfVertices(), 0)
+    , Mark(mesh.NumberOfVertices(), 0)
+  {
+    for (Index v : constraints.Minima)
+    {
+      this->Wanted[v] |= WantedMinimum;
+    }
+    for (Index v : constraints.Maxima)
+    {
+      this->Wanted[v] |= WantedMaximum;
+    }
+    for (Index v : constraints.BoundaryMinima)
+    {
+      this->Wanted[v] |= WantedBoundaryMinimum;
+    }
+    for (Index v : constraints.BoundaryMaxima)
+    {
+      this->Wanted[v] |= WantedBoundaryMaximum;
+    }
+  }
+
+  // One round: along the boundary curve first (stage 1's boundary rule), then whole links.
+  // Returns the number of changed vertices.
+  Index Round(std::vector<double>& values)
+  {
+    Index changed = this->Sweep(this->Graphs.Boundary, true, WantedBoundaryMinimum, values);
+    changed += this->Sweep(this->Graphs.Boundary, false, WantedBoundaryMaximum, values);
+    changed += this->Sweep(this->Graphs.All, true, WantedMinimum, values);
+    changed += this->Sweep(this->Graphs.All, false, WantedMaximum, values);
+    return changed;
+  }
+
+private:
+  Index Sweep(const Graph& graph, bool ascending, unsigned char flag, std::vector<double>& values)
+  {
+    const TriangleMeshTopology& mesh = this->Mesh;
+    const std::vector<unsigned char>& wanted = this->Wanted;
+    Index changed = 0;
+    std::vector<Index> candidates;
+    // Boundary vertices belong to the boundary passes, which ran first: an extremum of the
+    // whole link on the boundary is one of the boundary curve too, so those passes already
+    // removed it unless it is wanted there. If the whole-link passes lowered or raised them as
+    // well, the two would undo each other by a few ulps per round, walking along the boundary.
+    // So here they are skipped and fixed (floods drain into them), except a wanted boundary
+    // saddle above its whole link, which gets a way up.
+    const bool wholeLink = &graph == &this->Graphs.All;
+    auto getsWayUp = [&](Index v) { return flag == WantedMaximum && (wanted[v] & WantedBoundaryMaximum); };
+    auto isCandidate = [&](Index v) {
+      return !(wanted[v] & flag) && !(wholeLink && mesh.IsBoundaryVertex(v) && !getsWayUp(v)) &&
+        IsExtremum(graph, values, v, ascending);
+    };
+    for (Index v = mesh.NumberOfVertices() - 1; v >= 0; --v) // taken from the back: in vertex order
+    {
+      if (isCandidate(v))
+      {
+        candidates.push_back(v);
+      }
+    }
+    // A fill can leave a vertex next to its region with no lower neighbour (a cut, no higher
+    // one) where values differ by a few ulps (a nearly flat patch): such vertices are taken in
+    // the same pass, not a round later, so that a pit chain along an ulp-level valley drains in
+    // one pass instead of creeping up by a few ulps per round. Bounded, in case a fill and a
+    // way up undo each other vertex by vertex.
+    std::vector<Index> revalued;
+    std::size_t fills = 0;
+    const std::size_t maximumFills = 4 * candidates.size() + 4096;
+    while (!candidates.empty() && fills < maximumFills)
+    {
+      const Index v = candidates.back();
+      candidates.pop_back();
+      if (!IsExtremum(graph, values, v, ascending))
+      {
+        continue;
+      }
+      ++fills;
+      const Index raised = getsWayUp(v) ? RaiseWayUp(this->Graphs.All, mesh, values, v, this->Mark, this->Stamp) : 0;
+      revalued.clear();
+      changed += raised > 0 ? raised
+                            : Fill(graph, values, v, ascending, wanted, flag, this->Mark, this->Stamp,
+                                wholeLink ? &mesh : nullptr, &revalued);
+      for (Index r : revalued)
+      {
+        for (Index i = graph.Start[r]; i < graph.Start[r + 1]; ++i)
+        {
+          const Index w = graph.Adjacent[i];
+          if (isCandidate(w))
+          {
+            candidates.push_back(w);
+          }
+        }
+      }
+    }
+    if (this->Stamp > std::numeric_limits<unsigned>::max() / 2)
+    {
+      std::fill(this->Mark.begin(), this->Mark.end(), 0u);
+      this->Stamp = 0;
+    }
+    return changed;
+  }
+
+  const TriangleMeshTopology& Mesh;
+  VertexGraphs Graphs;
+  std::vector<unsigned char> Wanted;
+  // Visit marks of the fills (a vertex is visited when its mark equals Stamp).
+  std::vector<unsigned> Mark;
+  unsigned Stamp = 0;
+};
+} // namespace
+
 TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds)
 {
   TopologicalSamplingReport report;
-  const Index n = mesh.NumberOfVertices();
   const std::vector<double> original = values;
-  // Vertex adjacency (all edges, and boundary edges only), built once.
-  Graph all, boundary;
-  all.Start.assign(n + 1, 0);
-  boundary.Start.assign(n + 1, 0);
-  for (Index e = 0; e < mesh.NumberOfEdges(); ++e)
-  {
-    for (Index v : mesh.EdgeVertices[e])
-    {
-      ++all.Start[v + 1];
-      boundary.Start[v + 1] += mesh.IsBoundaryEdge(e) ? 1 : 0;
-    }
-  }
-  for (Index v = 0; v < n; ++v)
-  {
-    all.Start[v + 1] += all.Start[v];
-    boundary.Start[v + 1] += boundary.Start[v];
-  }
-  all.Adjacent.resize(all.Start[n]);
-  boundary.Adjacent.resize(boundary.Start[n]);
-  {
-    std::vector<Index> fill(all.Start.begin(), all.Start.end() - 1);
-    std::vector<Index> boundaryFill(boundary.Start.begin(), boundary.Start.end() - 1);
-    for (Index e = 0; e < mesh.NumberOfEdges(); ++e)
-    {
-      const Index a = mesh.EdgeVertices[e][0], b = mesh.EdgeVertices[e][1];
-      all.Adjacent[fill[a]++] = b;
-      all.Adjacent[fill[b]++] = a;
-      if (mesh.IsBoundaryEdge(e))
-      {
-        boundary.Adjacent[boundaryFill[a]++] = b;
-        boundary.Adjacent[boundaryFill[b]++] = a;
-      }
-    }
-  }
-  std::vector<unsigned char> wanted(n, 0);
-  for (Index v : constraints.Minima)
-  {
-    wanted[v] |= 1;
-  }
-  for (Index v : constraints.Maxima)
-  {
-    wanted[v] |= 2;
-  }
-  for (Index v : constraints.BoundaryMinima)
-  {
-    wanted[v] |= 4;
-  }
-  for (Index v : constraints.BoundaryMaxima)
-  {
-    wanted[v] |= 8;
-  }
-  // Passes: along the boundary curve first (stage 1's boundary rule), then whole links.
-  struct Pass
-  {
-    const Graph* G;
-    bool Ascending;
-    unsigned char Flag;
-  };
-  const Pass passes[4] = { { &boundary, true, 4 }, { &boundary, false, 8 }, { &all, true, 1 }, { &all, false, 2 } };
-  std::vector<unsigned> mark(n, 0);
-  unsigned stamp = 0;
+  FloodPass floods(mesh, constraints);
   Index previousChanged = -1;
   for (report.Rounds = 1; report.Rounds <= maximumRounds; ++report.Rounds)
   {
-    Index changed = 0;
-    for (const Pass& pass : passes)
-    {
-      std::vector<Index> candidates;
-      // Boundary vertices belong to the boundary passes, which ran first: an extremum of the
-      // whole link on the boundary is one of the boundary curve too, so those passes already
-      // removed it unless it is wanted there. If the whole-link passes lowered or raised them
-      // as well, the two would undo each other by a few ulps per round, walking along the
-      // boundary. So here they are skipped and fixed (floods drain into them), except a wanted
-      // boundary saddle above its whole link, which gets a way up.
-      const bool wholeLink = pass.G == &all;
-      auto getsWayUp = [&](Index v) { return pass.Flag == 2 && (wanted[v] & 8); };
-      auto isCandidate = [&](Index v) {
-        return !(wanted[v] & pass.Flag) && !(wholeLink && mesh.IsBoundaryVertex(v) && !getsWayUp(v)) &&
-          IsExtremum(*pass.G, values, v, pass.Ascending);
-      };
-      for (Index v = n - 1; v >= 0; --v) // taken from the back: in vertex order
-      {
-        if (isCandidate(v))
-        {
-          candidates.push_back(v);
-        }
-      }
-      // A fill can leave a vertex next to its region with no lower neighbour (a cut, no
-      // higher one) where values differ by a few ulps (a nearly flat patch): such vertices are
-      // taken in the same pass, not a round later, so that a pit chain along an ulp-level
-      // valley drains in one pass instead of creeping up by a few ulps per round.
-      // Bounded, in case a fill and a way up undo each other vertex by vertex.
-      std::vector<Index> revalued;
-      std::size_t fills = 0;
-      const std::size_t maximumFills = 4 * candidates.size() + 4096;
-      while (!candidates.empty() && fills < maximumFills)
-      {
-        const Index v = candidates.back();
-        candidates.pop_back();
-        if (!IsExtremum(*pass.G, values, v, pass.Ascending))
-        {
-          continue;
-        }
-        ++fills;
-        const Index raised = getsWayUp(v) ? RaiseWayUp(all, mesh, values, v, mark, stamp) : 0;
-        revalued.clear();
-        changed += raised > 0 ? raised
-                              : Fill(*pass.G, values, v, pass.Ascending, wanted, pass.Flag, mark, stamp,
-                                  wholeLink ? &mesh : nullptr, &revalued);
-        for (Index r : revalued)
-        {
-          for (Index i = pass.G->Start[r]; i < pass.G->Start[r + 1]; ++i)
-          {
-            const Index w = pass.G->Adjacent[i];
-            if (isCandidate(w))
-            {
-              candidates.push_back(w);
-            }
-          }
-        }
-      }
-      if (stamp > std::numeric_limits<unsigned>::max() / 2)
-      {
-        std::fill(mark.begin(), mark.end(), 0u);
-        stamp = 0;
-      }
-    }
+    const Index changed = floods.Round(values);
     if (changed == 0)
     {
       report.Converged = true;
