@@ -38,5 +38,9 @@ public:
   // Intermediate structures, kept for tests and later stages.
   TriangleMeshTopology Mesh;
   DiscreteGradient Gradient;
+
+private:
+  bool CheckField(const PlanarScalarField& field, std::string& error) const;
+  const TriangleMeshTopology* PrepareMesh(const PlanarScalarField& field, std::string& error);
 };
 } // namespace topospline
