@@ -79,6 +79,29 @@ std::vector<Index> TreeOfCell(const MorseSmaleComplex& complex, OneCell::Kind ki
   return tree;
 }
 
+// Calls visit(a, path, i) for every step i >= 1 of every 1-cell a of `kind`, followed from
+// its extremum, that lies in the extremum's tree (TreeOfCell).
+template <typename Visit>
+void ForEachStepInTree(
+  const MorseSmaleComplex& complex, OneCell::Kind kind, const std::vector<Index>& tree, Visit&& visit)
+{
+  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
+  {
+    const PathFromExtremum path{ complex.OneCells[a] };
+    if (path.Cell.Type != kind)
+    {
+      continue;
+    }
+    for (size_t i = 1; i < path.Size(); ++i)
+    {
+      if (tree[path.MeshCell(i)] == path.Extremum())
+      {
+        visit(a, path, i);
+      }
+    }
+  }
+}
+
 // Junction points of the 1-cells of one kind. A cell is a junction when the 1-cells of its
 // tree through it do not all continue the same way (to the same next cell, or all ending
 // there). A descending 1-cell that ends in its own tree, where others go on, makes the
@@ -87,71 +110,48 @@ void DetectJunctionPointsOfKind(
   const MorseSmaleComplex& complex, OneCell::Kind kind, std::vector<JunctionPoint>& junctions)
 {
   const std::vector<Index> tree = TreeOfCell(complex, kind);
-  const Index nOneCells = static_cast<Index>(complex.OneCells.size());
   std::vector<Index> next(tree.size(), Unseen);
   std::vector<unsigned char> split(tree.size(), 0);
-  for (Index a = 0; a < nOneCells; ++a)
-  {
-    const PathFromExtremum path{ complex.OneCells[a] };
-    if (path.Cell.Type != kind)
+  ForEachStepInTree(complex, kind, tree, [&](Index, const PathFromExtremum& path, size_t i) {
+    const Index u = path.MeshCell(i);
+    const Index following = Following(complex, path, i);
+    if (next[u] == Unseen)
     {
-      continue;
+      next[u] = following;
     }
-    for (size_t i = 1; i < path.Size(); ++i)
+    else if (next[u] != following)
     {
-      const Index u = path.MeshCell(i);
-      if (tree[u] != path.Extremum())
-      {
-        continue;
-      }
-      const Index following = Following(complex, path, i);
-      if (next[u] == Unseen)
-      {
-        next[u] = following;
-      }
-      else if (next[u] != following)
-      {
-        split[u] = 1;
-      }
+      split[u] = 1;
     }
-  }
+  });
 
   std::vector<Index> junctionOfCell(tree.size(), InvalidIndex);
-  for (Index a = 0; a < nOneCells; ++a)
-  {
-    const PathFromExtremum path{ complex.OneCells[a] };
-    if (path.Cell.Type != kind)
+  ForEachStepInTree(complex, kind, tree, [&](Index a, const PathFromExtremum& path, size_t i) {
+    const Index u = path.MeshCell(i);
+    if (!split[u])
     {
-      continue;
+      return;
     }
-    for (size_t i = 1; i < path.Size(); ++i)
+    if (junctionOfCell[u] == InvalidIndex)
     {
-      const Index u = path.MeshCell(i);
-      if (tree[u] != path.Extremum() || !split[u])
-      {
-        continue;
-      }
-      if (junctionOfCell[u] == InvalidIndex)
-      {
-        junctionOfCell[u] = static_cast<Index>(junctions.size());
-        JunctionPoint junction;
-        junction.Type = kind;
-        junction.Extremum = path.Extremum();
-        junction.Cell = u;
-        const size_t p = path.PointIndex(i);
-        junction.Position[0] = path.Cell.Points[2 * p];
-        junction.Position[1] = path.Cell.Points[2 * p + 1];
-        junction.Value = path.Cell.Values[p];
-        junctions.push_back(junction);
-      }
-      JunctionPoint& junction = junctions[junctionOfCell[u]];
-      junction.OneCells.push_back(a);
-      if (path.Descending() && i + 1 == path.Size())
-      {
-        junction.CriticalPoint = path.Cell.Destination;
-      }
+      junctionOfCell[u] = static_cast<Index>(junctions.size());
+      JunctionPoint junction;
+      junction.Type = kind;
+      junction.Extremum = path.Extremum();
+      junction.Cell = u;
+      const size_t p = path.PointIndex(i);
+      junction.Position[0] = path.Cell.Points[2 * p];
+      junction.Position[1] = path.Cell.Points[2 * p + 1];
+      junction.Value = path.Cell.Values[p];
+      junctions.push_back(junction);
     }
-  }
+    JunctionPoint& junction = junctions[junctionOfCell[u]];
+    junction.OneCells.push_back(a);
+    if (path.Descending() && i + 1 == path.Size())
+    {
+      junction.CriticalPoint = path.Cell.Destination;
+    }
+  });
 }
 } // namespace
 

@@ -69,37 +69,6 @@ MeshField JitteredGrid(int nx, int ny, std::uint64_t seed, double jitter, bool r
   return mesh;
 }
 
-// A disk of `rings` rings of `sectors` vertices around a centre.
-MeshField Fan(int rings, int sectors)
-{
-  MeshField mesh;
-  mesh.Name = "fan";
-  mesh.Points = { 0, 0 };
-  for (int r = 1; r <= rings; ++r)
-  {
-    for (int s = 0; s < sectors; ++s)
-    {
-      const double angle = 2 * M_PI * s / sectors + 0.1 * r;
-      mesh.Points.push_back(r * std::cos(angle));
-      mesh.Points.push_back(r * std::sin(angle));
-    }
-  }
-  auto id = [&](int r, int s) { return r == 0 ? 0 : 1 + (r - 1) * sectors + (s % sectors); };
-  for (int s = 0; s < sectors; ++s)
-  {
-    mesh.Triangles.insert(mesh.Triangles.end(), { id(0, 0), id(1, s), id(1, s + 1) });
-  }
-  for (int r = 1; r < rings; ++r)
-  {
-    for (int s = 0; s < sectors; ++s)
-    {
-      mesh.Triangles.insert(mesh.Triangles.end(), { id(r, s), id(r + 1, s), id(r + 1, s + 1) });
-      mesh.Triangles.insert(mesh.Triangles.end(), { id(r, s), id(r + 1, s + 1), id(r, s + 1) });
-    }
-  }
-  return mesh;
-}
-
 // Random values; with `levels` > 0 rounded to that many levels, so that ties are common.
 void RandomValues(MeshField& mesh, std::uint64_t seed, int levels)
 {
@@ -126,7 +95,7 @@ std::vector<MeshField> TestMeshes()
   }
   meshes.push_back(JitteredGrid(2, 2, 7, 0.0, false));
   meshes.push_back(JitteredGrid(3, 2, 8, 0.2, true));
-  meshes.push_back(Fan(6, 11));
+  meshes.push_back(JitteredGrid(30, 25, 9, 0.45, true));
   std::vector<MeshField> fields;
   for (const MeshField& mesh : meshes)
   {
