@@ -1,4 +1,4 @@
-// Junction points of a Morse-Smale complex (input of stage 3, paper section 3.3): where the
+// Junction points of a Morse-Smale complex (paper, section 4; the input of stage 3): where the
 // 1-cells that share an extremum split apart when followed from it. Stage 2 reports them with
 // the simplified complex; stage 3 needs them for any complex, simplified or not, and cuts the
 // 1-cells into pieces there.

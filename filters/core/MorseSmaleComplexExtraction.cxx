@@ -282,97 +282,117 @@ bool LabelAscendingManifolds(ExtractionState& state)
     [&state](Index v) { return state.MinimumOfVertex[v]; });
 }
 
-// 1-cells as V-paths: two descending (vertex - edge paths down to a minimum) and up to two
-// ascending (triangle - edge paths up to a maximum) per saddle. Slots are fixed per saddle
-// so the parallel tracing writes disjoint entries. False if the gradient has a cycle.
-bool TraceOneCells(ExtractionState& state)
+void AppendPoint(const PlanarScalarField& field, Index v, std::vector<double>& points)
+{
+  points.push_back(field.Points[2 * v]);
+  points.push_back(field.Points[2 * v + 1]);
+}
+
+// The descending 1-cell of saddle `saddle` through the endpoint `side` of its edge: the
+// vertex V-path from there down to a minimum, stored from the minimum. Returns false if the
+// path does not end (a cycle of the gradient).
+bool TraceDescendingOneCell(const ExtractionState& state, Index saddle, int side, OneCell& arc)
+{
+  const PlanarScalarField& field = state.Field;
+  const Index nV = state.NumberOfVertices;
+  const CriticalPoint& cp = state.Complex.CriticalPoints[saddle];
+  const Index owner = cp.Vertex;
+  arc.Type = OneCell::Descending;
+  arc.Destination = saddle;
+  std::vector<Index> cells{ owner };
+  Index u = state.Mesh.EdgeVertices[cp.Cell][side];
+  if (u != owner)
+  {
+    cells.push_back(u);
+  }
+  while (state.NextVertex(u) != InvalidIndex && static_cast<Index>(cells.size()) <= nV)
+  {
+    u = state.NextVertex(u);
+    cells.push_back(u);
+  }
+  const bool ends = state.NextVertex(u) == InvalidIndex;
+  arc.Source = state.MinimumOfVertex[u];
+  arc.MeshCells.assign(cells.rbegin(), cells.rend());
+  for (Index v : arc.MeshCells)
+  {
+    AppendPoint(field, v, arc.Points);
+    arc.Values.push_back(state.Values[v]);
+  }
+  return ends;
+}
+
+// The ascending 1-cell of `saddle` that starts at triangle t of its edge: the triangle
+// V-path up to a maximum, through the triangles' centroids, from the saddle's vertex to the
+// maximum's. Returns false if the path does not end (a cycle of the gradient).
+bool TraceAscendingOneCell(const ExtractionState& state, Index saddle, Index t, OneCell& arc)
 {
   const PlanarScalarField& field = state.Field;
   const TriangleMeshTopology& mesh = state.Mesh;
   const double* f = state.Values;
-  const Index nV = state.NumberOfVertices;
   const auto& cps = state.Complex.CriticalPoints;
+  const Index owner = cps[saddle].Vertex;
+  arc.Type = OneCell::Ascending;
+  arc.Source = saddle;
+  AppendPoint(field, owner, arc.Points);
+  arc.Values.push_back(f[owner]);
+  arc.MeshCells.push_back(t);
+  while (state.NextTriangle(t) != InvalidIndex && static_cast<Index>(arc.MeshCells.size()) <= mesh.NumberOfTriangles())
+  {
+    t = state.NextTriangle(t);
+    arc.MeshCells.push_back(t);
+  }
+  const bool ends = state.NextTriangle(t) == InvalidIndex;
+  for (Index cell : arc.MeshCells)
+  {
+    const auto& tv = mesh.TriangleVertices[cell];
+    double c[2] = { 0, 0 };
+    double value = 0;
+    for (Index v : tv)
+    {
+      c[0] += field.Points[2 * v] / 3;
+      c[1] += field.Points[2 * v + 1] / 3;
+      value += f[v] / 3;
+    }
+    arc.Points.push_back(c[0]);
+    arc.Points.push_back(c[1]);
+    arc.Values.push_back(value);
+  }
+  arc.Destination = state.MaximumOfTriangle[t];
+  const Index top = cps[arc.Destination].Vertex;
+  AppendPoint(field, top, arc.Points);
+  arc.Values.push_back(f[top]);
+  return ends;
+}
+
+// 1-cells as V-paths: two descending and up to two ascending per saddle (one per triangle of
+// its edge). Slots are fixed per saddle so the parallel tracing writes disjoint entries.
+// False if the gradient has a cycle.
+bool TraceOneCells(ExtractionState& state)
+{
   const auto& saddles = state.Saddles;
-  auto nextVertex = [&state](Index v) { return state.NextVertex(v); };
-  auto nextTriangle = [&state](Index t) { return state.NextTriangle(t); };
   const Index nS = static_cast<Index>(saddles.size());
   std::vector<OneCell> slots(4 * static_cast<size_t>(nS));
   std::vector<unsigned char> traced(4 * static_cast<size_t>(nS), 0);
-  auto point = [&](Index v, std::vector<double>& pts) {
-    pts.push_back(field.Points[2 * v]);
-    pts.push_back(field.Points[2 * v + 1]);
-  };
   bool cycle = false;
   state.Parallel(0, nS, [&](Index begin, Index end) {
     for (Index k = begin; k < end; ++k)
     {
-      const CriticalPoint& saddle = cps[saddles[k]];
-      const Index e = saddle.Cell;
-      const Index owner = saddle.Vertex;
+      const Index e = state.Complex.CriticalPoints[saddles[k]].Cell;
       for (int side = 0; side < 2; ++side)
       {
-        OneCell& arc = slots[4 * k + side];
-        arc.Type = OneCell::Descending;
-        arc.Destination = saddles[k];
-        std::vector<Index> cells{ owner };
-        Index u = mesh.EdgeVertices[e][side];
-        if (u != owner)
-        {
-          cells.push_back(u);
-        }
-        while (nextVertex(u) != InvalidIndex && static_cast<Index>(cells.size()) <= nV)
-        {
-          u = nextVertex(u);
-          cells.push_back(u);
-        }
-        cycle = cycle || nextVertex(u) != InvalidIndex;
-        arc.Source = state.MinimumOfVertex[u];
-        arc.MeshCells.assign(cells.rbegin(), cells.rend());
-        for (Index v : arc.MeshCells)
-        {
-          point(v, arc.Points);
-          arc.Values.push_back(f[v]);
-        }
+        const bool ends = TraceDescendingOneCell(state, saddles[k], side, slots[4 * k + side]);
+        cycle = cycle || !ends;
         traced[4 * k + side] = 1;
       }
       for (int side = 0; side < 2; ++side)
       {
-        Index t = mesh.EdgeTriangles[e][side];
+        const Index t = state.Mesh.EdgeTriangles[e][side];
         if (t == InvalidIndex)
         {
           continue;
         }
-        OneCell& arc = slots[4 * k + 2 + side];
-        arc.Type = OneCell::Ascending;
-        arc.Source = saddles[k];
-        point(owner, arc.Points);
-        arc.Values.push_back(f[owner]);
-        arc.MeshCells.push_back(t);
-        while (nextTriangle(t) != InvalidIndex && static_cast<Index>(arc.MeshCells.size()) <= mesh.NumberOfTriangles())
-        {
-          t = nextTriangle(t);
-          arc.MeshCells.push_back(t);
-        }
-        cycle = cycle || nextTriangle(t) != InvalidIndex;
-        for (Index cell : arc.MeshCells)
-        {
-          const auto& tv = mesh.TriangleVertices[cell];
-          double c[2] = { 0, 0 };
-          double value = 0;
-          for (Index v : tv)
-          {
-            c[0] += field.Points[2 * v] / 3;
-            c[1] += field.Points[2 * v + 1] / 3;
-            value += f[v] / 3;
-          }
-          arc.Points.push_back(c[0]);
-          arc.Points.push_back(c[1]);
-          arc.Values.push_back(value);
-        }
-        arc.Destination = state.MaximumOfTriangle[t];
-        const Index top = cps[arc.Destination].Vertex;
-        point(top, arc.Points);
-        arc.Values.push_back(f[top]);
+        const bool ends = TraceAscendingOneCell(state, saddles[k], t, slots[4 * k + 2 + side]);
+        cycle = cycle || !ends;
         traced[4 * k + 2 + side] = 1;
       }
     }
@@ -778,12 +798,10 @@ std::vector<Index> BuildTwoCells(ExtractionState& state)
   return cellOfRoot;
 }
 
-// Every vertex joins a 2-cell: vertices of regions get their cell; the rest (1-cell
-// vertices, slivers) join a neighbouring cell, first through neighbours flowing to the same
-// minimum, then through any neighbour.
-void AssignVerticesToTwoCells(ExtractionState& state, const std::vector<Index>& cellOfRoot)
+// Vertices of regions get their region's 2-cell, and a 2-cell without a region its saddle's
+// vertex. Returns the vertices that had no region.
+std::vector<Index> AssignRegionsToTwoCells(ExtractionState& state, const std::vector<Index>& cellOfRoot)
 {
-  const TriangleMeshTopology& mesh = state.Mesh;
   MorseSmaleComplex& complex = state.Complex;
   const auto& cps = complex.CriticalPoints;
   const Index nV = state.NumberOfVertices;
@@ -817,6 +835,16 @@ void AssignVerticesToTwoCells(ExtractionState& state, const std::vector<Index>& 
       complex.TwoCellId[v] = c;
     }
   }
+  return unassigned;
+}
+
+// The vertices without a 2-cell (1-cell vertices, slivers) join a neighbouring cell, first
+// through neighbours flowing to the same minimum, then through any neighbour.
+void GrowTwoCellsOverUnassigned(ExtractionState& state, std::vector<Index>& unassigned)
+{
+  const TriangleMeshTopology& mesh = state.Mesh;
+  MorseSmaleComplex& complex = state.Complex;
+  const Index nV = state.NumberOfVertices;
   auto forNeighbours = [&](Index u, auto&& visit) {
     for (Index i = mesh.VertexTriangleBegin(u); i < mesh.VertexTriangleEnd(u); ++i)
     {
@@ -960,7 +988,8 @@ bool MorseSmaleComplexExtraction::Extract(
   FindSectors(state);
   SortOneCellsAroundExtrema(state);
   PairLeftoverSectors(state, PairSectorsByPlanarOrder(state));
-  AssignVerticesToTwoCells(state, BuildTwoCells(state));
+  std::vector<Index> unassigned = AssignRegionsToTwoCells(state, BuildTwoCells(state));
+  GrowTwoCellsOverUnassigned(state, unassigned);
   DescendingManifoldsAndCentroids(state);
   this->Hooks.Report(1.0);
   return true;

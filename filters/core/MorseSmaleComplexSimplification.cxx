@@ -69,6 +69,22 @@ struct AdjacencyRows
     }
   }
 };
+
+// The path of a forest (parent[root] == root) from the root of `node`'s tree to `node`.
+std::vector<Index> PathFromRoot(const std::vector<Index>& parent, Index node)
+{
+  std::vector<Index> path; // node first
+  for (Index u = node;; u = parent[u])
+  {
+    path.push_back(u);
+    if (parent[u] == u)
+    {
+      break;
+    }
+  }
+  std::reverse(path.begin(), path.end()); // root first
+  return path;
+}
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -393,9 +409,8 @@ bool MorseSmaleComplexSimplification::FindSaddleCorners(std::string& error)
 // cancelling a saddle against a maximum joins the two triangles of the saddle edge.
 void MorseSmaleComplexSimplification::BuildForests()
 {
-  const auto& cps = this->Input.CriticalPoints;
   const auto& arcs = this->Input.OneCells;
-  const Index nCP = static_cast<Index>(cps.size());
+  const Index nCP = static_cast<Index>(this->Input.CriticalPoints.size());
   const Index nArcs = static_cast<Index>(arcs.size());
 
   Index vertexBound = 0, triangleBound = 0;
@@ -410,84 +425,19 @@ void MorseSmaleComplexSimplification::BuildForests()
   std::vector<Index> nodeOfVertex(vertexBound, InvalidIndex), nodeOfTriangle(triangleBound, InvalidIndex);
   this->DescendingNodes = NodeSet();
   this->AscendingNodes = NodeSet();
-  auto node = [](NodeSet& set, std::vector<Index>& nodeOf, Index cell, const double* point, double value) {
-    if (nodeOf[cell] == InvalidIndex)
-    {
-      nodeOf[cell] = static_cast<Index>(set.Cell.size());
-      set.Cell.push_back(cell);
-      set.Point.push_back(point[0]);
-      set.Point.push_back(point[1]);
-      set.Value.push_back(value);
-    }
-    return nodeOf[cell];
-  };
-  auto addEdge = [](NodeSet& set, Index a, Index b) {
-    if (a != b)
-    {
-      set.Edges.push_back({ std::min(a, b), std::max(a, b) });
-    }
-  };
-
   this->ArcFirstNode.assign(nArcs, InvalidIndex);
   this->ArcLastNode.assign(nArcs, InvalidIndex);
   this->RootNode.assign(nCP, InvalidIndex);
   this->CriticalPointPosition.assign(2 * static_cast<size_t>(nCP), 0.0);
-  auto setPosition = [this](Index cp, const double* point) {
-    this->CriticalPointPosition[2 * cp] = point[0];
-    this->CriticalPointPosition[2 * cp + 1] = point[1];
-  };
   for (Index a = 0; a < nArcs; ++a)
   {
-    const OneCell& arc = arcs[a];
-    const Index n = static_cast<Index>(arc.MeshCells.size());
-    if (arc.Type == OneCell::Descending)
+    if (arcs[a].Type == OneCell::Descending)
     {
-      Index previous = InvalidIndex;
-      for (Index i = 0; i < n; ++i)
-      {
-        const Index current =
-          node(this->DescendingNodes, nodeOfVertex, arc.MeshCells[i], &arc.Points[2 * i], arc.Values[i]);
-        if (i > 0 && i < n - 1)
-        {
-          addEdge(this->DescendingNodes, previous, current);
-        }
-        if (i == 0)
-        {
-          this->RootNode[arc.Source] = current;
-        }
-        previous = current;
-      }
-      if (n == 1)
-      {
-        // A boundary minimum that owns an interior saddle (an epsilon pair of the boundary
-        // rule): the 1-cell is that vertex alone, with no saddle step.
-        this->ArcFirstNode[a] = nodeOfVertex[arc.MeshCells[0]];
-      }
-      else
-      {
-        this->ArcFirstNode[a] = nodeOfVertex[arc.MeshCells[n - 2]];
-        this->ArcLastNode[a] = nodeOfVertex[arc.MeshCells[n - 1]];
-      }
-      setPosition(arc.Source, &arc.Points[0]);
-      setPosition(arc.Destination, &arc.Points[2 * (n - 1)]);
+      this->AddDescendingPath(a, nodeOfVertex);
     }
     else
     {
-      Index previous = InvalidIndex;
-      for (Index i = 0; i < n; ++i)
-      {
-        const Index current = node(
-          this->AscendingNodes, nodeOfTriangle, arc.MeshCells[i], &arc.Points[2 * (i + 1)], arc.Values[i + 1]);
-        if (i > 0)
-        {
-          addEdge(this->AscendingNodes, previous, current);
-        }
-        previous = current;
-      }
-      this->ArcFirstNode[a] = nodeOfTriangle[arc.MeshCells[0]];
-      this->RootNode[arc.Destination] = previous;
-      setPosition(arc.Source, &arc.Points[0]);
-      setPosition(arc.Destination, &arc.Points[2 * (n + 1)]);
+      this->AddAscendingPath(a, nodeOfTriangle);
     }
   }
   for (NodeSet* set : { &this->DescendingNodes, &this->AscendingNodes })
@@ -495,6 +445,92 @@ void MorseSmaleComplexSimplification::BuildForests()
     std::sort(set->Edges.begin(), set->Edges.end());
     set->Edges.erase(std::unique(set->Edges.begin(), set->Edges.end()), set->Edges.end());
   }
+}
+
+Index MorseSmaleComplexSimplification::NodeSet::Node(
+  std::vector<Index>& nodeOf, Index cell, const double* point, double value)
+{
+  if (nodeOf[cell] == InvalidIndex)
+  {
+    nodeOf[cell] = static_cast<Index>(this->Cell.size());
+    this->Cell.push_back(cell);
+    this->Point.push_back(point[0]);
+    this->Point.push_back(point[1]);
+    this->Value.push_back(value);
+  }
+  return nodeOf[cell];
+}
+
+void MorseSmaleComplexSimplification::NodeSet::AddEdge(Index a, Index b)
+{
+  if (a != b)
+  {
+    this->Edges.push_back({ std::min(a, b), std::max(a, b) });
+  }
+}
+
+void MorseSmaleComplexSimplification::SetCriticalPointPosition(Index cp, const double* point)
+{
+  this->CriticalPointPosition[2 * cp] = point[0];
+  this->CriticalPointPosition[2 * cp + 1] = point[1];
+}
+
+// The vertices of descending 1-cell a as nodes, its gradient steps (all but the saddle step)
+// as edges.
+void MorseSmaleComplexSimplification::AddDescendingPath(Index a, std::vector<Index>& nodeOfVertex)
+{
+  const OneCell& arc = this->Input.OneCells[a];
+  const Index n = static_cast<Index>(arc.MeshCells.size());
+  Index previous = InvalidIndex;
+  for (Index i = 0; i < n; ++i)
+  {
+    const Index current =
+      this->DescendingNodes.Node(nodeOfVertex, arc.MeshCells[i], &arc.Points[2 * i], arc.Values[i]);
+    if (i > 0 && i < n - 1)
+    {
+      this->DescendingNodes.AddEdge(previous, current);
+    }
+    if (i == 0)
+    {
+      this->RootNode[arc.Source] = current;
+    }
+    previous = current;
+  }
+  if (n == 1)
+  {
+    // A boundary minimum that owns an interior saddle (an epsilon pair of the boundary
+    // rule): the 1-cell is that vertex alone, with no saddle step.
+    this->ArcFirstNode[a] = nodeOfVertex[arc.MeshCells[0]];
+  }
+  else
+  {
+    this->ArcFirstNode[a] = nodeOfVertex[arc.MeshCells[n - 2]];
+    this->ArcLastNode[a] = nodeOfVertex[arc.MeshCells[n - 1]];
+  }
+  this->SetCriticalPointPosition(arc.Source, &arc.Points[0]);
+  this->SetCriticalPointPosition(arc.Destination, &arc.Points[2 * (n - 1)]);
+}
+
+// The triangles of ascending 1-cell a as nodes, its steps as edges.
+void MorseSmaleComplexSimplification::AddAscendingPath(Index a, std::vector<Index>& nodeOfTriangle)
+{
+  const OneCell& arc = this->Input.OneCells[a];
+  const Index n = static_cast<Index>(arc.MeshCells.size());
+  Index previous = InvalidIndex;
+  for (Index i = 0; i < n; ++i)
+  {
+    const Index current =
+      this->AscendingNodes.Node(nodeOfTriangle, arc.MeshCells[i], &arc.Points[2 * (i + 1)], arc.Values[i + 1]);
+    if (i > 0)
+    {
+      this->AscendingNodes.AddEdge(previous, current);
+    }
+    previous = current;
+  }
+  this->ArcFirstNode[a] = nodeOfTriangle[arc.MeshCells[0]];
+  this->RootNode[arc.Destination] = previous;
+  this->SetCriticalPointPosition(arc.Source, &arc.Points[0]);
+  this->SetCriticalPointPosition(arc.Destination, &arc.Points[2 * (n + 1)]);
 }
 
 //------------------------------------------------------------------------------
@@ -1210,16 +1246,7 @@ bool MorseSmaleComplexSimplification::BuildMergedOneCells(
       error = "internal error: 1-cell " + std::to_string(a) + " is not connected to the extremum that absorbed its own";
       return false;
     }
-    std::vector<Index> path; // saddle side first
-    for (Index u = start;; u = parent[u])
-    {
-      path.push_back(u);
-      if (parent[u] == u)
-      {
-        break;
-      }
-    }
-    std::reverse(path.begin(), path.end()); // extremum first
+    std::vector<Index> path = PathFromRoot(parent, start);
     if (descending && this->ArcLastNode[a] != InvalidIndex)
     {
       path.push_back(this->ArcLastNode[a]);
@@ -1270,16 +1297,12 @@ bool MorseSmaleComplexSimplification::BuildMergedOneCells(
 }
 
 //------------------------------------------------------------------------------
-// 2-cells: unions of the input ones. Cancelling (s, x) merges, for each 1-cell of s of the
-// other kind, the two 2-cells on either side of it that have s as a corner: the corners
-// (s, 1-cell to x, that 1-cell) and (s, 1-cell to the survivor, that 1-cell).
-void MorseSmaleComplexSimplification::BuildMergedTwoCells(Replay& replay, MorseSmaleComplex& out) const
+// Which input 2-cells the replayed cancellations merge (see BuildMergedTwoCells).
+void MorseSmaleComplexSimplification::MergeTwoCells(Replay& replay) const
 {
   const auto& cps = this->Input.CriticalPoints;
-  const auto& cells = this->Input.TwoCells;
-  const Index nCells = static_cast<Index>(cells.size());
   auto& cellForward = replay.CellForward;
-  cellForward.resize(nCells);
+  cellForward.resize(this->Input.TwoCells.size());
   std::iota(cellForward.begin(), cellForward.end(), 0);
   for (Index j = 0; j < replay.Performed; ++j)
   {
@@ -1297,6 +1320,18 @@ void MorseSmaleComplexSimplification::BuildMergedTwoCells(Replay& replay, MorseS
       }
     }
   }
+}
+
+//------------------------------------------------------------------------------
+// 2-cells: unions of the input ones. Cancelling (s, x) merges, for each 1-cell of s of the
+// other kind, the two 2-cells on either side of it that have s as a corner: the corners
+// (s, 1-cell to x, that 1-cell) and (s, 1-cell to the survivor, that 1-cell).
+void MorseSmaleComplexSimplification::BuildMergedTwoCells(Replay& replay, MorseSmaleComplex& out) const
+{
+  const auto& cells = this->Input.TwoCells;
+  const Index nCells = static_cast<Index>(cells.size());
+  this->MergeTwoCells(replay);
+  auto& cellForward = replay.CellForward;
   replay.OutputTwoCell.assign(nCells, InvalidIndex);
   std::vector<std::vector<std::array<Index, 3>>> outputCorners;
   std::vector<double> weightedCentroid;

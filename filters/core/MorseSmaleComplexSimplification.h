@@ -130,6 +130,10 @@ private:
     std::vector<double> Point; // x, y per node
     std::vector<double> Value;
     std::vector<std::array<Index, 2>> Edges; // gradient steps, each once
+
+    // The node of mesh cell `cell`, added with its point and value at its first visit.
+    Index Node(std::vector<Index>& nodeOf, Index cell, const double* point, double value);
+    void AddEdge(Index a, Index b);
   };
 
   // Defined in the .cxx: the greedy cancellation's queue entries, running state and plan of
@@ -145,6 +149,9 @@ private:
   void FindBoundaryCurve();
   bool FindSaddleCorners(std::string& error);
   void BuildForests();
+  void AddDescendingPath(Index oneCell, std::vector<Index>& nodeOfVertex);
+  void AddAscendingPath(Index oneCell, std::vector<Index>& nodeOfTriangle);
+  void SetCriticalPointPosition(Index criticalPoint, const double* point);
   void ComputeSequence();
   std::vector<PersistencePair> ElderRulePairs(bool minima) const;
   void ComputeOrdinaryPersistence(GreedyState& state);
@@ -160,6 +167,7 @@ private:
   Replay ReplayCancellations(Index performed, MorseSmaleComplex& out) const;
   MergedForests GrowMergedForests(const Replay& replay) const;
   bool BuildMergedOneCells(Replay& replay, const MergedForests& forests, MorseSmaleComplex& out, std::string& error) const;
+  void MergeTwoCells(Replay& replay) const;
   void BuildMergedTwoCells(Replay& replay, MorseSmaleComplex& out) const;
   void RelabelVertices(Replay& replay, MorseSmaleComplex& out) const;
 
