@@ -984,6 +984,8 @@ bool MorseSmaleComplexExtraction::Extract(
   }
   this->Hooks.Report(0.8);
 
+  // 2-cells: the regions the 1-cells cut out, identified by the saddle sectors that open into
+  // them; sectors pair up by the planar order of the 1-cells around the extrema.
   CutMeshAlongOneCells(state);
   FindSectors(state);
   SortOneCellsAroundExtrema(state);
