@@ -141,10 +141,26 @@ struct LowerStarProcessor
     }
   }
 
+  // ProcessLowerStars on the lower star of v.
   void Process(Index v)
   {
+    const bool boundaryVertex = this->Mesh.IsBoundaryVertex(v);
+    this->CollectLowerStar(v, boundaryVertex);
+    this->ClearPairings(v);
+    if (!boundaryVertex && !this->Edges.empty() && this->Triangles.size() + 1 == this->Edges.size() &&
+      !DiscreteGradient::GeneralPathOnly)
+    {
+      this->ProcessRegular(v);
+      return;
+    }
+    this->PairWithSteepestEdge(v, boundaryVertex);
+    this->PairWithQueues();
+  }
+
+  // The edges and triangles of the lower star of v, keyed by their other vertices.
+  void CollectLowerStar(Index v, bool boundaryVertex)
+  {
     const TriangleMeshTopology& mesh = this->Mesh;
-    const bool boundaryVertex = mesh.IsBoundaryVertex(v);
     this->Edges.clear();
     this->Triangles.clear();
     auto localEdge = [&](Index e, Index other) {
@@ -197,7 +213,11 @@ struct LowerStarProcessor
         this->Triangles.push_back(c);
       }
     }
+  }
 
+  // Every cell of the lower star is initialized here (FilledByPassVector): unpaired.
+  void ClearPairings(Index v)
+  {
     this->Gradient.VertexEdge[v] = InvalidIndex;
     for (const StarCell& edge : this->Edges)
     {
@@ -208,14 +228,11 @@ struct LowerStarProcessor
     {
       this->Gradient.TriangleEdge[tri.Id] = InvalidIndex;
     }
-    if (!boundaryVertex && !this->Edges.empty() && this->Triangles.size() + 1 == this->Edges.size() &&
-      !DiscreteGradient::GeneralPathOnly)
-    {
-      this->ProcessRegular(v);
-      return;
-    }
+  }
 
-    // 1. The vertex pairs with its steepest admissible lower edge (same boundary flag).
+  // The vertex pairs with its steepest admissible lower edge (same boundary flag).
+  void PairWithSteepestEdge(Index v, bool boundaryVertex)
+  {
     int steepest = -1;
     for (int i = 0; i < static_cast<int>(this->Edges.size()); ++i)
     {
@@ -231,9 +248,12 @@ struct LowerStarProcessor
       this->Gradient.VertexEdge[v] = this->Edges[steepest].Id;
       this->Gradient.EdgeVertex[this->Edges[steepest].Id] = v;
     }
+  }
 
-    // 2. Boundary edges cannot pair with triangles: the ones left are boundary saddles.
-    //    Interior edges and triangles go through the two queues of ProcessLowerStars.
+  void PairWithQueues()
+  {
+    // Boundary edges cannot pair with triangles: the ones left are boundary saddles.
+    // Interior edges and triangles go through the two queues of ProcessLowerStars.
     this->QueueZero.clear();
     this->QueueOne.clear();
     for (int i = 0; i < static_cast<int>(this->Edges.size()); ++i)

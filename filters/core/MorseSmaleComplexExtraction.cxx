@@ -123,85 +123,99 @@ void MorseSmaleComplexExtraction::SortAroundExtremum(const MorseSmaleComplex& co
   arcs = sorted;
 }
 
-bool MorseSmaleComplexExtraction::Extract(
-  const PlanarScalarField& field, MorseSmaleComplex& complex, std::string& error)
+namespace
 {
-  complex = MorseSmaleComplex();
-  const Index nV = static_cast<Index>(field.Values.size());
-  if (nV == 0 || (field.Triangles.empty() && !field.IsGrid() && !this->GivenMesh))
+// A saddle opens into 4 sectors (2 on the boundary), each between one descending and one
+// ascending 1-cell of it: a corner of one 2-cell.
+struct Sector
+{
+  Index Saddle, Descending, Ascending;
+  Index Component; // the region it opens into, if any
+  // Left of the descending 1-cell walked from the minimum to the saddle; then it is also
+  // left of the ascending 1-cell walked from the saddle to the maximum.
+  bool LeftOfDescending;
+};
+
+// What the steps of Extract after the discrete gradient share.
+struct ExtractionState
+{
+  ExtractionState(const PlanarScalarField& field, const TriangleMeshTopology& mesh, const DiscreteGradient& gradient,
+    const ParallelFor& parallel, MorseSmaleComplex& complex)
+    : Field(field)
+    , Mesh(mesh)
+    , Gradient(gradient)
+    , Values(field.Values.data())
+    , Parallel(parallel)
+    , Complex(complex)
+    , NumberOfVertices(static_cast<Index>(field.Values.size()))
   {
-    error = "the input has no triangles";
-    return false;
-  }
-  if (field.IsGrid() && static_cast<long long>(field.GridDimensions[0]) * field.GridDimensions[1] != nV)
-  {
-    error = "the grid dimensions do not match the number of values";
-    return false;
-  }
-  if (field.Points.size() != 2 * field.Values.size() && !(this->CriticalPointsOnly && field.Points.empty()))
-  {
-    error = "expected one scalar value per point";
-    return false;
-  }
-  for (Index v = 0; v < nV; ++v)
-  {
-    if (!std::isfinite(field.Values[v]))
-    {
-      error = "the scalar field has a non-finite value (NaN or Inf) at point " + std::to_string(v);
-      return false;
-    }
-  }
-  if (this->GivenMesh)
-  {
-    if (this->GivenMesh->NumberOfVertices() != nV)
-    {
-      error = "the given mesh does not match the field";
-      return false;
-    }
-  }
-  else if (field.IsGrid())
-  {
-    this->Mesh.BuildGrid(field.GridDimensions[0], field.GridDimensions[1], this->Parallel);
-  }
-  else if (!this->Mesh.Build(nV, field.Triangles, this->Parallel, error))
-  {
-    return false;
-  }
-  const TriangleMeshTopology& mesh = this->GivenMesh ? *this->GivenMesh : this->Mesh;
-  for (Index v = 0; v < nV; ++v)
-  {
-    if (mesh.VertexTriangleBegin(v) == mesh.VertexTriangleEnd(v))
-    {
-      error = "point " + std::to_string(v) + " is not used by any triangle";
-      return false;
-    }
-  }
-  // A mesh given as triangles (not a grid, not the caller's): must be a planar disk.
-  if (!this->GivenMesh && !field.IsGrid() && !field.Points.empty() && !this->Mesh.CheckPlanarDisk(field.Points, error))
-  {
-    return false;
-  }
-  this->Hooks.Report(0.2);
-  if (this->Hooks.Aborted())
-  {
-    error = "aborted";
-    return false;
   }
 
-  const double* f = field.Values.data();
+  const PlanarScalarField& Field;
+  const TriangleMeshTopology& Mesh;
+  const DiscreteGradient& Gradient;
+  const double* Values;
+  const ParallelFor& Parallel;
+  MorseSmaleComplex& Complex;
+  const Index NumberOfVertices;
+
+  // Critical points by their cell; the saddles in id order.
+  std::vector<Index> MinimumOfVertex, MaximumOfTriangle, Saddles;
+  // Per saddle k: the 1-cells traced from it, two descending (slots 4k, 4k+1) and up to two
+  // ascending ones (4k+2, 4k+3), InvalidIndex for none.
+  std::vector<Index> OneCellOfSlot;
+  // The mesh cut along the 1-cells: vertices on them, edges crossed, and the regions left.
+  std::vector<unsigned char> OnOneCell;
+  UnionFind Regions{ 0 };
+  std::vector<Sector> Sectors;
+  // Per extremum, its 1-cells counter-clockwise around it; per 1-cell, its place there.
+  std::vector<std::vector<Index>> OneCellsAround;
+  std::vector<Index> PlaceAround;
+  // 2-cells as pairs of sectors, and the sectors left without a partner.
+  std::vector<std::array<Index, 2>> CellSectors;
+  std::vector<Index> UnpairedSectors;
+
+  // The V-path steps of the gradient (InvalidIndex at a critical cell).
+  Index NextVertex(Index v) const
+  {
+    const Index e = this->Gradient.VertexEdge[v];
+    return e == InvalidIndex ? InvalidIndex : this->Mesh.OtherEdgeVertex(e, v);
+  }
+  Index NextTriangle(Index t) const
+  {
+    const Index e = this->Gradient.TriangleEdge[t];
+    return e == InvalidIndex ? InvalidIndex : this->Mesh.OtherEdgeTriangle(e, t);
+  }
+  bool SameLabels(Index a, Index b) const
+  {
+    return this->Complex.AscendingManifold[a] == this->Complex.AscendingManifold[b];
+  }
+  // The 1-cell next to `arc` around its extremum: counter-clockwise (+1) or clockwise (-1).
+  Index NeighbourAround(Index arc, int direction) const
+  {
+    const OneCell& sep = this->Complex.OneCells[arc];
+    const auto& around = this->OneCellsAround[sep.Type == OneCell::Descending ? sep.Source : sep.Destination];
+    const Index n = static_cast<Index>(around.size());
+    return around[(this->PlaceAround[arc] + n + direction) % n];
+  }
+  // The minimum and maximum of the 2-cell a sector is a corner of.
+  std::pair<Index, Index> GroupKey(Index i) const
+  {
+    return std::make_pair(this->Complex.OneCells[this->Sectors[i].Descending].Source,
+      this->Complex.OneCells[this->Sectors[i].Ascending].Destination);
+  }
+};
+
+// Critical cells, placed at their highest vertex, in an order that depends only on the data
+// (stable ids).
+void CollectCriticalPoints(ExtractionState& state)
+{
+  const TriangleMeshTopology& mesh = state.Mesh;
+  const DiscreteGradient& grad = state.Gradient;
+  const double* f = state.Values;
   const VertexOrder order{ f };
-  this->Gradient.Compute(mesh, f, this->Parallel);
-  const DiscreteGradient& grad = this->Gradient;
-  this->Hooks.Report(0.5);
-  if (this->Hooks.Aborted())
-  {
-    error = "aborted";
-    return false;
-  }
-
-  // Critical points, in an order that depends only on the data (stable ids).
-  auto& cps = complex.CriticalPoints;
-  for (Index v = 0; v < nV; ++v)
+  auto& cps = state.Complex.CriticalPoints;
+  for (Index v = 0; v < state.NumberOfVertices; ++v)
   {
     if (grad.IsCriticalVertex(v))
     {
@@ -231,159 +245,189 @@ bool MorseSmaleComplexExtraction::Extract(
     }
     return a.Vertex != b.Vertex ? a.Vertex < b.Vertex : a.Cell < b.Cell;
   });
-  if (this->CriticalPointsOnly)
-  {
-    for (Index id = 0; id < static_cast<Index>(cps.size()); ++id)
-    {
-      cps[id].Id = id;
-    }
-    this->Hooks.Report(1.0);
-    return true;
-  }
-  std::vector<Index> minimumOfVertex(nV, InvalidIndex);
-  std::vector<Index> maximumOfTriangle(mesh.NumberOfTriangles(), InvalidIndex);
-  std::vector<Index> saddles;
   for (Index id = 0; id < static_cast<Index>(cps.size()); ++id)
   {
     cps[id].Id = id;
+  }
+}
+
+void IndexCriticalPoints(ExtractionState& state)
+{
+  const auto& cps = state.Complex.CriticalPoints;
+  state.MinimumOfVertex.assign(state.NumberOfVertices, InvalidIndex);
+  state.MaximumOfTriangle.assign(state.Mesh.NumberOfTriangles(), InvalidIndex);
+  for (Index id = 0; id < static_cast<Index>(cps.size()); ++id)
+  {
     if (cps[id].MorseIndex == 0)
     {
-      minimumOfVertex[cps[id].Cell] = id;
+      state.MinimumOfVertex[cps[id].Cell] = id;
     }
     else if (cps[id].MorseIndex == 1)
     {
-      saddles.push_back(id);
+      state.Saddles.push_back(id);
     }
     else
     {
-      maximumOfTriangle[cps[id].Cell] = id;
+      state.MaximumOfTriangle[cps[id].Cell] = id;
     }
   }
+}
 
-  // Ascending manifolds: per vertex, the minimum its V-path reaches. (Descending manifolds
-  // are read from the 2-cells below.)
-  auto nextVertex = [&](Index v) {
-    const Index e = grad.VertexEdge[v];
-    return e == InvalidIndex ? InvalidIndex : mesh.OtherEdgeVertex(e, v);
-  };
-  auto nextTriangle = [&](Index t) {
-    const Index e = grad.TriangleEdge[t];
-    return e == InvalidIndex ? InvalidIndex : mesh.OtherEdgeTriangle(e, t);
-  };
-  if (!LabelByFlow(nV, complex.AscendingManifold, nextVertex, [&](Index v) { return minimumOfVertex[v]; }))
+// Ascending manifolds: per vertex, the minimum its V-path reaches. (Descending manifolds are
+// read from the 2-cells, DescendingManifoldsAndCentroids.) False if the gradient has a cycle.
+bool LabelAscendingManifolds(ExtractionState& state)
+{
+  return LabelByFlow(
+    state.NumberOfVertices, state.Complex.AscendingManifold, [&state](Index v) { return state.NextVertex(v); },
+    [&state](Index v) { return state.MinimumOfVertex[v]; });
+}
+
+void AppendPoint(const PlanarScalarField& field, Index v, std::vector<double>& points)
+{
+  points.push_back(field.Points[2 * v]);
+  points.push_back(field.Points[2 * v + 1]);
+}
+
+// The descending 1-cell of saddle `saddle` through the endpoint `side` of its edge: the
+// vertex V-path from there down to a minimum, stored from the minimum. Returns false if the
+// path does not end (a cycle of the gradient).
+bool TraceDescendingOneCell(const ExtractionState& state, Index saddle, int side, OneCell& arc)
+{
+  const PlanarScalarField& field = state.Field;
+  const Index nV = state.NumberOfVertices;
+  const CriticalPoint& cp = state.Complex.CriticalPoints[saddle];
+  const Index owner = cp.Vertex;
+  arc.Type = OneCell::Descending;
+  arc.Destination = saddle;
+  std::vector<Index> cells{ owner };
+  Index u = state.Mesh.EdgeVertices[cp.Cell][side];
+  if (u != owner)
   {
-    error = "internal error: the discrete gradient has a cycle";
-    return false;
+    cells.push_back(u);
   }
-  this->Hooks.Report(0.65);
+  while (state.NextVertex(u) != InvalidIndex && static_cast<Index>(cells.size()) <= nV)
+  {
+    u = state.NextVertex(u);
+    cells.push_back(u);
+  }
+  const bool ends = state.NextVertex(u) == InvalidIndex;
+  arc.Source = state.MinimumOfVertex[u];
+  arc.MeshCells.assign(cells.rbegin(), cells.rend());
+  for (Index v : arc.MeshCells)
+  {
+    AppendPoint(field, v, arc.Points);
+    arc.Values.push_back(state.Values[v]);
+  }
+  return ends;
+}
 
-  // OneCells: two descending and up to two ascending V-paths per saddle. Slots are fixed
-  // per saddle so the parallel tracing writes disjoint entries.
+// The ascending 1-cell of `saddle` that starts at triangle t of its edge: the triangle
+// V-path up to a maximum, through the triangles' centroids, from the saddle's vertex to the
+// maximum's. Returns false if the path does not end (a cycle of the gradient).
+bool TraceAscendingOneCell(const ExtractionState& state, Index saddle, Index t, OneCell& arc)
+{
+  const PlanarScalarField& field = state.Field;
+  const TriangleMeshTopology& mesh = state.Mesh;
+  const double* f = state.Values;
+  const auto& cps = state.Complex.CriticalPoints;
+  const Index owner = cps[saddle].Vertex;
+  arc.Type = OneCell::Ascending;
+  arc.Source = saddle;
+  AppendPoint(field, owner, arc.Points);
+  arc.Values.push_back(f[owner]);
+  arc.MeshCells.push_back(t);
+  while (state.NextTriangle(t) != InvalidIndex && static_cast<Index>(arc.MeshCells.size()) <= mesh.NumberOfTriangles())
+  {
+    t = state.NextTriangle(t);
+    arc.MeshCells.push_back(t);
+  }
+  const bool ends = state.NextTriangle(t) == InvalidIndex;
+  for (Index cell : arc.MeshCells)
+  {
+    const auto& tv = mesh.TriangleVertices[cell];
+    double c[2] = { 0, 0 };
+    double value = 0;
+    for (Index v : tv)
+    {
+      c[0] += field.Points[2 * v] / 3;
+      c[1] += field.Points[2 * v + 1] / 3;
+      value += f[v] / 3;
+    }
+    arc.Points.push_back(c[0]);
+    arc.Points.push_back(c[1]);
+    arc.Values.push_back(value);
+  }
+  arc.Destination = state.MaximumOfTriangle[t];
+  const Index top = cps[arc.Destination].Vertex;
+  AppendPoint(field, top, arc.Points);
+  arc.Values.push_back(f[top]);
+  return ends;
+}
+
+// 1-cells as V-paths: two descending and up to two ascending per saddle (one per triangle of
+// its edge). Slots are fixed per saddle so the parallel tracing writes disjoint entries.
+// False if the gradient has a cycle.
+bool TraceOneCells(ExtractionState& state)
+{
+  const auto& saddles = state.Saddles;
   const Index nS = static_cast<Index>(saddles.size());
   std::vector<OneCell> slots(4 * static_cast<size_t>(nS));
   std::vector<unsigned char> traced(4 * static_cast<size_t>(nS), 0);
-  auto point = [&](Index v, std::vector<double>& pts) {
-    pts.push_back(field.Points[2 * v]);
-    pts.push_back(field.Points[2 * v + 1]);
-  };
   bool cycle = false;
-  this->Parallel(0, nS, [&](Index begin, Index end) {
+  state.Parallel(0, nS, [&](Index begin, Index end) {
     for (Index k = begin; k < end; ++k)
     {
-      const CriticalPoint& saddle = cps[saddles[k]];
-      const Index e = saddle.Cell;
-      const Index owner = saddle.Vertex;
+      const Index e = state.Complex.CriticalPoints[saddles[k]].Cell;
       for (int side = 0; side < 2; ++side)
       {
-        OneCell& arc = slots[4 * k + side];
-        arc.Type = OneCell::Descending;
-        arc.Destination = saddles[k];
-        std::vector<Index> cells{ owner };
-        Index u = mesh.EdgeVertices[e][side];
-        if (u != owner)
-        {
-          cells.push_back(u);
-        }
-        while (nextVertex(u) != InvalidIndex && static_cast<Index>(cells.size()) <= nV)
-        {
-          u = nextVertex(u);
-          cells.push_back(u);
-        }
-        cycle = cycle || nextVertex(u) != InvalidIndex;
-        arc.Source = minimumOfVertex[u];
-        arc.MeshCells.assign(cells.rbegin(), cells.rend());
-        for (Index v : arc.MeshCells)
-        {
-          point(v, arc.Points);
-          arc.Values.push_back(f[v]);
-        }
+        const bool ends = TraceDescendingOneCell(state, saddles[k], side, slots[4 * k + side]);
+        cycle = cycle || !ends;
         traced[4 * k + side] = 1;
       }
       for (int side = 0; side < 2; ++side)
       {
-        Index t = mesh.EdgeTriangles[e][side];
+        const Index t = state.Mesh.EdgeTriangles[e][side];
         if (t == InvalidIndex)
         {
           continue;
         }
-        OneCell& arc = slots[4 * k + 2 + side];
-        arc.Type = OneCell::Ascending;
-        arc.Source = saddles[k];
-        point(owner, arc.Points);
-        arc.Values.push_back(f[owner]);
-        arc.MeshCells.push_back(t);
-        while (nextTriangle(t) != InvalidIndex && static_cast<Index>(arc.MeshCells.size()) <= mesh.NumberOfTriangles())
-        {
-          t = nextTriangle(t);
-          arc.MeshCells.push_back(t);
-        }
-        cycle = cycle || nextTriangle(t) != InvalidIndex;
-        for (Index cell : arc.MeshCells)
-        {
-          const auto& tv = mesh.TriangleVertices[cell];
-          double c[2] = { 0, 0 };
-          double value = 0;
-          for (Index v : tv)
-          {
-            c[0] += field.Points[2 * v] / 3;
-            c[1] += field.Points[2 * v + 1] / 3;
-            value += f[v] / 3;
-          }
-          arc.Points.push_back(c[0]);
-          arc.Points.push_back(c[1]);
-          arc.Values.push_back(value);
-        }
-        arc.Destination = maximumOfTriangle[t];
-        const Index top = cps[arc.Destination].Vertex;
-        point(top, arc.Points);
-        arc.Values.push_back(f[top]);
+        const bool ends = TraceAscendingOneCell(state, saddles[k], t, slots[4 * k + 2 + side]);
+        cycle = cycle || !ends;
         traced[4 * k + 2 + side] = 1;
       }
     }
   });
   if (cycle)
   {
-    error = "internal error: the discrete gradient has a cycle";
     return false;
   }
-  std::vector<Index> arcOfSlot(slots.size(), InvalidIndex);
+  auto& oneCells = state.Complex.OneCells;
+  state.OneCellOfSlot.assign(slots.size(), InvalidIndex);
   for (size_t s = 0; s < slots.size(); ++s)
   {
     if (traced[s])
     {
-      arcOfSlot[s] = static_cast<Index>(complex.OneCells.size());
-      complex.OneCells.push_back(std::move(slots[s]));
+      state.OneCellOfSlot[s] = static_cast<Index>(oneCells.size());
+      oneCells.push_back(std::move(slots[s]));
     }
   }
-  this->Hooks.Report(0.8);
+  return true;
+}
 
-  // 2-cells. A 2-cell is a region of vertices that no 1-cell crosses. Cut the mesh along
-  // the 1-cells: vertices of descending 1-cells and of maximum triangles join no region
-  // directly, and edges that an ascending 1-cell crosses join nothing. Descending 1-cells
-  // bound the descending manifolds, so each region lies in one of them; its maximum is read
-  // from the sectors. (Per-vertex labels alone are not enough: both sides of a 1-cell can
-  // flow to the same extrema, e.g. next to a saddle whose descending 1-cells share a minimum.)
-  std::vector<unsigned char> onOneCell(nV, 0);
+// A 2-cell is a region of vertices that no 1-cell crosses. Cut the mesh along the 1-cells:
+// vertices of descending 1-cells and of maximum triangles join no region directly, and edges
+// that an ascending 1-cell crosses join nothing. Descending 1-cells bound the descending
+// manifolds, so each region lies in one of them; its maximum is read from the sectors.
+// (Per-vertex labels alone are not enough: both sides of a 1-cell can flow to the same
+// extrema, e.g. next to a saddle whose descending 1-cells share a minimum.)
+void CutMeshAlongOneCells(ExtractionState& state)
+{
+  const TriangleMeshTopology& mesh = state.Mesh;
+  const MorseSmaleComplex& complex = state.Complex;
+  const auto& cps = complex.CriticalPoints;
+  const Index nV = state.NumberOfVertices;
+  std::vector<unsigned char>& onOneCell = state.OnOneCell;
+  onOneCell.assign(nV, 0);
   std::vector<unsigned char> crossed(mesh.NumberOfEdges(), 0);
   for (const OneCell& arc : complex.OneCells)
   {
@@ -399,7 +443,7 @@ bool MorseSmaleComplexExtraction::Extract(
       crossed[cps[arc.Source].Cell] = 1;
       for (size_t i = 0; i + 1 < arc.MeshCells.size(); ++i)
       {
-        crossed[grad.TriangleEdge[arc.MeshCells[i]]] = 1;
+        crossed[state.Gradient.TriangleEdge[arc.MeshCells[i]]] = 1;
       }
     }
   }
@@ -413,39 +457,35 @@ bool MorseSmaleComplexExtraction::Extract(
       }
     }
   }
-  auto sameLabels = [&](Index a, Index b) {
-    return complex.AscendingManifold[a] == complex.AscendingManifold[b];
-  };
-  UnionFind components(nV);
+  state.Regions = UnionFind(nV);
   for (Index e = 0; e < mesh.NumberOfEdges(); ++e)
   {
     const Index a = mesh.EdgeVertices[e][0], b = mesh.EdgeVertices[e][1];
-    if (!crossed[e] && !onOneCell[a] && !onOneCell[b] && sameLabels(a, b))
+    if (!crossed[e] && !onOneCell[a] && !onOneCell[b] && state.SameLabels(a, b))
     {
-      components.Union(a, b);
+      state.Regions.Union(a, b);
     }
   }
+}
 
-  // Each saddle opens into 4 sectors (2 on the boundary), each between one descending and
-  // one ascending 1-cell: a corner of one 2-cell. That 2-cell runs along the whole
-  // ascending 1-cell on the side of the descending one, so walk the ascending path,
-  // tracking which endpoint of each crossed edge is on that side, and take the region of the
-  // first such vertex that is off the 1-cells and carries the sector's labels.
-  struct Sector
-  {
-    Index Saddle, Descending, Ascending, Component;
-    // Left of the descending 1-cell walked from the minimum to the saddle; then it is also
-    // left of the ascending 1-cell walked from the saddle to the maximum.
-    bool LeftOfDescending;
-  };
-  std::vector<Sector> sectors;
+// The sectors of every saddle and the region each opens into. The 2-cell of a sector runs
+// along the whole ascending 1-cell on the side of the descending one, so walk the ascending
+// path, tracking which endpoint of each crossed edge is on that side, and take the region of
+// the first such vertex that is off the 1-cells and carries the sector's labels.
+void FindSectors(ExtractionState& state)
+{
+  const TriangleMeshTopology& mesh = state.Mesh;
+  const MorseSmaleComplex& complex = state.Complex;
+  const auto& cps = complex.CriticalPoints;
+  const auto& saddles = state.Saddles;
+  const Index nS = static_cast<Index>(saddles.size());
   for (Index k = 0; k < nS; ++k)
   {
     const CriticalPoint& saddle = cps[saddles[k]];
     const Index e = saddle.Cell;
     for (int tside = 0; tside < 2; ++tside)
     {
-      const Index ascending = arcOfSlot[4 * k + 2 + tside];
+      const Index ascending = state.OneCellOfSlot[4 * k + 2 + tside];
       if (ascending == InvalidIndex)
       {
         continue;
@@ -457,13 +497,13 @@ bool MorseSmaleComplexExtraction::Extract(
         // saddle edge when its triangle does.
         const Index x = mesh.EdgeVertices[e][dside], y = mesh.EdgeVertices[e][1 - dside];
         const Index c = ThirdVertex(mesh, up.MeshCells.front(), x, y);
-        Sector sector{ saddles[k], arcOfSlot[4 * k + dside], ascending, InvalidIndex,
-          Orientation(field.Points, x, y, c) > 0 };
+        Sector sector{ saddles[k], state.OneCellOfSlot[4 * k + dside], ascending, InvalidIndex,
+          Orientation(state.Field.Points, x, y, c) > 0 };
         const Index m = complex.OneCells[sector.Descending].Source;
         auto accept = [&](Index w) {
-          if (!onOneCell[w] && complex.AscendingManifold[w] == m)
+          if (!state.OnOneCell[w] && complex.AscendingManifold[w] == m)
           {
-            sector.Component = components.Find(w);
+            sector.Component = state.Regions.Find(w);
             return true;
           }
           return false;
@@ -472,7 +512,7 @@ bool MorseSmaleComplexExtraction::Extract(
         bool found = accept(near);
         for (size_t i = 0; !found && i + 1 < up.MeshCells.size(); ++i)
         {
-          const Index crossing = grad.TriangleEdge[up.MeshCells[i]];
+          const Index crossing = state.Gradient.TriangleEdge[up.MeshCells[i]];
           const Index p = mesh.EdgeVertices[crossing][0], q = mesh.EdgeVertices[crossing][1];
           if (p == near || q == near)
           {
@@ -484,17 +524,25 @@ bool MorseSmaleComplexExtraction::Extract(
             found = accept(near);
           }
         }
-        sectors.push_back(sector);
+        state.Sectors.push_back(sector);
       }
     }
   }
+}
 
-  // The 1-cells of each extremum (descending ones for minima, ascending ones for maxima),
-  // counter-clockwise around it, and each 1-cell's place in its extremum's order. Each 1-cell
-  // ends at the midpoint of its saddle edge: two saddles that share their highest vertex
-  // share a 1-cell path up to it, and only their edges tell the two apart.
+// The 1-cells of each extremum (descending ones for minima, ascending ones for maxima),
+// counter-clockwise around it, and each 1-cell's place in its extremum's order. Each 1-cell
+// ends at the midpoint of its saddle edge: two saddles that share their highest vertex
+// share a 1-cell path up to it, and only their edges tell the two apart.
+void SortOneCellsAroundExtrema(ExtractionState& state)
+{
+  const PlanarScalarField& field = state.Field;
+  const TriangleMeshTopology& mesh = state.Mesh;
+  const MorseSmaleComplex& complex = state.Complex;
+  const auto& cps = complex.CriticalPoints;
   std::vector<double> saddleEdgeMidpoints(2 * complex.OneCells.size());
-  std::vector<std::vector<Index>> arcsOfExtremum(cps.size());
+  auto& arcsOfExtremum = state.OneCellsAround;
+  arcsOfExtremum.assign(cps.size(), {});
   for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
   {
     const OneCell& arc = complex.OneCells[a];
@@ -507,40 +555,38 @@ bool MorseSmaleComplexExtraction::Extract(
         (field.Points[2 * mesh.EdgeVertices[edge][0] + c] + field.Points[2 * mesh.EdgeVertices[edge][1] + c]);
     }
   }
-  std::vector<Index> placeAroundExtremum(complex.OneCells.size(), InvalidIndex);
-  this->Parallel(0, static_cast<Index>(cps.size()), [&](Index begin, Index end) {
+  auto& placeAroundExtremum = state.PlaceAround;
+  placeAroundExtremum.assign(complex.OneCells.size(), InvalidIndex);
+  state.Parallel(0, static_cast<Index>(cps.size()), [&](Index begin, Index end) {
     for (Index x = begin; x < end; ++x)
     {
-      SortAroundExtremum(complex, saddleEdgeMidpoints, x, arcsOfExtremum[x]);
+      MorseSmaleComplexExtraction::SortAroundExtremum(complex, saddleEdgeMidpoints, x, arcsOfExtremum[x]);
       for (size_t k = 0; k < arcsOfExtremum[x].size(); ++k)
       {
         placeAroundExtremum[arcsOfExtremum[x][k]] = static_cast<Index>(k);
       }
     }
   });
-  // The 1-cell next to `arc` around its extremum: counter-clockwise (+1) or clockwise (-1).
-  auto neighbourAround = [&](Index arc, int direction) {
-    const OneCell& sep = complex.OneCells[arc];
-    const auto& around = arcsOfExtremum[sep.Type == OneCell::Descending ? sep.Source : sep.Destination];
-    const Index n = static_cast<Index>(around.size());
-    return around[(placeAroundExtremum[arc] + n + direction) % n];
-  };
+}
 
-  // Pair sectors into 2-cells by tracing the faces of the planar graph of 1-cells. A cell lies
-  // left of its first descending 1-cell (walked from the minimum), so counter-clockwise of it
-  // around the minimum up to the next descending 1-cell; and left of its first ascending
-  // 1-cell (walked to the maximum), so clockwise of it around the maximum up to the previous
-  // ascending 1-cell. Those two 1-cells must belong to one saddle, whose sector between them
-  // (right of both) closes the cell. The order is what makes this exact: a sliver between
-  // two 1-cells that run side by side has no region to identify it, and one region can touch
-  // the sectors of two cells on both sides of a thin loop (a saddle whose two ascending
-  // 1-cells reach the same maximum), which paired them into a pouch outside its own loop.
+// Pair sectors into 2-cells by tracing the faces of the planar graph of 1-cells. A cell lies
+// left of its first descending 1-cell (walked from the minimum), so counter-clockwise of it
+// around the minimum up to the next descending 1-cell; and left of its first ascending
+// 1-cell (walked to the maximum), so clockwise of it around the maximum up to the previous
+// ascending 1-cell. Those two 1-cells must belong to one saddle, whose sector between them
+// (right of both) closes the cell. The order is what makes this exact: a sliver between
+// two 1-cells that run side by side has no region to identify it, and one region can touch
+// the sectors of two cells on both sides of a thin loop (a saddle whose two ascending
+// 1-cells reach the same maximum), which paired them into a pouch outside its own loop.
+// Returns which sectors it paired.
+std::vector<unsigned char> PairSectorsByPlanarOrder(ExtractionState& state)
+{
+  const auto& sectors = state.Sectors;
   std::map<std::pair<Index, Index>, Index> sectorOfArcs;
   for (Index i = 0; i < static_cast<Index>(sectors.size()); ++i)
   {
     sectorOfArcs[{ sectors[i].Descending, sectors[i].Ascending }] = i;
   }
-  std::vector<std::array<Index, 2>> cellSectors;
   std::vector<unsigned char> sectorPaired(sectors.size(), 0);
   for (Index i = 0; i < static_cast<Index>(sectors.size()); ++i)
   {
@@ -549,20 +595,92 @@ bool MorseSmaleComplexExtraction::Extract(
     {
       continue;
     }
-    const auto right = sectorOfArcs.find({ neighbourAround(left.Descending, +1), neighbourAround(left.Ascending, -1) });
+    const auto right =
+      sectorOfArcs.find({ state.NeighbourAround(left.Descending, +1), state.NeighbourAround(left.Ascending, -1) });
     if (right == sectorOfArcs.end() || sectors[right->second].LeftOfDescending || sectorPaired[right->second])
     {
       continue;
     }
-    cellSectors.push_back({ i, right->second });
+    state.CellSectors.push_back({ i, right->second });
     sectorPaired[i] = sectorPaired[right->second] = 1;
   }
+  return sectorPaired;
+}
 
-  // What the planar order leaves (it fails only where it ties): two sectors form a 2-cell when
-  // they share (minimum, maximum) and open into the same region. A cell thinner than the mesh
-  // may have no region (no vertex off its 1-cells) or fall apart into two: within a
-  // (minimum, maximum) group, the sectors left over after pairing by region pair up when
-  // exactly two are left.
+// Thin cells (e.g. ascending 1-cells that run side by side and merge) have no region to tell
+// them apart: pair a whole (minimum, maximum) group by the planar order of the descending
+// 1-cells at the minimum. A cell lies between two descending 1-cells that are consecutive
+// around its minimum: the sector left of one pairs with the sector right of its
+// counter-clockwise successor. At the maximum the same holds with the ascending 1-cells;
+// there the sector left of one (walking towards the maximum) pairs with the one right of
+// its clockwise predecessor. Try the minimum first; fall back to the maximum when some stay
+// unpaired (e.g. saddles sharing a vertex have identical descending paths).
+void PairGroupByPlanarOrder(ExtractionState& state, const std::vector<Index>& group)
+{
+  const auto& sectors = state.Sectors;
+  std::vector<std::array<Index, 2>> pairs;
+  std::vector<Index> rest;
+  for (int end = 0; end < 2; ++end)
+  {
+    std::vector<std::array<Index, 2>> tryPairs;
+    std::vector<Index> tryRest;
+    auto arcOf = [&](const Sector& sector) { return end == 0 ? sector.Descending : sector.Ascending; };
+    std::vector<unsigned char> used(group.size(), 0);
+    for (size_t a = 0; a < group.size(); ++a)
+    {
+      const Sector& left = sectors[group[a]];
+      if (used[a] || !left.LeftOfDescending)
+      {
+        continue;
+      }
+      const Index neighbour = state.NeighbourAround(arcOf(left), end == 0 ? +1 : -1);
+      for (size_t b = 0; b < group.size(); ++b)
+      {
+        const Sector& right = sectors[group[b]];
+        if (!used[b] && b != a && !right.LeftOfDescending && arcOf(right) == neighbour)
+        {
+          tryPairs.push_back({ group[a], group[b] });
+          used[a] = used[b] = 1;
+          break;
+        }
+      }
+    }
+    for (size_t a = 0; a < group.size(); ++a)
+    {
+      if (!used[a])
+      {
+        tryRest.push_back(group[a]);
+      }
+    }
+    if (end == 0 || tryRest.size() < rest.size())
+    {
+      pairs = tryPairs;
+      rest = tryRest;
+    }
+    if (rest.size() <= 2)
+    {
+      break;
+    }
+  }
+  state.CellSectors.insert(state.CellSectors.end(), pairs.begin(), pairs.end());
+  if (rest.size() == 2)
+  {
+    state.CellSectors.push_back({ rest[0], rest[1] });
+  }
+  else
+  {
+    state.UnpairedSectors.insert(state.UnpairedSectors.end(), rest.begin(), rest.end());
+  }
+}
+
+// What the planar order leaves (it fails only where it ties): two sectors form a 2-cell when
+// they share (minimum, maximum) and open into the same region. A cell thinner than the mesh
+// may have no region (no vertex off its 1-cells) or fall apart into two: within a
+// (minimum, maximum) group, the sectors left over after pairing by region pair up when
+// exactly two are left; with more, the group is paired by planar order alone.
+void PairLeftoverSectors(ExtractionState& state, const std::vector<unsigned char>& sectorPaired)
+{
+  const auto& sectors = state.Sectors;
   std::vector<Index> bySector;
   for (Index i = 0; i < static_cast<Index>(sectors.size()); ++i)
   {
@@ -571,23 +689,18 @@ bool MorseSmaleComplexExtraction::Extract(
       bySector.push_back(i);
     }
   }
-  auto groupKey = [&](Index i) {
-    return std::make_pair(complex.OneCells[sectors[i].Descending].Source,
-      complex.OneCells[sectors[i].Ascending].Destination);
-  };
   std::stable_sort(bySector.begin(), bySector.end(), [&](Index a, Index b) {
-    const auto ka = groupKey(a), kb = groupKey(b);
+    const auto ka = state.GroupKey(a), kb = state.GroupKey(b);
     if (ka != kb)
     {
       return ka < kb;
     }
     return sectors[a].Component < sectors[b].Component;
   });
-  std::vector<Index> unpairedSectors;
   for (size_t i = 0; i < bySector.size();)
   {
     size_t j = i;
-    while (j < bySector.size() && groupKey(bySector[j]) == groupKey(bySector[i]))
+    while (j < bySector.size() && state.GroupKey(bySector[j]) == state.GroupKey(bySector[i]))
     {
       ++j;
     }
@@ -613,81 +726,28 @@ bool MorseSmaleComplexExtraction::Extract(
     }
     if (leftover.size() <= 2)
     {
-      cellSectors.insert(cellSectors.end(), byRegion.begin(), byRegion.end());
+      state.CellSectors.insert(state.CellSectors.end(), byRegion.begin(), byRegion.end());
       if (leftover.size() == 2)
       {
-        cellSectors.push_back({ leftover[0], leftover[1] });
+        state.CellSectors.push_back({ leftover[0], leftover[1] });
       }
     }
     else
     {
-      // Thin cells (e.g. ascending 1-cells that run side by side and merge) have no region to
-      // tell them apart: pair the whole group by the planar order of the descending 1-cells
-      // at the minimum. A cell lies between two descending 1-cells that are consecutive
-      // around its minimum: the sector left of one pairs with the sector right of its
-      // counter-clockwise successor.
-      const std::vector<Index> group(bySector.begin() + i, bySector.begin() + j);
-      std::vector<std::array<Index, 2>> pairs;
-      std::vector<Index> rest;
-      // At the maximum the same holds with the ascending 1-cells; there the sector left of
-      // one (walking towards the maximum) pairs with the one right of its clockwise
-      // predecessor. Try the minimum first; fall back to the maximum when some stay unpaired
-      // (e.g. saddles sharing a vertex have identical descending paths).
-      for (int end = 0; end < 2; ++end)
-      {
-        std::vector<std::array<Index, 2>> tryPairs;
-        std::vector<Index> tryRest;
-        auto arcOf = [&](const Sector& sector) { return end == 0 ? sector.Descending : sector.Ascending; };
-        std::vector<unsigned char> used(group.size(), 0);
-        for (size_t a = 0; a < group.size(); ++a)
-        {
-          const Sector& left = sectors[group[a]];
-          if (used[a] || !left.LeftOfDescending)
-          {
-            continue;
-          }
-          const Index neighbour = neighbourAround(arcOf(left), end == 0 ? +1 : -1);
-          for (size_t b = 0; b < group.size(); ++b)
-          {
-            const Sector& right = sectors[group[b]];
-            if (!used[b] && b != a && !right.LeftOfDescending && arcOf(right) == neighbour)
-            {
-              tryPairs.push_back({ group[a], group[b] });
-              used[a] = used[b] = 1;
-              break;
-            }
-          }
-        }
-        for (size_t a = 0; a < group.size(); ++a)
-        {
-          if (!used[a])
-          {
-            tryRest.push_back(group[a]);
-          }
-        }
-        if (end == 0 || tryRest.size() < rest.size())
-        {
-          pairs = tryPairs;
-          rest = tryRest;
-        }
-        if (rest.size() <= 2)
-        {
-          break;
-        }
-      }
-      cellSectors.insert(cellSectors.end(), pairs.begin(), pairs.end());
-      if (rest.size() == 2)
-      {
-        cellSectors.push_back({ rest[0], rest[1] });
-      }
-      else
-      {
-        unpairedSectors.insert(unpairedSectors.end(), rest.begin(), rest.end());
-      }
+      PairGroupByPlanarOrder(state, std::vector<Index>(bySector.begin() + i, bySector.begin() + j));
     }
     i = j;
   }
-  // Cells in the order of their first sector: an order fixed by the saddles' ids.
+}
+
+// The 2-cells, from the pairs of sectors, in the order of their first sector: an order fixed
+// by the saddles' ids; then a cell per sector left without a partner. Returns the 2-cell of
+// each region's root vertex.
+std::vector<Index> BuildTwoCells(ExtractionState& state)
+{
+  MorseSmaleComplex& complex = state.Complex;
+  auto& cellSectors = state.CellSectors;
+  const auto& sectors = state.Sectors;
   for (auto& pair : cellSectors)
   {
     if (pair[1] < pair[0])
@@ -696,7 +756,7 @@ bool MorseSmaleComplexExtraction::Extract(
     }
   }
   std::sort(cellSectors.begin(), cellSectors.end());
-  std::vector<Index> cellOfRoot(nV, InvalidIndex);
+  std::vector<Index> cellOfRoot(state.NumberOfVertices, InvalidIndex);
   for (const auto& pair : cellSectors)
   {
     TwoCell cell;
@@ -719,7 +779,7 @@ bool MorseSmaleComplexExtraction::Extract(
   }
   // A sector that found no partner still bounds a region of the domain: keep it as a cell
   // with one sector, so that nothing is silently dropped (tests flag such cells).
-  for (Index i : unpairedSectors)
+  for (Index i : state.UnpairedSectors)
   {
     const Sector& sector = sectors[i];
     TwoCell cell;
@@ -735,16 +795,22 @@ bool MorseSmaleComplexExtraction::Extract(
     }
     complex.TwoCells.push_back(cell);
   }
+  return cellOfRoot;
+}
 
-  // Every vertex joins a 2-cell: vertices of regions get their cell; the rest (1-cell
-  // vertices, slivers) join a neighbouring cell, first through neighbours flowing to the same
-  // minimum, then through any neighbour.
+// Vertices of regions get their region's 2-cell, and a 2-cell without a region its saddle's
+// vertex. Returns the vertices that had no region.
+std::vector<Index> AssignRegionsToTwoCells(ExtractionState& state, const std::vector<Index>& cellOfRoot)
+{
+  MorseSmaleComplex& complex = state.Complex;
+  const auto& cps = complex.CriticalPoints;
+  const Index nV = state.NumberOfVertices;
   complex.TwoCellId.assign(nV, InvalidIndex);
   std::vector<unsigned char> hasRegion(complex.TwoCells.size(), 0);
-  this->Parallel(0, nV, [&](Index begin, Index end) {
+  state.Parallel(0, nV, [&](Index begin, Index end) {
     for (Index v = begin; v < end; ++v)
     {
-      complex.TwoCellId[v] = cellOfRoot[components.Root(v)];
+      complex.TwoCellId[v] = cellOfRoot[state.Regions.Root(v)];
     }
   });
   std::vector<Index> unassigned;
@@ -769,6 +835,16 @@ bool MorseSmaleComplexExtraction::Extract(
       complex.TwoCellId[v] = c;
     }
   }
+  return unassigned;
+}
+
+// The vertices without a 2-cell (1-cell vertices, slivers) join a neighbouring cell, first
+// through neighbours flowing to the same minimum, then through any neighbour.
+void GrowTwoCellsOverUnassigned(ExtractionState& state, std::vector<Index>& unassigned)
+{
+  const TriangleMeshTopology& mesh = state.Mesh;
+  MorseSmaleComplex& complex = state.Complex;
+  const Index nV = state.NumberOfVertices;
   auto forNeighbours = [&](Index u, auto&& visit) {
     for (Index i = mesh.VertexTriangleBegin(u); i < mesh.VertexTriangleEnd(u); ++i)
     {
@@ -808,7 +884,7 @@ bool MorseSmaleComplexExtraction::Extract(
     {
       const Index u = queue[head];
       forNeighbours(u, [&](Index w) {
-        if (complex.TwoCellId[w] == InvalidIndex && (pass == 1 || sameLabels(u, w)))
+        if (complex.TwoCellId[w] == InvalidIndex && (pass == 1 || state.SameLabels(u, w)))
         {
           complex.TwoCellId[w] = complex.TwoCellId[u];
           queue.push_back(w);
@@ -816,6 +892,16 @@ bool MorseSmaleComplexExtraction::Extract(
       });
     }
   }
+}
+
+// Per 2-cell its vertex count and centroid; per vertex the maximum it flows up to, the
+// maximum of its 2-cell.
+void DescendingManifoldsAndCentroids(ExtractionState& state)
+{
+  const PlanarScalarField& field = state.Field;
+  MorseSmaleComplex& complex = state.Complex;
+  const auto& cps = complex.CriticalPoints;
+  const Index nV = state.NumberOfVertices;
   for (Index v = 0; v < nV; ++v)
   {
     TwoCell& cell = complex.TwoCells[complex.TwoCellId[v]];
@@ -843,7 +929,140 @@ bool MorseSmaleComplexExtraction::Extract(
       cell.Centroid[1] = field.Points[2 * v + 1];
     }
   }
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+// The steps of the paper's section 3.1: the mesh, the discrete gradient, its critical cells,
+// the 1-cells as V-paths, the 2-cells and the per-vertex manifolds.
+bool MorseSmaleComplexExtraction::Extract(
+  const PlanarScalarField& field, MorseSmaleComplex& complex, std::string& error)
+{
+  complex = MorseSmaleComplex();
+  if (!this->CheckField(field, error))
+  {
+    return false;
+  }
+  const TriangleMeshTopology* mesh = this->PrepareMesh(field, error);
+  if (!mesh)
+  {
+    return false;
+  }
+  this->Hooks.Report(0.2);
+  if (this->Hooks.Aborted())
+  {
+    error = "aborted";
+    return false;
+  }
+
+  this->Gradient.Compute(*mesh, field.Values.data(), this->Parallel);
+  this->Hooks.Report(0.5);
+  if (this->Hooks.Aborted())
+  {
+    error = "aborted";
+    return false;
+  }
+
+  ExtractionState state(field, *mesh, this->Gradient, this->Parallel, complex);
+  CollectCriticalPoints(state);
+  if (this->CriticalPointsOnly)
+  {
+    this->Hooks.Report(1.0);
+    return true;
+  }
+  IndexCriticalPoints(state);
+  if (!LabelAscendingManifolds(state))
+  {
+    error = "internal error: the discrete gradient has a cycle";
+    return false;
+  }
+  this->Hooks.Report(0.65);
+  if (!TraceOneCells(state))
+  {
+    error = "internal error: the discrete gradient has a cycle";
+    return false;
+  }
+  this->Hooks.Report(0.8);
+
+  // 2-cells: the regions the 1-cells cut out, identified by the saddle sectors that open into
+  // them; sectors pair up by the planar order of the 1-cells around the extrema.
+  CutMeshAlongOneCells(state);
+  FindSectors(state);
+  SortOneCellsAroundExtrema(state);
+  PairLeftoverSectors(state, PairSectorsByPlanarOrder(state));
+  std::vector<Index> unassigned = AssignRegionsToTwoCells(state, BuildTwoCells(state));
+  GrowTwoCellsOverUnassigned(state, unassigned);
+  DescendingManifoldsAndCentroids(state);
   this->Hooks.Report(1.0);
   return true;
+}
+
+//------------------------------------------------------------------------------
+bool MorseSmaleComplexExtraction::CheckField(const PlanarScalarField& field, std::string& error) const
+{
+  const Index nV = static_cast<Index>(field.Values.size());
+  if (nV == 0 || (field.Triangles.empty() && !field.IsGrid() && !this->GivenMesh))
+  {
+    error = "the input has no triangles";
+    return false;
+  }
+  if (field.IsGrid() && static_cast<long long>(field.GridDimensions[0]) * field.GridDimensions[1] != nV)
+  {
+    error = "the grid dimensions do not match the number of values";
+    return false;
+  }
+  if (field.Points.size() != 2 * field.Values.size() && !(this->CriticalPointsOnly && field.Points.empty()))
+  {
+    error = "expected one scalar value per point";
+    return false;
+  }
+  for (Index v = 0; v < nV; ++v)
+  {
+    if (!std::isfinite(field.Values[v]))
+    {
+      error = "the scalar field has a non-finite value (NaN or Inf) at point " + std::to_string(v);
+      return false;
+    }
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+// The given mesh or Mesh, built from the grid or the triangles; null (with `error`) for a
+// mesh the complex cannot live on.
+const TriangleMeshTopology* MorseSmaleComplexExtraction::PrepareMesh(const PlanarScalarField& field, std::string& error)
+{
+  const Index nV = static_cast<Index>(field.Values.size());
+  if (this->GivenMesh)
+  {
+    if (this->GivenMesh->NumberOfVertices() != nV)
+    {
+      error = "the given mesh does not match the field";
+      return nullptr;
+    }
+  }
+  else if (field.IsGrid())
+  {
+    this->Mesh.BuildGrid(field.GridDimensions[0], field.GridDimensions[1], this->Parallel);
+  }
+  else if (!this->Mesh.Build(nV, field.Triangles, this->Parallel, error))
+  {
+    return nullptr;
+  }
+  const TriangleMeshTopology& mesh = this->GivenMesh ? *this->GivenMesh : this->Mesh;
+  for (Index v = 0; v < nV; ++v)
+  {
+    if (mesh.VertexTriangleBegin(v) == mesh.VertexTriangleEnd(v))
+    {
+      error = "point " + std::to_string(v) + " is not used by any triangle";
+      return nullptr;
+    }
+  }
+  // A mesh given as triangles (not a grid, not the caller's): must be a planar disk.
+  if (!this->GivenMesh && !field.IsGrid() && !field.Points.empty() && !this->Mesh.CheckPlanarDisk(field.Points, error))
+  {
+    return nullptr;
+  }
+  return &mesh;
 }
 } // namespace topospline

@@ -1,5 +1,5 @@
 // Stage 1 of the paper (section 3.1): the discrete Morse-Smale complex of a PL scalar field on
-// a planar triangulation: critical points, 1-cells (1-cells), 2-cells, and the per-vertex
+// a planar triangulation: critical points, 1-cells, 2-cells, and the per-vertex
 // ascending/descending manifolds that embed them.
 #pragma once
 
@@ -38,5 +38,9 @@ public:
   // Intermediate structures, kept for tests and later stages.
   TriangleMeshTopology Mesh;
   DiscreteGradient Gradient;
+
+private:
+  bool CheckField(const PlanarScalarField& field, std::string& error) const;
+  const TriangleMeshTopology* PrepareMesh(const PlanarScalarField& field, std::string& error);
 };
 } // namespace topospline

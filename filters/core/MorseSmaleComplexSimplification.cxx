@@ -1,6 +1,7 @@
 #include "MorseSmaleComplexSimplification.h"
 
 #include "DisjointSets.h"
+#include "JunctionPointDetection.h"
 
 #include <algorithm>
 #include <cmath>
@@ -68,6 +69,22 @@ struct AdjacencyRows
     }
   }
 };
+
+// The path of a forest (parent[root] == root) from the root of `node`'s tree to `node`.
+std::vector<Index> PathFromRoot(const std::vector<Index>& parent, Index node)
+{
+  std::vector<Index> path; // node first
+  for (Index u = node;; u = parent[u])
+  {
+    path.push_back(u);
+    if (parent[u] == u)
+    {
+      break;
+    }
+  }
+  std::reverse(path.begin(), path.end()); // root first
+  return path;
+}
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -92,29 +109,46 @@ const char* BlockReasonName(BlockReason reason)
 }
 
 //------------------------------------------------------------------------------
-bool MorseSmaleComplexSimplification::Check(const MorseSmaleComplex& input, std::string& error) const
+// The checks of the input's form, one part of the complex each. Each returns false with the
+// first problem in `error`.
+namespace
 {
-  auto fail = [&error](const std::string& what) {
-    error = "the input is not a Morse-Smale complex: " + what;
-    return false;
-  };
+bool Fail(std::string& error, const std::string& what)
+{
+  error = "the input is not a Morse-Smale complex: " + what;
+  return false;
+}
+
+bool IsCriticalPointOfIndex(const std::vector<CriticalPoint>& cps, Index i, int morseIndex)
+{
+  return i >= 0 && i < static_cast<Index>(cps.size()) && cps[i].MorseIndex == morseIndex;
+}
+
+bool CheckCriticalPoints(const MorseSmaleComplex& input, std::string& error)
+{
   const auto& cps = input.CriticalPoints;
   const Index nCP = static_cast<Index>(cps.size());
   if (nCP == 0)
   {
-    return fail("it has no critical points");
+    return Fail(error, "it has no critical points");
   }
   for (Index i = 0; i < nCP; ++i)
   {
     const CriticalPoint& cp = cps[i];
     if (cp.MorseIndex < 0 || cp.MorseIndex > 2 || cp.Vertex < 0 || cp.Cell < 0 || !std::isfinite(cp.Value))
     {
-      return fail("critical point " + std::to_string(i) + " has an invalid index, vertex, cell or value");
+      return Fail(error, "critical point " + std::to_string(i) + " has an invalid index, vertex, cell or value");
     }
   }
-  auto isCriticalPoint = [&](Index i, int morseIndex) {
-    return i >= 0 && i < nCP && cps[i].MorseIndex == morseIndex;
-  };
+  return true;
+}
+
+// Each 1-cell joins critical points of the right indices along its mesh cells, and every
+// saddle has two descending 1-cells and one or two ascending ones.
+bool CheckOneCells(const MorseSmaleComplex& input, std::string& error)
+{
+  const auto& cps = input.CriticalPoints;
+  const Index nCP = static_cast<Index>(cps.size());
   std::vector<int> descending(nCP, 0), ascending(nCP, 0);
   const auto& arcs = input.OneCells;
   for (size_t a = 0; a < arcs.size(); ++a)
@@ -124,61 +158,71 @@ bool MorseSmaleComplexSimplification::Check(const MorseSmaleComplex& input, std:
     const size_t n = arc.MeshCells.size();
     if (std::any_of(arc.MeshCells.begin(), arc.MeshCells.end(), [](Index c) { return c < 0; }))
     {
-      return fail(name + " has a negative mesh cell id");
+      return Fail(error, name + " has a negative mesh cell id");
     }
     if (arc.Type == OneCell::Descending)
     {
-      if (!isCriticalPoint(arc.Source, 0) || !isCriticalPoint(arc.Destination, 1))
+      if (!IsCriticalPointOfIndex(cps, arc.Source, 0) || !IsCriticalPointOfIndex(cps, arc.Destination, 1))
       {
-        return fail(name + " is descending but does not join a minimum to a saddle");
+        return Fail(error, name + " is descending but does not join a minimum to a saddle");
       }
       if (n < 1 || arc.Points.size() != 2 * n || arc.Values.size() != n)
       {
-        return fail(name + ": a descending 1-cell needs 1+ vertices, with one point and value each");
+        return Fail(error, name + ": a descending 1-cell needs 1+ vertices, with one point and value each");
       }
       if (arc.MeshCells.front() != cps[arc.Source].Vertex || arc.MeshCells.back() != cps[arc.Destination].Vertex)
       {
-        return fail(name + " does not run from its minimum's vertex to its saddle's vertex");
+        return Fail(error, name + " does not run from its minimum's vertex to its saddle's vertex");
       }
       ++descending[arc.Destination];
     }
     else if (arc.Type == OneCell::Ascending)
     {
-      if (!isCriticalPoint(arc.Source, 1) || !isCriticalPoint(arc.Destination, 2))
+      if (!IsCriticalPointOfIndex(cps, arc.Source, 1) || !IsCriticalPointOfIndex(cps, arc.Destination, 2))
       {
-        return fail(name + " is ascending but does not join a saddle to a maximum");
+        return Fail(error, name + " is ascending but does not join a saddle to a maximum");
       }
       if (n < 1 || arc.Points.size() != 2 * (n + 2) || arc.Values.size() != n + 2)
       {
-        return fail(name + ": an ascending 1-cell needs 1+ triangles and n+2 points and values");
+        return Fail(error, name + ": an ascending 1-cell needs 1+ triangles and n+2 points and values");
       }
       if (arc.MeshCells.back() != cps[arc.Destination].Cell)
       {
-        return fail(name + " does not end at its maximum's triangle");
+        return Fail(error, name + " does not end at its maximum's triangle");
       }
       ++ascending[arc.Source];
     }
     else
     {
-      return fail(name + " has an unknown type");
+      return Fail(error, name + " has an unknown type");
     }
   }
   for (Index i = 0; i < nCP; ++i)
   {
     if (cps[i].MorseIndex == 1 && (descending[i] != 2 || ascending[i] < 1 || ascending[i] > 2))
     {
-      return fail("saddle " + std::to_string(i) + " has " + std::to_string(descending[i]) +
+      return Fail(error, "saddle " + std::to_string(i) + " has " + std::to_string(descending[i]) +
         " descending and " + std::to_string(ascending[i]) + " ascending 1-cells (expected 2 and 1 or 2)");
     }
   }
+  return true;
+}
+
+// Each corner of a 2-cell is a saddle with a descending 1-cell to the cell's minimum and an
+// ascending one to its maximum.
+bool CheckTwoCells(const MorseSmaleComplex& input, std::string& error)
+{
+  const auto& cps = input.CriticalPoints;
+  const auto& arcs = input.OneCells;
   const Index nArcs = static_cast<Index>(arcs.size());
   for (size_t c = 0; c < input.TwoCells.size(); ++c)
   {
     const TwoCell& cell = input.TwoCells[c];
     const std::string name = "2-cell " + std::to_string(c);
-    if (!isCriticalPoint(cell.Minimum, 0) || !isCriticalPoint(cell.Maximum, 2) || cell.Saddles[0] == InvalidIndex)
+    if (!IsCriticalPointOfIndex(cps, cell.Minimum, 0) || !IsCriticalPointOfIndex(cps, cell.Maximum, 2) ||
+      cell.Saddles[0] == InvalidIndex)
     {
-      return fail(name + " lacks its minimum, maximum or first saddle");
+      return Fail(error, name + " lacks its minimum, maximum or first saddle");
     }
     for (int k = 0; k < 2; ++k)
     {
@@ -187,35 +231,49 @@ bool MorseSmaleComplexSimplification::Check(const MorseSmaleComplex& input, std:
         continue;
       }
       const Index d = cell.BoundaryOneCells[2 * k], u = cell.BoundaryOneCells[2 * k + 1];
-      if (!isCriticalPoint(cell.Saddles[k], 1) || d < 0 || d >= nArcs || u < 0 || u >= nArcs ||
+      if (!IsCriticalPointOfIndex(cps, cell.Saddles[k], 1) || d < 0 || d >= nArcs || u < 0 || u >= nArcs ||
         arcs[d].Type != OneCell::Descending || arcs[d].Destination != cell.Saddles[k] ||
         arcs[u].Type != OneCell::Ascending || arcs[u].Source != cell.Saddles[k])
       {
-        return fail(name + " has a corner whose 1-cells do not belong to its saddle");
+        return Fail(error, name + " has a corner whose 1-cells do not belong to its saddle");
       }
       if (arcs[d].Source != cell.Minimum || arcs[u].Destination != cell.Maximum)
       {
-        return fail(name + " has a corner whose 1-cells do not reach its minimum and maximum");
+        return Fail(error, name + " has a corner whose 1-cells do not reach its minimum and maximum");
       }
     }
   }
+  return true;
+}
+
+bool CheckVertexLabels(const MorseSmaleComplex& input, std::string& error)
+{
+  const auto& cps = input.CriticalPoints;
   const size_t nV = input.AscendingManifold.size();
   if (input.DescendingManifold.size() != nV || input.TwoCellId.size() != nV)
   {
-    return fail("its per-vertex arrays (manifolds, 2-cell ids) have different sizes");
+    return Fail(error, "its per-vertex arrays (manifolds, 2-cell ids) have different sizes");
   }
   const Index nCells = static_cast<Index>(input.TwoCells.size());
   for (size_t v = 0; v < nV; ++v)
   {
     const Index a = input.AscendingManifold[v], d = input.DescendingManifold[v], c = input.TwoCellId[v];
-    if ((a != InvalidIndex && !isCriticalPoint(a, 0)) || (d != InvalidIndex && !isCriticalPoint(d, 2)) ||
-      c < 0 || c >= nCells)
+    if ((a != InvalidIndex && !IsCriticalPointOfIndex(cps, a, 0)) ||
+      (d != InvalidIndex && !IsCriticalPointOfIndex(cps, d, 2)) || c < 0 || c >= nCells)
     {
-      return fail("vertex " + std::to_string(v) + " has an invalid manifold or 2-cell id");
+      return Fail(error, "vertex " + std::to_string(v) + " has an invalid manifold or 2-cell id");
     }
   }
   return true;
 }
+
+// A complex of the stage-1 form, as far as the simplification relies on it.
+bool CheckInput(const MorseSmaleComplex& input, std::string& error)
+{
+  return CheckCriticalPoints(input, error) && CheckOneCells(input, error) && CheckTwoCells(input, error) &&
+    CheckVertexLabels(input, error);
+}
+} // namespace
 
 //------------------------------------------------------------------------------
 bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& input, std::string& error)
@@ -224,15 +282,12 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
   this->Sequence.clear();
   this->Steps.clear();
 
-  if (!this->Check(input, error))
+  if (!CheckInput(input, error))
   {
     return false;
   }
   this->Input = input;
   const auto& cps = this->Input.CriticalPoints;
-  const auto& arcs = this->Input.OneCells;
-  const Index nCP = static_cast<Index>(cps.size());
-
   double lowest = cps[0].Value, highest = cps[0].Value;
   for (const CriticalPoint& cp : cps)
   {
@@ -241,6 +296,32 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
   }
   this->MaxPersistence = highest - lowest;
 
+  this->IndexOneCellsBySaddle();
+  this->FindBoundaryCurve();
+  if (!this->FindSaddleCorners(error))
+  {
+    return false;
+  }
+  this->Hooks.Report(0.1);
+
+  this->BuildForests();
+  this->Hooks.Report(0.3);
+  this->ComputeSequence();
+  if (this->Hooks.Aborted())
+  {
+    error = "aborted on request";
+    return false;
+  }
+  this->Hooks.Report(1.0);
+  this->Computed = true;
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void MorseSmaleComplexSimplification::IndexOneCellsBySaddle()
+{
+  const auto& arcs = this->Input.OneCells;
+  const Index nCP = static_cast<Index>(this->Input.CriticalPoints.size());
   this->SaddleOneCells.assign(nCP, { InvalidIndex, InvalidIndex, InvalidIndex, InvalidIndex });
   this->ArcExtremum.resize(arcs.size());
   for (Index a = 0; a < static_cast<Index>(arcs.size()); ++a)
@@ -251,16 +332,22 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
     slots[slots[first] == InvalidIndex ? first : first + 1] = a;
     this->ArcExtremum[a] = arc.Type == OneCell::Descending ? arc.Source : arc.Destination;
   }
+}
 
-  // The domain boundary is a closed curve made of descending 1-cells between boundary minima
-  // and boundary saddles (stage 1's boundary rule: boundary cells pair only with boundary
-  // cells): a 1D complex of its own, whose critical points are those of f along the curve,
-  // as many minima as saddles. A saddle is on it when its edge is a boundary edge, i.e. it
-  // has one triangle and so one ascending 1-cell; a minimum when such a saddle's 1-cells
-  // reach it. Read from the complex itself rather than from CriticalPoint::OnBoundary, which
-  // says where the vertex is: an interior saddle edge can hang from a boundary vertex (the
-  // epsilon pair of a boundary minimum whose vertex also owns an interior saddle), and a
-  // maximum triangle can touch the boundary; neither is a cell of the curve.
+//------------------------------------------------------------------------------
+// The domain boundary is a closed curve made of descending 1-cells between boundary minima
+// and boundary saddles (stage 1's boundary rule: boundary cells pair only with boundary
+// cells): a 1D complex of its own, whose critical points are those of f along the curve,
+// as many minima as saddles. A saddle is on it when its edge is a boundary edge, i.e. it
+// has one triangle and so one ascending 1-cell; a minimum when such a saddle's 1-cells
+// reach it. Read from the complex itself rather than from CriticalPoint::OnBoundary, which
+// says where the vertex is: an interior saddle edge can hang from a boundary vertex (the
+// epsilon pair of a boundary minimum whose vertex also owns an interior saddle), and a
+// maximum triangle can touch the boundary; neither is a cell of the curve.
+void MorseSmaleComplexSimplification::FindBoundaryCurve()
+{
+  const auto& cps = this->Input.CriticalPoints;
+  const Index nCP = static_cast<Index>(cps.size());
   this->OnBoundaryCurve.assign(nCP, 0);
   for (Index s = 0; s < nCP; ++s)
   {
@@ -271,8 +358,13 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
       this->OnBoundaryCurve[this->ArcExtremum[this->SaddleOneCells[s][1]]] = 1;
     }
   }
+}
 
-  // The 2-cell at each corner of each saddle (a descending and an ascending 1-cell of it).
+//------------------------------------------------------------------------------
+// The 2-cell at each corner of each saddle (a descending and an ascending 1-cell of it).
+bool MorseSmaleComplexSimplification::FindSaddleCorners(std::string& error)
+{
+  const Index nCP = static_cast<Index>(this->Input.CriticalPoints.size());
   this->SaddleCorners.assign(nCP, { InvalidIndex, InvalidIndex, InvalidIndex, InvalidIndex });
   for (Index c = 0; c < static_cast<Index>(this->Input.TwoCells.size()); ++c)
   {
@@ -296,18 +388,6 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
       }
     }
   }
-  this->Hooks.Report(0.1);
-
-  this->BuildForests();
-  this->Hooks.Report(0.3);
-  this->ComputeSequence();
-  if (this->Hooks.Aborted())
-  {
-    error = "aborted on request";
-    return false;
-  }
-  this->Hooks.Report(1.0);
-  this->Computed = true;
   return true;
 }
 
@@ -329,9 +409,8 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
 // cancelling a saddle against a maximum joins the two triangles of the saddle edge.
 void MorseSmaleComplexSimplification::BuildForests()
 {
-  const auto& cps = this->Input.CriticalPoints;
   const auto& arcs = this->Input.OneCells;
-  const Index nCP = static_cast<Index>(cps.size());
+  const Index nCP = static_cast<Index>(this->Input.CriticalPoints.size());
   const Index nArcs = static_cast<Index>(arcs.size());
 
   Index vertexBound = 0, triangleBound = 0;
@@ -346,84 +425,19 @@ void MorseSmaleComplexSimplification::BuildForests()
   std::vector<Index> nodeOfVertex(vertexBound, InvalidIndex), nodeOfTriangle(triangleBound, InvalidIndex);
   this->DescendingNodes = NodeSet();
   this->AscendingNodes = NodeSet();
-  auto node = [](NodeSet& set, std::vector<Index>& nodeOf, Index cell, const double* point, double value) {
-    if (nodeOf[cell] == InvalidIndex)
-    {
-      nodeOf[cell] = static_cast<Index>(set.Cell.size());
-      set.Cell.push_back(cell);
-      set.Point.push_back(point[0]);
-      set.Point.push_back(point[1]);
-      set.Value.push_back(value);
-    }
-    return nodeOf[cell];
-  };
-  auto addEdge = [](NodeSet& set, Index a, Index b) {
-    if (a != b)
-    {
-      set.Edges.push_back({ std::min(a, b), std::max(a, b) });
-    }
-  };
-
   this->ArcFirstNode.assign(nArcs, InvalidIndex);
   this->ArcLastNode.assign(nArcs, InvalidIndex);
   this->RootNode.assign(nCP, InvalidIndex);
   this->CriticalPointPosition.assign(2 * static_cast<size_t>(nCP), 0.0);
-  auto setPosition = [this](Index cp, const double* point) {
-    this->CriticalPointPosition[2 * cp] = point[0];
-    this->CriticalPointPosition[2 * cp + 1] = point[1];
-  };
   for (Index a = 0; a < nArcs; ++a)
   {
-    const OneCell& arc = arcs[a];
-    const Index n = static_cast<Index>(arc.MeshCells.size());
-    if (arc.Type == OneCell::Descending)
+    if (arcs[a].Type == OneCell::Descending)
     {
-      Index previous = InvalidIndex;
-      for (Index i = 0; i < n; ++i)
-      {
-        const Index current =
-          node(this->DescendingNodes, nodeOfVertex, arc.MeshCells[i], &arc.Points[2 * i], arc.Values[i]);
-        if (i > 0 && i < n - 1)
-        {
-          addEdge(this->DescendingNodes, previous, current);
-        }
-        if (i == 0)
-        {
-          this->RootNode[arc.Source] = current;
-        }
-        previous = current;
-      }
-      if (n == 1)
-      {
-        // A boundary minimum that owns an interior saddle (an epsilon pair of the boundary
-        // rule): the 1-cell is that vertex alone, with no saddle step.
-        this->ArcFirstNode[a] = nodeOfVertex[arc.MeshCells[0]];
-      }
-      else
-      {
-        this->ArcFirstNode[a] = nodeOfVertex[arc.MeshCells[n - 2]];
-        this->ArcLastNode[a] = nodeOfVertex[arc.MeshCells[n - 1]];
-      }
-      setPosition(arc.Source, &arc.Points[0]);
-      setPosition(arc.Destination, &arc.Points[2 * (n - 1)]);
+      this->AddDescendingPath(a, nodeOfVertex);
     }
     else
     {
-      Index previous = InvalidIndex;
-      for (Index i = 0; i < n; ++i)
-      {
-        const Index current = node(
-          this->AscendingNodes, nodeOfTriangle, arc.MeshCells[i], &arc.Points[2 * (i + 1)], arc.Values[i + 1]);
-        if (i > 0)
-        {
-          addEdge(this->AscendingNodes, previous, current);
-        }
-        previous = current;
-      }
-      this->ArcFirstNode[a] = nodeOfTriangle[arc.MeshCells[0]];
-      this->RootNode[arc.Destination] = previous;
-      setPosition(arc.Source, &arc.Points[0]);
-      setPosition(arc.Destination, &arc.Points[2 * (n + 1)]);
+      this->AddAscendingPath(a, nodeOfTriangle);
     }
   }
   for (NodeSet* set : { &this->DescendingNodes, &this->AscendingNodes })
@@ -431,6 +445,92 @@ void MorseSmaleComplexSimplification::BuildForests()
     std::sort(set->Edges.begin(), set->Edges.end());
     set->Edges.erase(std::unique(set->Edges.begin(), set->Edges.end()), set->Edges.end());
   }
+}
+
+Index MorseSmaleComplexSimplification::NodeSet::Node(
+  std::vector<Index>& nodeOf, Index cell, const double* point, double value)
+{
+  if (nodeOf[cell] == InvalidIndex)
+  {
+    nodeOf[cell] = static_cast<Index>(this->Cell.size());
+    this->Cell.push_back(cell);
+    this->Point.push_back(point[0]);
+    this->Point.push_back(point[1]);
+    this->Value.push_back(value);
+  }
+  return nodeOf[cell];
+}
+
+void MorseSmaleComplexSimplification::NodeSet::AddEdge(Index a, Index b)
+{
+  if (a != b)
+  {
+    this->Edges.push_back({ std::min(a, b), std::max(a, b) });
+  }
+}
+
+void MorseSmaleComplexSimplification::SetCriticalPointPosition(Index cp, const double* point)
+{
+  this->CriticalPointPosition[2 * cp] = point[0];
+  this->CriticalPointPosition[2 * cp + 1] = point[1];
+}
+
+// The vertices of descending 1-cell a as nodes, its gradient steps (all but the saddle step)
+// as edges.
+void MorseSmaleComplexSimplification::AddDescendingPath(Index a, std::vector<Index>& nodeOfVertex)
+{
+  const OneCell& arc = this->Input.OneCells[a];
+  const Index n = static_cast<Index>(arc.MeshCells.size());
+  Index previous = InvalidIndex;
+  for (Index i = 0; i < n; ++i)
+  {
+    const Index current =
+      this->DescendingNodes.Node(nodeOfVertex, arc.MeshCells[i], &arc.Points[2 * i], arc.Values[i]);
+    if (i > 0 && i < n - 1)
+    {
+      this->DescendingNodes.AddEdge(previous, current);
+    }
+    if (i == 0)
+    {
+      this->RootNode[arc.Source] = current;
+    }
+    previous = current;
+  }
+  if (n == 1)
+  {
+    // A boundary minimum that owns an interior saddle (an epsilon pair of the boundary
+    // rule): the 1-cell is that vertex alone, with no saddle step.
+    this->ArcFirstNode[a] = nodeOfVertex[arc.MeshCells[0]];
+  }
+  else
+  {
+    this->ArcFirstNode[a] = nodeOfVertex[arc.MeshCells[n - 2]];
+    this->ArcLastNode[a] = nodeOfVertex[arc.MeshCells[n - 1]];
+  }
+  this->SetCriticalPointPosition(arc.Source, &arc.Points[0]);
+  this->SetCriticalPointPosition(arc.Destination, &arc.Points[2 * (n - 1)]);
+}
+
+// The triangles of ascending 1-cell a as nodes, its steps as edges.
+void MorseSmaleComplexSimplification::AddAscendingPath(Index a, std::vector<Index>& nodeOfTriangle)
+{
+  const OneCell& arc = this->Input.OneCells[a];
+  const Index n = static_cast<Index>(arc.MeshCells.size());
+  Index previous = InvalidIndex;
+  for (Index i = 0; i < n; ++i)
+  {
+    const Index current =
+      this->AscendingNodes.Node(nodeOfTriangle, arc.MeshCells[i], &arc.Points[2 * (i + 1)], arc.Values[i + 1]);
+    if (i > 0)
+    {
+      this->AscendingNodes.AddEdge(previous, current);
+    }
+    previous = current;
+  }
+  this->ArcFirstNode[a] = nodeOfTriangle[arc.MeshCells[0]];
+  this->RootNode[arc.Destination] = previous;
+  this->SetCriticalPointPosition(arc.Source, &arc.Points[0]);
+  this->SetCriticalPointPosition(arc.Destination, &arc.Points[2 * (n + 1)]);
 }
 
 //------------------------------------------------------------------------------
@@ -503,6 +603,119 @@ std::vector<MorseSmaleComplexSimplification::PersistencePair> MorseSmaleComplexS
 }
 
 //------------------------------------------------------------------------------
+// A saddle-extremum pair joined by a 1-cell, waiting in the greedy queue.
+struct MorseSmaleComplexSimplification::Candidate
+{
+  double Persistence;
+  Index Saddle;
+  Index Extremum;
+};
+
+// What the greedy cancellation knows between two pops (positions of the input).
+struct MorseSmaleComplexSimplification::GreedyState
+{
+  // Ties in persistence (common: symmetric fields, and pairs on one vertex) are broken so
+  // that the younger extremum goes first, as the elder rule of persistent homology would
+  // (a higher minimum, a lower maximum, in stage 1's (value, vertex) order), then the saddle
+  // where the elder rule would pair it (the lower saddle for a minimum, the higher for a
+  // maximum), then ids: a total order, so the hierarchy does not depend on the queue.
+  static bool PopsBefore(const std::vector<CriticalPoint>& cps, const Candidate& a, const Candidate& b)
+  {
+    if (a.Persistence != b.Persistence)
+    {
+      return a.Persistence < b.Persistence;
+    }
+    const CriticalPoint& xa = cps[a.Extremum];
+    const CriticalPoint& xb = cps[b.Extremum];
+    if (xa.MorseIndex != xb.MorseIndex)
+    {
+      return xa.MorseIndex < xb.MorseIndex;
+    }
+    const bool minima = xa.MorseIndex == 0;
+    if (a.Extremum != b.Extremum)
+    {
+      return LowerCriticalPoint(xa, xb) != minima;
+    }
+    if (a.Saddle != b.Saddle)
+    {
+      return LowerCriticalPoint(cps[a.Saddle], cps[b.Saddle]) == minima;
+    }
+    return false;
+  }
+  // The queue's order: the top pops first.
+  struct PopsAfter
+  {
+    const std::vector<CriticalPoint>* CriticalPoints;
+    bool operator()(const Candidate& a, const Candidate& b) const
+    {
+      return PopsBefore(*this->CriticalPoints, b, a);
+    }
+  };
+
+  GreedyState(const std::vector<CriticalPoint>& cps, Index numberOfTwoCells)
+    : CriticalPoints(cps)
+    , Alive(cps.size(), 1)
+    , MergesMaxima(cps.size(), 0)
+    , PersistencePartner(cps.size(), InvalidIndex)
+    , PinnedBy(cps.size())
+    , StructuralPair(cps.size(), 0)
+    , Queue(PopsAfter{ &cps })
+    , SaddlesOf(cps.size())
+    , Forward(cps.size())
+    , Stamp(cps.size(), InvalidIndex)
+    , CellForward(numberOfTwoCells)
+  {
+    std::iota(this->Forward.begin(), this->Forward.end(), 0);
+    std::iota(this->CellForward.begin(), this->CellForward.end(), 0);
+  }
+
+  void Push(Index saddle, Index extremum)
+  {
+    const auto& cps = this->CriticalPoints;
+    this->Queue.push({ std::abs(cps[saddle].Value - cps[extremum].Value), saddle, extremum });
+  }
+  // Whether a living interior saddle on the boundary other than `except` pins boundary minimum b.
+  bool Pinned(Index b, Index except) const
+  {
+    return std::any_of(this->PinnedBy[b].begin(), this->PinnedBy[b].end(),
+      [&](Index e) { return e != except && this->Alive[e]; });
+  }
+  // The 2-cell that now represents the union holding input 2-cell `cell`.
+  Index CellClass(Index cell)
+  {
+    return cell == InvalidIndex ? InvalidIndex : FollowForwarding(this->CellForward, cell);
+  }
+
+  const std::vector<CriticalPoint>& CriticalPoints;
+  std::vector<unsigned char> Alive;
+  // Per saddle: whether it is where two superlevel components meet (elder rule on maxima).
+  std::vector<unsigned char> MergesMaxima;
+  // Per extremum: the saddle of its elder-rule pair.
+  std::vector<Index> PersistencePartner;
+  // Per boundary minimum: the interior saddles on the boundary that pin it; whether it is a
+  // boundary junction (cancelled with the saddle on its own vertex).
+  std::vector<std::vector<Index>> PinnedBy;
+  std::vector<unsigned char> StructuralPair;
+  std::priority_queue<Candidate, std::vector<Candidate>, PopsAfter> Queue;
+  // Saddles reached by each extremum's 1-cells (may hold dead saddles and repeats).
+  std::vector<std::vector<Index>> SaddlesOf;
+  std::vector<Index> Forward; // cancelled extremum -> the one that absorbed it
+  std::vector<Index> Stamp;   // per saddle: the last step that offered it again
+  std::vector<Index> CellForward;
+  double Threshold = 0; // running maximum of the persistences performed
+};
+
+// Where and how a popped pair would be cancelled.
+struct MorseSmaleComplexSimplification::CancellationPlan
+{
+  bool Minimum = false;
+  int Side = 0; // the saddle's 1-cell (of the extremum's kind) that reaches the extremum
+  Index Survivor = InvalidIndex;
+  std::array<std::array<Index, 2>, 2> Merges;
+  int NumberOfMerges = 0;
+};
+
+//------------------------------------------------------------------------------
 // Greedy cancellation in order of increasing persistence with a lazy priority queue
 // (Shivashankar's mscomplex-tri): every saddle-extremum pair joined by a 1-cell is a
 // candidate; validity is checked when a candidate is popped. The threshold is infinite, so
@@ -524,14 +737,38 @@ std::vector<MorseSmaleComplexSimplification::PersistencePair> MorseSmaleComplexS
 // saddle lives (BoundaryMinimumPinned).
 void MorseSmaleComplexSimplification::ComputeSequence()
 {
-  const auto& cps = this->Input.CriticalPoints;
-  const Index nCP = static_cast<Index>(cps.size());
+  const Index nCP = static_cast<Index>(this->Input.CriticalPoints.size());
+  GreedyState state(this->Input.CriticalPoints, static_cast<Index>(this->Input.TwoCells.size()));
+  this->ComputeOrdinaryPersistence(state);
+  this->FindBoundaryPins(state);
+  this->OfferAllPairs(state);
+  // Why each surviving extremum was last refused (NotAdjacent: never offered a 1-cell that
+  // reaches its persistence).
+  this->RefusalOf.assign(nCP, BlockReason::NotAdjacent);
+  this->CancelledAt.assign(nCP, std::numeric_limits<double>::infinity());
+  size_t pops = 0;
+  while (!state.Queue.empty())
+  {
+    if ((++pops & 0xfff) == 0 && this->Hooks.Aborted())
+    {
+      return;
+    }
+    const Candidate candidate = state.Queue.top();
+    state.Queue.pop();
+    CancellationPlan plan;
+    if (this->PlanCancellation(state, candidate, plan))
+    {
+      this->Cancel(state, candidate, plan);
+    }
+  }
+}
 
-  std::vector<unsigned char> alive(nCP, 1);
-  // Ordinary persistence of every extremum (the global ones: infinite, never cancelled).
-  this->OrdinaryPersistence.assign(nCP, std::numeric_limits<double>::infinity());
-  std::vector<unsigned char> mergesMaxima(nCP, 0);
-  std::vector<Index> persistencePartner(nCP, InvalidIndex);
+//------------------------------------------------------------------------------
+// Ordinary persistence of every extremum (the global ones: infinite, never cancelled), by the
+// elder rule on both kinds.
+void MorseSmaleComplexSimplification::ComputeOrdinaryPersistence(GreedyState& state)
+{
+  this->OrdinaryPersistence.assign(this->Input.CriticalPoints.size(), std::numeric_limits<double>::infinity());
   this->ElderPairs.clear();
   for (const bool minima : { true, false })
   {
@@ -540,17 +777,22 @@ void MorseSmaleComplexSimplification::ComputeSequence()
     for (const PersistencePair& pair : pairs)
     {
       this->OrdinaryPersistence[pair.Extremum] = pair.Persistence;
-      persistencePartner[pair.Extremum] = pair.Saddle;
-      mergesMaxima[pair.Saddle] |= minima ? 0 : 1;
+      state.PersistencePartner[pair.Extremum] = pair.Saddle;
+      state.MergesMaxima[pair.Saddle] |= minima ? 0 : 1;
     }
   }
-  // Interior saddles whose vertex lies on the boundary: the descending 1-cell that starts at
-  // that vertex runs along the boundary (boundary vertices pair with boundary edges) to a
-  // minimum of the boundary curve, which they pin (see BoundaryMinimumPinned below). The one
-  // on the minimum's own vertex is its zero-persistence partner, cancelled with it as a
-  // boundary junction unless it also merges maxima.
-  std::vector<std::vector<Index>> pinnedBy(nCP);
-  std::vector<unsigned char> structuralPair(nCP, 0);
+}
+
+//------------------------------------------------------------------------------
+// Interior saddles whose vertex lies on the boundary: the descending 1-cell that starts at
+// that vertex runs along the boundary (boundary vertices pair with boundary edges) to a
+// minimum of the boundary curve, which they pin (see BoundaryMinimumPinned). The one on the
+// minimum's own vertex is its zero-persistence partner, cancelled with it as a boundary
+// junction unless it also merges maxima.
+void MorseSmaleComplexSimplification::FindBoundaryPins(GreedyState& state) const
+{
+  const auto& cps = this->Input.CriticalPoints;
+  const Index nCP = static_cast<Index>(cps.size());
   for (Index e = 0; e < nCP; ++e)
   {
     if (cps[e].MorseIndex != 1 || this->OnBoundaryCurve[e] || !cps[e].OnBoundary)
@@ -562,59 +804,22 @@ void MorseSmaleComplexSimplification::ComputeSequence()
       const Index b = this->ArcExtremum[this->SaddleOneCells[e][k]];
       if (this->OnBoundaryCurve[b])
       {
-        pinnedBy[b].push_back(e);
-        if (cps[b].Vertex == cps[e].Vertex && persistencePartner[b] == e && !mergesMaxima[e])
+        state.PinnedBy[b].push_back(e);
+        if (cps[b].Vertex == cps[e].Vertex && state.PersistencePartner[b] == e && !state.MergesMaxima[e])
         {
-          structuralPair[b] = 1;
+          state.StructuralPair[b] = 1;
         }
       }
     }
   }
-  auto pinned = [&](Index b, Index except) {
-    return std::any_of(pinnedBy[b].begin(), pinnedBy[b].end(), [&](Index e) { return e != except && alive[e]; });
-  };
+}
 
-  struct Candidate
-  {
-    double Persistence;
-    Index Saddle;
-    Index Extremum;
-  };
-  // Ties in persistence (common: symmetric fields, and pairs on one vertex) are broken so
-  // that the younger extremum goes first, as the elder rule of persistent homology would
-  // (a higher minimum, a lower maximum, in stage 1's (value, vertex) order), then the saddle
-  // where the elder rule would pair it (the lower saddle for a minimum, the higher for a
-  // maximum), then ids: a total order, so the hierarchy does not depend on the queue.
-  auto popsBefore = [&cps](const Candidate& a, const Candidate& b) {
-    if (a.Persistence != b.Persistence)
-    {
-      return a.Persistence < b.Persistence;
-    }
-    const CriticalPoint& xa = cps[a.Extremum];
-    const CriticalPoint& xb = cps[b.Extremum];
-    if (xa.MorseIndex != xb.MorseIndex)
-    {
-      return xa.MorseIndex < xb.MorseIndex;
-    }
-    const bool minima = xa.MorseIndex == 0;
-    if (a.Extremum != b.Extremum)
-    {
-      return LowerCriticalPoint(xa, xb) != minima;
-    }
-    if (a.Saddle != b.Saddle)
-    {
-      return LowerCriticalPoint(cps[a.Saddle], cps[b.Saddle]) == minima;
-    }
-    return false;
-  };
-  auto popsAfter = [&popsBefore](const Candidate& a, const Candidate& b) { return popsBefore(b, a); };
-  std::priority_queue<Candidate, std::vector<Candidate>, decltype(popsAfter)> queue(popsAfter);
-  auto push = [&](Index saddle, Index extremum) {
-    queue.push({ std::abs(cps[saddle].Value - cps[extremum].Value), saddle, extremum });
-  };
-
-  // Saddles reached by each extremum's 1-cells (may hold dead saddles and repeats).
-  std::vector<std::vector<Index>> saddlesOf(nCP);
+//------------------------------------------------------------------------------
+// Every saddle-extremum pair joined by a 1-cell is a candidate.
+void MorseSmaleComplexSimplification::OfferAllPairs(GreedyState& state) const
+{
+  const auto& cps = this->Input.CriticalPoints;
+  const Index nCP = static_cast<Index>(cps.size());
   for (Index s = 0; s < nCP; ++s)
   {
     if (cps[s].MorseIndex != 1)
@@ -625,168 +830,174 @@ void MorseSmaleComplexSimplification::ComputeSequence()
     {
       if (a != InvalidIndex)
       {
-        saddlesOf[this->ArcExtremum[a]].push_back(s);
-        push(s, this->ArcExtremum[a]);
+        state.SaddlesOf[this->ArcExtremum[a]].push_back(s);
+        state.Push(s, this->ArcExtremum[a]);
       }
     }
   }
+}
 
-  std::vector<Index> forward(nCP);
-  std::iota(forward.begin(), forward.end(), 0);
-  std::vector<Index> stamp(nCP, InvalidIndex);
-  std::vector<Index> cellForward(this->Input.TwoCells.size());
-  std::iota(cellForward.begin(), cellForward.end(), 0);
-  auto cellClass = [&cellForward](Index cell) {
-    return cell == InvalidIndex ? InvalidIndex : FollowForwarding(cellForward, cell);
-  };
-  // Why each surviving extremum was last refused (NotAdjacent: never offered a 1-cell that
-  // reaches its persistence).
-  this->RefusalOf.assign(nCP, BlockReason::NotAdjacent);
-  this->CancelledAt.assign(nCP, std::numeric_limits<double>::infinity());
-  double threshold = 0;
-  size_t pops = 0;
-  while (!queue.empty())
+//------------------------------------------------------------------------------
+// The cancellation rules (paper, section 3.2, and the boundary rules at the top of the
+// header), checked when a pair is popped. False when the pair cannot be cancelled now; for
+// the rules that block its extremum, RefusalOf says which.
+bool MorseSmaleComplexSimplification::PlanCancellation(
+  GreedyState& state, const Candidate& candidate, CancellationPlan& plan)
+{
+  const auto& cps = this->Input.CriticalPoints;
+  const Index s = candidate.Saddle, x = candidate.Extremum;
+  if (!state.Alive[s] || !state.Alive[x])
   {
-    if ((++pops & 0xfff) == 0 && this->Hooks.Aborted())
+    return false;
+  }
+  // The saddle's 1-cells of the extremum's kind, and how many of them reach it now.
+  plan.Minimum = cps[x].MorseIndex == 0;
+  const int first = plan.Minimum ? 0 : 2;
+  const auto& slots = this->SaddleOneCells[s];
+  if (slots[first + 1] == InvalidIndex)
+  {
+    // A boundary saddle has a single ascending 1-cell: no other maximum could take over.
+    return false;
+  }
+  // A 1-cell shorter in value than the extremum's persistence is not where its sublevel
+  // (superlevel) component ends: cancelling there would remove a larger feature.
+  if (candidate.Persistence < this->OrdinaryPersistence[x])
+  {
+    return false;
+  }
+  int reaching = 0;
+  for (int k = 0; k < 2; ++k)
+  {
+    if (FollowForwarding(state.Forward, this->ArcExtremum[slots[first + k]]) == x)
     {
-      return;
+      ++reaching;
+      plan.Side = k;
     }
-    const Candidate candidate = queue.top();
-    queue.pop();
-    const Index s = candidate.Saddle, x = candidate.Extremum;
-    if (!alive[s] || !alive[x])
-    {
-      continue;
-    }
-    // The saddle's 1-cells of the extremum's kind, and how many of them reach it now.
-    const bool minimum = cps[x].MorseIndex == 0;
-    const int first = minimum ? 0 : 2;
-    const auto& slots = this->SaddleOneCells[s];
-    if (slots[first + 1] == InvalidIndex)
-    {
-      // A boundary saddle has a single ascending 1-cell: no other maximum could take over.
-      continue;
-    }
-    // A 1-cell shorter in value than the extremum's persistence is not where its sublevel
-    // (superlevel) component ends: cancelling there would remove a larger feature.
-    if (candidate.Persistence < this->OrdinaryPersistence[x])
-    {
-      continue;
-    }
-    int reaching = 0, side = 0;
-    for (int k = 0; k < 2; ++k)
-    {
-      if (FollowForwarding(forward, this->ArcExtremum[slots[first + k]]) == x)
-      {
-        ++reaching;
-        side = k;
-      }
-    }
-    // Exactly one 1-cell: a pair joined twice bounds a region (a pouch or a strangulation)
-    // that the cancellation would pinch off, and the new 1-cells would be loops.
-    if (reaching != 1)
-    {
-      this->RefusalOf[x] = BlockReason::DoubleOneCell;
-      continue;
-    }
-    // Boundary-boundary pairs are cancellations inside the 1D complex of the boundary curve:
-    // the curve keeps as many minima as saddles and stays a chain of descending 1-cells. A
-    // boundary-interior pair would remove a critical point of that curve alone: the curve
-    // would lose a minimum (or saddle) without its partner, so it would no longer be made of
-    // 1-cells joining boundary minima and saddles, and the 2-cells along it would not close.
-    // The one exception is a boundary junction (above): its 1-cells go on into the domain.
-    const bool junction = structuralPair[x] && cps[s].Vertex == cps[x].Vertex;
-    if (this->OnBoundaryCurve[s] != this->OnBoundaryCurve[x] && !junction)
-    {
-      this->RefusalOf[x] = BlockReason::BoundaryInterior;
-      continue;
-    }
-    // A boundary minimum pinned by a living interior saddle on the boundary: cancelling it
-    // along the curve would send that saddle's 1-cell on along the boundary to the survivor,
-    // back over the saddle's own vertex or past the vertices of other such saddles, which
-    // may be higher than it: stage 3 could not make it monotone.
-    if (pinned(x, s))
-    {
-      this->RefusalOf[x] = BlockReason::BoundaryMinimumPinned;
-      continue;
-    }
-    // Each merge of 2-cells must join two different ones. In a planar complex they always
-    // do; a merge inside one 2-cell would leave a 2-cell without corners. That happens only
-    // when the two 2-cells on both sides of a loop of s are both pouches of s, which no
-    // planar complex has: it flags a wrong sector pairing of stage 1, and the pair is kept.
-    std::array<std::array<Index, 2>, 2> merges;
-    const int numberOfMerges = this->CellMerges(s, minimum, side, merges);
-    std::array<Index, 2> firstMerge{ cellClass(merges[0][0]), cellClass(merges[0][1]) };
-    std::array<Index, 2> secondMerge{ InvalidIndex, InvalidIndex };
-    if (numberOfMerges == 2)
-    {
-      secondMerge = { cellClass(merges[1][0]), cellClass(merges[1][1]) };
-    }
-    std::sort(firstMerge.begin(), firstMerge.end());
-    std::sort(secondMerge.begin(), secondMerge.end());
-    const bool cellsKnown = firstMerge[0] != InvalidIndex && (numberOfMerges == 1 || secondMerge[0] != InvalidIndex);
-    if (cellsKnown &&
-      (firstMerge[0] == firstMerge[1] ||
-        (numberOfMerges == 2 && (secondMerge[0] == secondMerge[1] || firstMerge == secondMerge))))
-    {
-      this->RefusalOf[x] = BlockReason::TwoCellPinched;
-      continue;
-    }
-    const Index survivor = FollowForwarding(forward, this->ArcExtremum[slots[first + 1 - side]]);
-    // Every other saddle of x gets a 1-cell to the survivor, which must be lower than it (a
-    // minimum; higher for a maximum). Popping in order of value difference guarantees this,
-    // unless a 1-cell shorter than its extremum's persistence was passed over above.
-    const bool inverts = std::any_of(saddlesOf[x].begin(), saddlesOf[x].end(), [&](Index other) {
-      return other != s && alive[other] && LowerCriticalPoint(cps[other], cps[survivor]) == minimum;
-    });
-    if (inverts)
-    {
-      this->RefusalOf[x] = BlockReason::InvertedOneCell;
-      continue;
-    }
-    threshold = std::max(threshold, candidate.Persistence);
-    for (int k = 0; k < numberOfMerges; ++k)
-    {
-      const Index a = cellClass(merges[k][0]), b = cellClass(merges[k][1]);
-      if (a != InvalidIndex && b != InvalidIndex && a != b)
-      {
-        cellForward[std::max(a, b)] = std::min(a, b);
-      }
-    }
-    this->Sequence.push_back({ minimum ? cps[x].Id : cps[s].Id, minimum ? cps[s].Id : cps[x].Id,
-      cps[survivor].Id, candidate.Persistence, threshold });
-    this->Steps.push_back({ s, x, survivor, side });
-    this->CancelledAt[x] = threshold;
-    alive[s] = alive[x] = 0;
-    forward[x] = survivor;
+  }
+  // Exactly one 1-cell: a pair joined twice bounds a region (a pouch or a strangulation)
+  // that the cancellation would pinch off, and the new 1-cells would be loops.
+  if (reaching != 1)
+  {
+    this->RefusalOf[x] = BlockReason::DoubleOneCell;
+    return false;
+  }
+  // Boundary-boundary pairs are cancellations inside the 1D complex of the boundary curve:
+  // the curve keeps as many minima as saddles and stays a chain of descending 1-cells. A
+  // boundary-interior pair would remove a critical point of that curve alone: the curve
+  // would lose a minimum (or saddle) without its partner, so it would no longer be made of
+  // 1-cells joining boundary minima and saddles, and the 2-cells along it would not close.
+  // The one exception is a boundary junction (ComputeSequence): its 1-cells go on into the
+  // domain.
+  const bool junction = state.StructuralPair[x] && cps[s].Vertex == cps[x].Vertex;
+  if (this->OnBoundaryCurve[s] != this->OnBoundaryCurve[x] && !junction)
+  {
+    this->RefusalOf[x] = BlockReason::BoundaryInterior;
+    return false;
+  }
+  // A boundary minimum pinned by a living interior saddle on the boundary: cancelling it
+  // along the curve would send that saddle's 1-cell on along the boundary to the survivor,
+  // back over the saddle's own vertex or past the vertices of other such saddles, which
+  // may be higher than it: stage 3 could not make it monotone.
+  if (state.Pinned(x, s))
+  {
+    this->RefusalOf[x] = BlockReason::BoundaryMinimumPinned;
+    return false;
+  }
+  if (this->WouldPinchTwoCell(state, s, plan))
+  {
+    this->RefusalOf[x] = BlockReason::TwoCellPinched;
+    return false;
+  }
+  plan.Survivor = FollowForwarding(state.Forward, this->ArcExtremum[slots[first + 1 - plan.Side]]);
+  // Every other saddle of x gets a 1-cell to the survivor, which must be lower than it (a
+  // minimum; higher for a maximum). Popping in order of value difference guarantees this,
+  // unless a 1-cell shorter than its extremum's persistence was passed over above.
+  const bool inverts = std::any_of(state.SaddlesOf[x].begin(), state.SaddlesOf[x].end(), [&](Index other) {
+    return other != s && state.Alive[other] && LowerCriticalPoint(cps[other], cps[plan.Survivor]) == plan.Minimum;
+  });
+  if (inverts)
+  {
+    this->RefusalOf[x] = BlockReason::InvertedOneCell;
+    return false;
+  }
+  return true;
+}
 
-    // The paper's rule: every other saddle of x is now joined to the survivor, once per
-    // 1-cell that reached x (multiplicities multiply, and s has one 1-cell to the survivor).
-    const Index step = static_cast<Index>(this->Steps.size());
-    std::vector<Index>& moved = saddlesOf[x];
-    std::vector<Index>& kept = saddlesOf[survivor];
-    for (Index other : moved)
+//------------------------------------------------------------------------------
+// Each merge of 2-cells must join two different ones. In a planar complex they always do; a
+// merge inside one 2-cell would leave a 2-cell without corners. That happens only when the
+// two 2-cells on both sides of a loop of s are both pouches of s, which no planar complex
+// has: it flags a wrong sector pairing of stage 1, and the pair is kept. Fills plan.Merges.
+bool MorseSmaleComplexSimplification::WouldPinchTwoCell(GreedyState& state, Index s, CancellationPlan& plan) const
+{
+  auto& merges = plan.Merges;
+  plan.NumberOfMerges = this->CellMerges(s, plan.Minimum, plan.Side, merges);
+  const int numberOfMerges = plan.NumberOfMerges;
+  std::array<Index, 2> firstMerge{ state.CellClass(merges[0][0]), state.CellClass(merges[0][1]) };
+  std::array<Index, 2> secondMerge{ InvalidIndex, InvalidIndex };
+  if (numberOfMerges == 2)
+  {
+    secondMerge = { state.CellClass(merges[1][0]), state.CellClass(merges[1][1]) };
+  }
+  std::sort(firstMerge.begin(), firstMerge.end());
+  std::sort(secondMerge.begin(), secondMerge.end());
+  const bool cellsKnown = firstMerge[0] != InvalidIndex && (numberOfMerges == 1 || secondMerge[0] != InvalidIndex);
+  return cellsKnown &&
+    (firstMerge[0] == firstMerge[1] ||
+      (numberOfMerges == 2 && (secondMerge[0] == secondMerge[1] || firstMerge == secondMerge)));
+}
+
+//------------------------------------------------------------------------------
+// Performs a planned cancellation: records it, merges the 2-cells and offers the pairs it
+// creates.
+void MorseSmaleComplexSimplification::Cancel(
+  GreedyState& state, const Candidate& candidate, const CancellationPlan& plan)
+{
+  const auto& cps = this->Input.CriticalPoints;
+  const Index s = candidate.Saddle, x = candidate.Extremum, survivor = plan.Survivor;
+  state.Threshold = std::max(state.Threshold, candidate.Persistence);
+  for (int k = 0; k < plan.NumberOfMerges; ++k)
+  {
+    const Index a = state.CellClass(plan.Merges[k][0]), b = state.CellClass(plan.Merges[k][1]);
+    if (a != InvalidIndex && b != InvalidIndex && a != b)
     {
-      if (alive[other] && stamp[other] != step)
-      {
-        stamp[other] = step;
-        kept.push_back(other);
-        push(other, survivor);
-      }
+      state.CellForward[std::max(a, b)] = std::min(a, b);
     }
-    std::vector<Index>().swap(moved);
-    // A boundary minimum pinned by this saddle may be free now: offer its 1-cells again.
-    for (int k = 0; k < 2; ++k)
+  }
+  this->Sequence.push_back({ plan.Minimum ? cps[x].Id : cps[s].Id, plan.Minimum ? cps[s].Id : cps[x].Id,
+    cps[survivor].Id, candidate.Persistence, state.Threshold });
+  this->Steps.push_back({ s, x, survivor, plan.Side });
+  this->CancelledAt[x] = state.Threshold;
+  state.Alive[s] = state.Alive[x] = 0;
+  state.Forward[x] = survivor;
+
+  // The paper's rule: every other saddle of x is now joined to the survivor, once per
+  // 1-cell that reached x (multiplicities multiply, and s has one 1-cell to the survivor).
+  const Index step = static_cast<Index>(this->Steps.size());
+  std::vector<Index>& moved = state.SaddlesOf[x];
+  std::vector<Index>& kept = state.SaddlesOf[survivor];
+  for (Index other : moved)
+  {
+    if (state.Alive[other] && state.Stamp[other] != step)
     {
-      const Index b = FollowForwarding(forward, this->ArcExtremum[slots[k]]);
-      if (alive[b] && this->OnBoundaryCurve[b] && !pinned(b, InvalidIndex))
+      state.Stamp[other] = step;
+      kept.push_back(other);
+      state.Push(other, survivor);
+    }
+  }
+  std::vector<Index>().swap(moved);
+  // A boundary minimum pinned by this saddle may be free now: offer its 1-cells again.
+  const auto& slots = this->SaddleOneCells[s];
+  for (int k = 0; k < 2; ++k)
+  {
+    const Index b = FollowForwarding(state.Forward, this->ArcExtremum[slots[k]]);
+    if (state.Alive[b] && this->OnBoundaryCurve[b] && !state.Pinned(b, InvalidIndex))
+    {
+      for (Index other : state.SaddlesOf[b])
       {
-        for (Index other : saddlesOf[b])
+        if (state.Alive[other])
         {
-          if (alive[other])
-          {
-            push(other, b);
-          }
+          state.Push(other, b);
         }
       }
     }
@@ -822,6 +1033,32 @@ bool MorseSmaleComplexSimplification::Simplify(double percent, MorseSmaleComplex
   return true;
 }
 
+// The input after the first cancellations of the hierarchy: what survives, and where each
+// input element went in the output.
+struct MorseSmaleComplexSimplification::Replay
+{
+  Index Performed = 0;
+  std::vector<unsigned char> Alive;
+  std::vector<Index> Forward;  // cancelled extremum -> the one that absorbed it
+  std::vector<Index> Position; // surviving critical point -> its position in the output
+  std::vector<Index> OutputOneCell; // per input 1-cell (InvalidIndex if gone)
+  std::vector<Index> CellForward;   // merged 2-cell -> the 2-cell that represents the union
+  std::vector<Index> OutputTwoCell; // per representative input 2-cell
+
+  // The output position of the critical point that holds cp's region now.
+  Index SurvivorPosition(Index cp)
+  {
+    return cp == InvalidIndex ? InvalidIndex : this->Position[FollowForwarding(this->Forward, cp)];
+  }
+};
+
+// The gradient forests with the joins of the cancelled saddles, each tree grown from its
+// surviving extremum: per node, its parent towards the extremum and the extremum (its tree).
+struct MorseSmaleComplexSimplification::MergedForests
+{
+  std::vector<Index> DescendingParent, DescendingTree, AscendingParent, AscendingTree;
+};
+
 bool MorseSmaleComplexSimplification::Simplify(
   double percent, SimplificationOutput& output, std::string& error) const
 {
@@ -839,8 +1076,25 @@ bool MorseSmaleComplexSimplification::Simplify(
   output.AbsoluteThreshold = percent / 100 * this->MaxPersistence;
   const Index performed = this->NumberOfCancellations(percent);
   output.Cancellations.assign(this->Sequence.begin(), this->Sequence.begin() + performed);
-  // Extrema below the threshold that the rules kept (a replay at percent = 100 keeps none
-  // that any rule allows to go).
+  this->ReportBlockedExtrema(percent, output);
+
+  Replay replay = this->ReplayCancellations(performed, output.Complex);
+  const MergedForests forests = this->GrowMergedForests(replay);
+  if (!this->BuildMergedOneCells(replay, forests, output.Complex, error))
+  {
+    return false;
+  }
+  this->BuildMergedTwoCells(replay, output.Complex);
+  this->RelabelVertices(replay, output.Complex);
+  output.JunctionPoints = DetectJunctionPoints(output.Complex);
+  return true;
+}
+
+//------------------------------------------------------------------------------
+// Extrema below the threshold that the rules kept (a replay at percent = 100 keeps none that
+// any rule allows to go).
+void MorseSmaleComplexSimplification::ReportBlockedExtrema(double percent, SimplificationOutput& output) const
+{
   const double absolute = percent >= 100 ? std::numeric_limits<double>::infinity() : output.AbsoluteThreshold;
   for (const auto& pair : this->ElderPairs)
   {
@@ -853,24 +1107,28 @@ bool MorseSmaleComplexSimplification::Simplify(
       output.BlockReasons.push_back(this->RefusalOf[x]);
     }
   }
+}
 
+//------------------------------------------------------------------------------
+// Survivors and where each cancelled extremum's region went; the surviving critical points
+// and the boundary junctions of the output.
+MorseSmaleComplexSimplification::Replay MorseSmaleComplexSimplification::ReplayCancellations(
+  Index performed, MorseSmaleComplex& out) const
+{
   const MorseSmaleComplex& in = this->Input;
   const auto& cps = in.CriticalPoints;
-  const auto& arcs = in.OneCells;
   const Index nCP = static_cast<Index>(cps.size());
-  const Index nArcs = static_cast<Index>(arcs.size());
-  MorseSmaleComplex& out = output.Complex;
-
-  // Survivors and where each cancelled extremum's region went.
-  std::vector<unsigned char> alive(nCP, 1);
-  std::vector<Index> forward(nCP);
-  std::iota(forward.begin(), forward.end(), 0);
+  Replay replay;
+  replay.Performed = performed;
+  replay.Alive.assign(nCP, 1);
+  replay.Forward.resize(nCP);
+  std::iota(replay.Forward.begin(), replay.Forward.end(), 0);
   out.BoundaryJunctions = in.BoundaryJunctions;
   for (Index j = 0; j < performed; ++j)
   {
     const Step& step = this->Steps[j];
-    alive[step.Saddle] = alive[step.Extremum] = 0;
-    forward[step.Extremum] = step.Survivor;
+    replay.Alive[step.Saddle] = replay.Alive[step.Extremum] = 0;
+    replay.Forward[step.Extremum] = step.Survivor;
     // The only boundary-interior cancellations ComputeSequence performs are boundary junctions.
     if (this->OnBoundaryCurve[step.Extremum] != this->OnBoundaryCurve[step.Saddle])
     {
@@ -878,23 +1136,29 @@ bool MorseSmaleComplexSimplification::Simplify(
     }
   }
   std::sort(out.BoundaryJunctions.begin(), out.BoundaryJunctions.end());
-  std::vector<Index> position(nCP, InvalidIndex);
+  replay.Position.assign(nCP, InvalidIndex);
   for (Index i = 0; i < nCP; ++i)
   {
-    if (alive[i])
+    if (replay.Alive[i])
     {
-      position[i] = static_cast<Index>(out.CriticalPoints.size());
+      replay.Position[i] = static_cast<Index>(out.CriticalPoints.size());
       out.CriticalPoints.push_back(cps[i]);
     }
   }
-  auto survivorPosition = [&](Index cp) {
-    return cp == InvalidIndex ? InvalidIndex : position[FollowForwarding(forward, cp)];
-  };
+  return replay;
+}
 
-  // The merged gradient forests, each tree grown from its surviving extremum. A tree is
-  // traversed breadth-first, so every node gets its parent towards the extremum.
+//------------------------------------------------------------------------------
+// The merged gradient forests (see BuildForests): the forests of the input joined by the
+// saddle steps of the cancelled saddles. A tree is traversed breadth-first, so every node
+// gets its parent towards the extremum.
+MorseSmaleComplexSimplification::MergedForests MorseSmaleComplexSimplification::GrowMergedForests(
+  const Replay& replay) const
+{
+  const auto& cps = this->Input.CriticalPoints;
+  const Index nCP = static_cast<Index>(cps.size());
   std::vector<std::array<Index, 2>> descendingJoins, ascendingJoins;
-  for (Index j = 0; j < performed; ++j)
+  for (Index j = 0; j < replay.Performed; ++j)
   {
     const Step& step = this->Steps[j];
     const auto& slots = this->SaddleOneCells[step.Saddle];
@@ -924,7 +1188,7 @@ bool MorseSmaleComplexSimplification::Simplify(
     for (Index x = 0; x < nCP; ++x)
     {
       const Index root = this->RootNode[x];
-      if (!alive[x] || cps[x].MorseIndex != morseIndex || root == InvalidIndex || tree[root] != InvalidIndex)
+      if (!replay.Alive[x] || cps[x].MorseIndex != morseIndex || root == InvalidIndex || tree[root] != InvalidIndex)
       {
         continue;
       }
@@ -947,54 +1211,53 @@ bool MorseSmaleComplexSimplification::Simplify(
       }
     }
   };
-  std::vector<Index> descendingParent, descendingTree, ascendingParent, ascendingTree;
-  growForest(this->DescendingNodes, descendingJoins, 0, descendingParent, descendingTree);
-  growForest(this->AscendingNodes, ascendingJoins, 2, ascendingParent, ascendingTree);
+  MergedForests forests;
+  growForest(this->DescendingNodes, descendingJoins, 0, forests.DescendingParent, forests.DescendingTree);
+  growForest(this->AscendingNodes, ascendingJoins, 2, forests.AscendingParent, forests.AscendingTree);
+  return forests;
+}
 
-  // 1-cells: one per 1-cell of a surviving saddle, now ending at the survivor of its
-  // extremum. Each keeps its node sequence from the extremum, for the junction points.
-  std::vector<Index> outputArc(nArcs, InvalidIndex);
-  std::vector<std::vector<Index>> fromExtremum;
+//------------------------------------------------------------------------------
+// 1-cells: one per 1-cell of a surviving saddle, now ending at the survivor of its extremum,
+// along its path in the merged forest.
+bool MorseSmaleComplexSimplification::BuildMergedOneCells(
+  Replay& replay, const MergedForests& forests, MorseSmaleComplex& out, std::string& error) const
+{
+  const auto& cps = this->Input.CriticalPoints;
+  const auto& arcs = this->Input.OneCells;
+  const Index nArcs = static_cast<Index>(arcs.size());
+  replay.OutputOneCell.assign(nArcs, InvalidIndex);
   for (Index a = 0; a < nArcs; ++a)
   {
     const OneCell& arc = arcs[a];
     const bool descending = arc.Type == OneCell::Descending;
     const Index saddle = descending ? arc.Destination : arc.Source;
-    if (!alive[saddle])
+    if (!replay.Alive[saddle])
     {
       continue;
     }
-    const Index extremum = FollowForwarding(forward, this->ArcExtremum[a]);
+    const Index extremum = FollowForwarding(replay.Forward, this->ArcExtremum[a]);
     const NodeSet& nodes = descending ? this->DescendingNodes : this->AscendingNodes;
-    const std::vector<Index>& parent = descending ? descendingParent : ascendingParent;
-    const std::vector<Index>& tree = descending ? descendingTree : ascendingTree;
+    const std::vector<Index>& parent = descending ? forests.DescendingParent : forests.AscendingParent;
+    const std::vector<Index>& tree = descending ? forests.DescendingTree : forests.AscendingTree;
     const Index start = this->ArcFirstNode[a];
     if (tree[start] != extremum)
     {
       error = "internal error: 1-cell " + std::to_string(a) + " is not connected to the extremum that absorbed its own";
       return false;
     }
-    std::vector<Index> path; // saddle side first
-    for (Index u = start;; u = parent[u])
-    {
-      path.push_back(u);
-      if (parent[u] == u)
-      {
-        break;
-      }
-    }
-    std::reverse(path.begin(), path.end()); // extremum first
+    std::vector<Index> path = PathFromRoot(parent, start);
     if (descending && this->ArcLastNode[a] != InvalidIndex)
     {
       path.push_back(this->ArcLastNode[a]);
     }
 
-    outputArc[a] = static_cast<Index>(out.OneCells.size());
+    replay.OutputOneCell[a] = static_cast<Index>(out.OneCells.size());
     out.OneCells.emplace_back();
     OneCell& merged = out.OneCells.back();
     merged.Type = arc.Type;
-    merged.Source = descending ? position[extremum] : position[saddle];
-    merged.Destination = descending ? position[saddle] : position[extremum];
+    merged.Source = descending ? replay.Position[extremum] : replay.Position[saddle];
+    merged.Destination = descending ? replay.Position[saddle] : replay.Position[extremum];
     const size_t n = path.size();
     merged.MeshCells.resize(n);
     if (descending)
@@ -1029,102 +1292,19 @@ bool MorseSmaleComplexSimplification::Simplify(
       merged.Points[2 * (n + 1) + 1] = this->CriticalPointPosition[2 * extremum + 1];
       merged.Values[n + 1] = cps[extremum].Value;
     }
-    fromExtremum.push_back(std::move(path));
   }
+  return true;
+}
 
-  // Junction points. Followed from the extremum, each 1-cell is a path down its tree; a node
-  // is a junction when the 1-cells through it do not all continue the same way (to the same
-  // next node, or all ending there). An ascending 1-cell goes on from its first triangle to
-  // its saddle's vertex (encoded below zero). A descending one ends at its saddle's vertex,
-  // which lies either in another tree (a saddle edge joins two trees: skipped, as the 1-cells
-  // of one extremum share nothing outside its tree) or in this one, where other 1-cells may
-  // go on through it: then the junction is also where that saddle sits.
-  for (int pass = 0; pass < 2; ++pass)
-  {
-    const bool descending = pass == 0;
-    const NodeSet& nodes = descending ? this->DescendingNodes : this->AscendingNodes;
-    const std::vector<Index>& tree = descending ? descendingTree : ascendingTree;
-    const Index n = static_cast<Index>(nodes.Cell.size());
-    constexpr Index Unseen = std::numeric_limits<Index>::min();
-    constexpr Index EndsHere = -1;
-    std::vector<Index> next(n, Unseen);
-    std::vector<unsigned char> split(n, 0);
-    std::vector<Index> junctionOfNode(n, InvalidIndex);
-    for (int sweep = 0; sweep < 2; ++sweep)
-    {
-      for (Index a = 0; a < static_cast<Index>(out.OneCells.size()); ++a)
-      {
-        const OneCell& arc = out.OneCells[a];
-        if ((arc.Type == OneCell::Descending) != descending)
-        {
-          continue;
-        }
-        const std::vector<Index>& path = fromExtremum[a];
-        const Index extremum = descending ? arc.Source : arc.Destination;
-        const Index owner = tree[path[0]];
-        for (size_t i = 1; i < path.size(); ++i)
-        {
-          const Index u = path[i];
-          if (tree[u] != owner)
-          {
-            continue;
-          }
-          if (sweep == 0)
-          {
-            Index following = EndsHere;
-            if (i + 1 < path.size())
-            {
-              following = path[i + 1];
-            }
-            else if (!descending)
-            {
-              following = -2 - out.CriticalPoints[arc.Source].Vertex;
-            }
-            if (next[u] == Unseen)
-            {
-              next[u] = following;
-            }
-            else if (next[u] != following)
-            {
-              split[u] = 1;
-            }
-            continue;
-          }
-          if (!split[u])
-          {
-            continue;
-          }
-          if (junctionOfNode[u] == InvalidIndex)
-          {
-            junctionOfNode[u] = static_cast<Index>(output.JunctionPoints.size());
-            JunctionPoint junction;
-            junction.Type = arc.Type;
-            junction.Extremum = extremum;
-            junction.Cell = nodes.Cell[u];
-            junction.Position[0] = nodes.Point[2 * u];
-            junction.Position[1] = nodes.Point[2 * u + 1];
-            junction.Value = nodes.Value[u];
-            output.JunctionPoints.push_back(junction);
-          }
-          JunctionPoint& junction = output.JunctionPoints[junctionOfNode[u]];
-          junction.OneCells.push_back(a);
-          if (descending && i + 1 == path.size())
-          {
-            junction.CriticalPoint = arc.Destination;
-          }
-        }
-      }
-    }
-  }
-
-  // 2-cells: unions of the input ones. Cancelling (s, x) merges, for each 1-cell of s of the
-  // other kind, the two 2-cells on either side of it that have s as a corner: the corners
-  // (s, 1-cell to x, that 1-cell) and (s, 1-cell to the survivor, that 1-cell).
-  const auto& cells = in.TwoCells;
-  const Index nCells = static_cast<Index>(cells.size());
-  std::vector<Index> cellForward(nCells);
+//------------------------------------------------------------------------------
+// Which input 2-cells the replayed cancellations merge (see BuildMergedTwoCells).
+void MorseSmaleComplexSimplification::MergeTwoCells(Replay& replay) const
+{
+  const auto& cps = this->Input.CriticalPoints;
+  auto& cellForward = replay.CellForward;
+  cellForward.resize(this->Input.TwoCells.size());
   std::iota(cellForward.begin(), cellForward.end(), 0);
-  for (Index j = 0; j < performed; ++j)
+  for (Index j = 0; j < replay.Performed; ++j)
   {
     const Step& step = this->Steps[j];
     std::array<std::array<Index, 2>, 2> merges;
@@ -1140,7 +1320,19 @@ bool MorseSmaleComplexSimplification::Simplify(
       }
     }
   }
-  std::vector<Index> outputCell(nCells, InvalidIndex);
+}
+
+//------------------------------------------------------------------------------
+// 2-cells: unions of the input ones. Cancelling (s, x) merges, for each 1-cell of s of the
+// other kind, the two 2-cells on either side of it that have s as a corner: the corners
+// (s, 1-cell to x, that 1-cell) and (s, 1-cell to the survivor, that 1-cell).
+void MorseSmaleComplexSimplification::BuildMergedTwoCells(Replay& replay, MorseSmaleComplex& out) const
+{
+  const auto& cells = this->Input.TwoCells;
+  const Index nCells = static_cast<Index>(cells.size());
+  this->MergeTwoCells(replay);
+  auto& cellForward = replay.CellForward;
+  replay.OutputTwoCell.assign(nCells, InvalidIndex);
   std::vector<std::vector<std::array<Index, 3>>> outputCorners;
   std::vector<double> weightedCentroid;
   std::vector<Index> members;
@@ -1150,10 +1342,10 @@ bool MorseSmaleComplexSimplification::Simplify(
     const Index root = FollowForwarding(cellForward, c);
     if (root == c)
     {
-      outputCell[c] = static_cast<Index>(out.TwoCells.size());
+      replay.OutputTwoCell[c] = static_cast<Index>(out.TwoCells.size());
       TwoCell merged = cell;
-      merged.Minimum = survivorPosition(cell.Minimum);
-      merged.Maximum = survivorPosition(cell.Maximum);
+      merged.Minimum = replay.SurvivorPosition(cell.Minimum);
+      merged.Maximum = replay.SurvivorPosition(cell.Maximum);
       merged.NumberOfVertices = 0;
       out.TwoCells.push_back(merged);
       outputCorners.emplace_back();
@@ -1161,7 +1353,7 @@ bool MorseSmaleComplexSimplification::Simplify(
       weightedCentroid.push_back(0);
       members.push_back(0);
     }
-    const Index target = outputCell[root];
+    const Index target = replay.OutputTwoCell[root];
     ++members[target];
     TwoCell& merged = out.TwoCells[target];
     merged.NumberOfVertices += cell.NumberOfVertices;
@@ -1169,7 +1361,7 @@ bool MorseSmaleComplexSimplification::Simplify(
     weightedCentroid[2 * target + 1] += cell.Centroid[1] * cell.NumberOfVertices;
     for (int k = 0; k < 2; ++k)
     {
-      if (cell.Saddles[k] != InvalidIndex && alive[cell.Saddles[k]])
+      if (cell.Saddles[k] != InvalidIndex && replay.Alive[cell.Saddles[k]])
       {
         outputCorners[target].push_back({ cell.Saddles[k], cell.BoundaryOneCells[2 * k], cell.BoundaryOneCells[2 * k + 1] });
       }
@@ -1184,9 +1376,9 @@ bool MorseSmaleComplexSimplification::Simplify(
     for (int k = 0; k < 2; ++k)
     {
       const bool present = k < static_cast<int>(list.size());
-      cell.Saddles[k] = present ? position[list[k][0]] : InvalidIndex;
-      cell.BoundaryOneCells[2 * k] = present ? outputArc[list[k][1]] : InvalidIndex;
-      cell.BoundaryOneCells[2 * k + 1] = present ? outputArc[list[k][2]] : InvalidIndex;
+      cell.Saddles[k] = present ? replay.Position[list[k][0]] : InvalidIndex;
+      cell.BoundaryOneCells[2 * k] = present ? replay.OutputOneCell[list[k][1]] : InvalidIndex;
+      cell.BoundaryOneCells[2 * k + 1] = present ? replay.OutputOneCell[list[k][2]] : InvalidIndex;
     }
     cell.Pouch = list.size() == 2 && cell.Saddles[0] == cell.Saddles[1];
     if (members[c] == 1)
@@ -1205,18 +1397,22 @@ bool MorseSmaleComplexSimplification::Simplify(
       cell.Centroid[1] = this->CriticalPointPosition[2 * list[0][0] + 1];
     }
   }
+}
 
-  // Per-vertex labels: unions of the old regions.
+//------------------------------------------------------------------------------
+// Per-vertex labels: unions of the old regions.
+void MorseSmaleComplexSimplification::RelabelVertices(Replay& replay, MorseSmaleComplex& out) const
+{
+  const MorseSmaleComplex& in = this->Input;
   const size_t nV = in.TwoCellId.size();
   out.TwoCellId.resize(nV);
   out.AscendingManifold.resize(nV);
   out.DescendingManifold.resize(nV);
   for (size_t v = 0; v < nV; ++v)
   {
-    out.TwoCellId[v] = outputCell[FollowForwarding(cellForward, in.TwoCellId[v])];
-    out.AscendingManifold[v] = survivorPosition(in.AscendingManifold[v]);
-    out.DescendingManifold[v] = survivorPosition(in.DescendingManifold[v]);
+    out.TwoCellId[v] = replay.OutputTwoCell[FollowForwarding(replay.CellForward, in.TwoCellId[v])];
+    out.AscendingManifold[v] = replay.SurvivorPosition(in.AscendingManifold[v]);
+    out.DescendingManifold[v] = replay.SurvivorPosition(in.DescendingManifold[v]);
   }
-  return true;
 }
 } // namespace topospline

@@ -130,13 +130,46 @@ private:
     std::vector<double> Point; // x, y per node
     std::vector<double> Value;
     std::vector<std::array<Index, 2>> Edges; // gradient steps, each once
+
+    // The node of mesh cell `cell`, added with its point and value at its first visit.
+    Index Node(std::vector<Index>& nodeOf, Index cell, const double* point, double value);
+    void AddEdge(Index a, Index b);
   };
 
-  bool Check(const MorseSmaleComplex& input, std::string& error) const;
-  int CellMerges(Index saddle, bool minimum, int side, std::array<std::array<Index, 2>, 2>& pairs) const;
+  // Defined in the .cxx: the greedy cancellation's queue entries, running state and plan of
+  // one cancellation; a replay of the hierarchy's first cancellations and its merged forests.
+  struct Candidate;
+  struct GreedyState;
+  struct CancellationPlan;
+  struct Replay;
+  struct MergedForests;
+
+  // ComputeHierarchy, in order: index the input, then the elder rule and the greedy sequence.
+  void IndexOneCellsBySaddle();
+  void FindBoundaryCurve();
+  bool FindSaddleCorners(std::string& error);
   void BuildForests();
-  std::vector<PersistencePair> ElderRulePairs(bool minima) const;
+  void AddDescendingPath(Index oneCell, std::vector<Index>& nodeOfVertex);
+  void AddAscendingPath(Index oneCell, std::vector<Index>& nodeOfTriangle);
+  void SetCriticalPointPosition(Index criticalPoint, const double* point);
   void ComputeSequence();
+  std::vector<PersistencePair> ElderRulePairs(bool minima) const;
+  void ComputeOrdinaryPersistence(GreedyState& state);
+  void FindBoundaryPins(GreedyState& state) const;
+  void OfferAllPairs(GreedyState& state) const;
+  bool PlanCancellation(GreedyState& state, const Candidate& candidate, CancellationPlan& plan);
+  bool WouldPinchTwoCell(GreedyState& state, Index saddle, CancellationPlan& plan) const;
+  void Cancel(GreedyState& state, const Candidate& candidate, const CancellationPlan& plan);
+  int CellMerges(Index saddle, bool minimum, int side, std::array<std::array<Index, 2>, 2>& pairs) const;
+
+  // Simplify, in order.
+  void ReportBlockedExtrema(double percent, SimplificationOutput& output) const;
+  Replay ReplayCancellations(Index performed, MorseSmaleComplex& out) const;
+  MergedForests GrowMergedForests(const Replay& replay) const;
+  bool BuildMergedOneCells(Replay& replay, const MergedForests& forests, MorseSmaleComplex& out, std::string& error) const;
+  void MergeTwoCells(Replay& replay) const;
+  void BuildMergedTwoCells(Replay& replay, MorseSmaleComplex& out) const;
+  void RelabelVertices(Replay& replay, MorseSmaleComplex& out) const;
 
   bool Computed = false;
   MorseSmaleComplex Input;

@@ -1,4 +1,5 @@
-// Unit tests of stage 1 (pure core): the discrete gradient and the Morse-Smale complex.
+// Unit tests of stage 1 (pure core): the Morse-Smale complex. The discrete gradient has its own
+// program, TestDiscreteGradient.
 #include "MorseSmaleComplexExtraction.h"
 #include "SyntheticFields.h"
 #include "TestHarness.h"
@@ -255,33 +256,6 @@ TEST_CASE(GridTopologyEqualsGeneralBuild)
       }
     }
     CHECK(sameStars);
-  }
-}
-
-TEST_CASE(RegularVertexShortcutEqualsProcessLowerStars)
-{
-  // The gradient's shortcut for regular interior vertices must give exactly the pairing of the
-  // general queue-based ProcessLowerStars, on smooth fields and on fields full of ties.
-  GridField ties = ShepardField(30, 2, 90, 5);
-  for (double& v : ties.Values)
-  {
-    v = std::round(v * 20) / 20;
-  }
-  for (const GridField& grid : { ShepardField(50, 2, 200, 4), TrigonometricField(7, 80, -30), ties })
-  {
-    const auto field = FieldFromGrid(grid);
-    TriangleMeshTopology mesh;
-    std::string error;
-    CHECK(mesh.Build(static_cast<Index>(field.Values.size()), field.Triangles, SequentialFor, error));
-    DiscreteGradient fast, general;
-    fast.Compute(mesh, field.Values.data(), SequentialFor);
-    DiscreteGradient::GeneralPathOnly = true;
-    general.Compute(mesh, field.Values.data(), SequentialFor);
-    DiscreteGradient::GeneralPathOnly = false;
-    CHECK(fast.VertexEdge == general.VertexEdge);
-    CHECK(fast.EdgeVertex == general.EdgeVertex);
-    CHECK(fast.EdgeTriangle == general.EdgeTriangle);
-    CHECK(fast.TriangleEdge == general.TriangleEdge);
   }
 }
 
