@@ -4,7 +4,7 @@
 #include "vtkTopoSplineDomainConversion.h"
 #include "vtkTopoSplineWireFormat.h"
 
-#include "MorseSmaleComplexSimplification.h" // core
+#include "JunctionPointDetection.h" // core
 #include "OneCellSmoothing.h"                // core
 
 #include <vtkCellArray.h>
@@ -96,22 +96,8 @@ int vtkTopoSplineSmoothOneCells::RequestData(
   }
   vtkDataSet* domain = vtkTopoSplineWireFormat::SegmentationOf(input);
 
-  // Junction points: from the simplified complex, or (for an unsimplified one) from the
-  // simplification at 0 %, which finds where its 1-cells merge.
-  std::vector<topospline::JunctionPoint> junctions;
-  if (!vtkTopoSplineWireFormat::ReadJunctionPoints(input, complex, junctions))
-  {
-    vtkLogScopeF(TRACE, "find junction points");
-    topospline::MorseSmaleComplexSimplification simplification;
-    topospline::SimplificationOutput none;
-    if (!simplification.ComputeHierarchy(complex, error) || !simplification.Simplify(0.0, none, error))
-    {
-      vtkErrorMacro("Smooth 1-Cells: " << error << ".");
-      return 1;
-    }
-    junctions = std::move(none.JunctionPoints);
-    complex = std::move(none.Complex);
-  }
+  // Where 1-cells sharing an extremum split: the pieces' ends (any complex, simplified or not).
+  const std::vector<topospline::JunctionPoint> junctions = topospline::DetectJunctionPoints(complex);
 
   double bounds[4];
   vtkTopoSplineDomainConversion::PlanarBounds(domain, bounds);
