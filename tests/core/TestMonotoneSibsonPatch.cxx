@@ -2,7 +2,7 @@
 // (stage 4). The formulas of algorithms.md section 1 are a derivation, not a quote: every one
 // used is proven here numerically (interpolation, C1 continuity, the D_(1,1)F coefficient
 // table, sufficiency of (C0)-(C3), and that violations show up).
-#include "MonotoneSibsonPatch.h"
+#include "MonotoneSibsonSurface.h"
 #include "DeterministicRandom.h"
 #include "TestHarness.h"
 
@@ -891,7 +891,7 @@ TEST_CASE(UnevenSidesAreSubdividedToACommonCount)
     bottom.front()[0] = b0;
     bottom.back()[3] = b1;
     coarse.Bottom = bottom;
-    const int common = CommonSegmentCount(coarse.Bottom, coarse.Left, coarse.Top, coarse.Right);
+    const int common = CommonSegmentCount(coarse.Bottom, coarse.Right, coarse.Top, coarse.Left);
     CHECK(common == 2 * k);
     MonotoneSurfaceBoundary even;
     CHECK(SubdivideSide(coarse.Bottom, common, even.Bottom));
