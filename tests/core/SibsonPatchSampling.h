@@ -1,4 +1,4 @@
-// Sampling of one Sibson patch, shared by the patch and surface tests.
+// Sampling of Sibson patches and their triangles, shared by the patch and surface tests.
 #pragma once
 
 #include "MonotoneSibsonPatch.h"
@@ -52,5 +52,19 @@ inline double MinimumDiagonalDerivative(const topospline::MonotoneSibsonPatch& p
     sample(1 - 2 * e, 1 - e);
   }
   return minimum;
+}
+
+// Uniformly distributed barycentric coordinates of a point of a triangle.
+template <typename Random>
+void RandomBarycentric(Random& random, double& l0, double& l1, double& l2)
+{
+  l1 = random.Uniform();
+  l2 = random.Uniform();
+  if (l1 + l2 > 1)
+  {
+    l1 = 1 - l1;
+    l2 = 1 - l2;
+  }
+  l0 = 1 - l1 - l2;
 }
 } // namespace topospline_test

@@ -15,6 +15,7 @@
 
 using namespace topospline;
 using topospline_test::MinimumDiagonalDerivative;
+using topospline_test::RandomBarycentric;
 
 namespace
 {
@@ -225,13 +226,8 @@ TEST_CASE(DiagonalDerivativeCoefficientTable)
       MonotoneSibsonPatch::GetTriangleVertices(AllTriangles[t], vertices);
       for (int sample = 0; sample < 20; ++sample)
       {
-        double l1 = random.Uniform(), l2 = random.Uniform();
-        if (l1 + l2 > 1)
-        {
-          l1 = 1 - l1;
-          l2 = 1 - l2;
-        }
-        const double l0 = 1 - l1 - l2;
+        double l0, l1, l2;
+        RandomBarycentric(random, l0, l1, l2);
         const double X = l0 * vertices[0][0] + l1 * vertices[1][0] + l2 * vertices[2][0];
         const double Y = l0 * vertices[0][1] + l1 * vertices[1][1] + l2 * vertices[2][1];
         double value, g[2];

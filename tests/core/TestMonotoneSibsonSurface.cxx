@@ -18,6 +18,7 @@
 
 using namespace topospline;
 using topospline_test::MinimumDiagonalDerivative;
+using topospline_test::RandomBarycentric;
 
 namespace
 {
@@ -118,6 +119,18 @@ MonotoneSurfaceBoundary MakeBoundary(Random& random, int n, BoundaryFlavour flav
   b.Top = MakeSide(random, n, saddleY, maximum, flavour, junctionSide == 2);
   b.Left = MakeSide(random, n, minimum, saddleY, flavour, junctionSide == 3);
   return b;
+}
+
+// Surface number `trial` of a seeded series that cycles through the grid sizes 1..8 and the
+// flavours; returns the value range of its boundary.
+double BuildSeriesSurface(Random& random, int trial, MonotoneSurfaceBoundary& b, MonotoneSibsonSurface& surface)
+{
+  const int n = 1 + trial % 8;
+  const auto flavour = static_cast<BoundaryFlavour>(trial % static_cast<int>(BoundaryFlavour::Count));
+  b = MakeBoundary(random, n, flavour);
+  std::string error;
+  CHECK(surface.Build(b, error));
+  return b.Top.back()[3] - b.Bottom.front()[0];
 }
 
 // d/dt of a side at t in [0, 1] (its own parameter, so n times the segment's derivative).
@@ -569,13 +582,9 @@ TEST_CASE(ValuesIncreaseAlongDiagonalLines)
   double worstDiagonal = 0, worstSide = 0;
   for (int trial = 0; trial < 60; ++trial)
   {
-    const int n = 1 + trial % 8;
-    const auto flavour = static_cast<BoundaryFlavour>(trial % static_cast<int>(BoundaryFlavour::Count));
-    const MonotoneSurfaceBoundary b = MakeBoundary(random, n, flavour);
+    MonotoneSurfaceBoundary b;
     MonotoneSibsonSurface surface;
-    std::string error;
-    CHECK(surface.Build(b, error));
-    const double range = b.Top.back()[3] - b.Bottom.front()[0];
+    const double range = BuildSeriesSurface(random, trial, b, surface);
     worstDiagonal = std::max(worstDiagonal, LargestDiagonalDecrease(surface, range));
     for (int a = 0; a < 500; ++a)
     {
@@ -599,13 +608,10 @@ TEST_CASE(BoundaryBeziersAreInterpolatedWithTheirDerivatives)
   double worstValue = 0, worstDerivative = 0;
   for (int trial = 0; trial < 60; ++trial)
   {
-    const int n = 1 + trial % 8;
-    const auto flavour = static_cast<BoundaryFlavour>(trial % static_cast<int>(BoundaryFlavour::Count));
-    const MonotoneSurfaceBoundary b = MakeBoundary(random, n, flavour);
+    MonotoneSurfaceBoundary b;
     MonotoneSibsonSurface surface;
-    std::string error;
-    CHECK(surface.Build(b, error));
-    const double range = b.Top.back()[3] - b.Bottom.front()[0];
+    const double range = BuildSeriesSurface(random, trial, b, surface);
+    const int n = surface.GetGridSize();
     for (int a = 0; a <= 24 * n; ++a)
     {
       const double t = a / (24.0 * n);
@@ -712,13 +718,8 @@ TEST_CASE(BezierTrianglesMatchTheSurface)
     const auto& C = t.Points[9];
     for (int s = 0; s < 10; ++s)
     {
-      double l1 = random.Uniform(), l2 = random.Uniform();
-      if (l1 + l2 > 1)
-      {
-        l1 = 1 - l1;
-        l2 = 1 - l2;
-      }
-      const double l0 = 1 - l1 - l2;
+      double l0, l1, l2;
+      RandomBarycentric(random, l0, l1, l2);
       double value = 0;
       for (int i = 0; i <= 3; ++i)
       {
