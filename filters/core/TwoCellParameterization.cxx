@@ -777,22 +777,28 @@ bool TriangulateCell(const CellBoundary& cell, double edgeLength, double shapeBo
   return true;
 }
 
-// Floater's mean value coordinates (paper, section 5.1): interior vertex i satisfies
-// sum_j w_ij (uv_i - uv_j) = 0 with w_ij = (tan(a/2) + tan(b/2)) / |v_j - v_i|, a and b the
-// angles at v_i beside edge ij, the boundary (u, v) fixed.
-bool SolveMeanValueCoordinates(TwoCellMesh& mesh, std::string& error)
+// The linear system of Floater's mean value coordinates (paper, section 5.1): interior vertex i
+// satisfies sum_j w_ij (uv_i - uv_j) = 0 with w_ij = (tan(a/2) + tan(b/2)) / |v_j - v_i|, a and
+// b the angles at v_i beside edge ij; the boundary (u, v) are fixed and go to the right side.
+struct MeanValueSystem
+{
+  std::vector<Eigen::Triplet<double>> OffDiagonal; // -w_ij between interior vertices
+  std::vector<double> Diagonal;                    // sum_j w_ij
+  Eigen::MatrixXd RightSide;                       // sum over boundary j of w_ij uv_j
+};
+
+// False if a weight is zero or not finite (a degenerate triangle).
+bool AssembleMeanValueSystem(const TwoCellMesh& mesh, MeanValueSystem& system)
 {
   const Index boundaryCount = mesh.BoundaryCount;
   const Index interiorCount = mesh.NumberOfPoints() - boundaryCount;
   const std::vector<double>& p = mesh.Points;
-  if (interiorCount <= 0)
-  {
-    return true;
-  }
-  std::vector<Eigen::Triplet<double>> entries;
+  std::vector<Eigen::Triplet<double>>& entries = system.OffDiagonal;
   entries.reserve(static_cast<std::size_t>(mesh.NumberOfTriangles()) * 6 + interiorCount);
-  std::vector<double> diagonal(interiorCount, 0);
-  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(interiorCount, 2);
+  std::vector<double>& diagonal = system.Diagonal;
+  diagonal.assign(interiorCount, 0);
+  Eigen::MatrixXd& rhs = system.RightSide;
+  rhs = Eigen::MatrixXd::Zero(interiorCount, 2);
   bool finite = true;
   for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
   {
@@ -829,11 +835,27 @@ bool SolveMeanValueCoordinates(TwoCellMesh& mesh, std::string& error)
       }
     }
   }
-  if (!finite)
+  return finite;
+}
+
+// (u, v) of the interior vertices from the mean value system.
+bool SolveMeanValueCoordinates(TwoCellMesh& mesh, std::string& error)
+{
+  const Index boundaryCount = mesh.BoundaryCount;
+  const Index interiorCount = mesh.NumberOfPoints() - boundaryCount;
+  if (interiorCount <= 0)
+  {
+    return true;
+  }
+  MeanValueSystem system;
+  if (!AssembleMeanValueSystem(mesh, system))
   {
     error = "TwoCellParameterization: degenerate triangle (zero or non-finite mean value weight)";
     return false;
   }
+  std::vector<Eigen::Triplet<double>>& entries = system.OffDiagonal;
+  const std::vector<double>& diagonal = system.Diagonal;
+  Eigen::MatrixXd& rhs = system.RightSide;
   for (Index i = 0; i < interiorCount; ++i)
   {
     entries.emplace_back(i, i, diagonal[i]);
