@@ -585,7 +585,7 @@ bool CheckOuterLoop(CellBoundary& cell, std::string& error)
 
 // The target edge length of the interior triangles: `target`, or (<= 0) the mean sample
 // spacing of the whole walk (slit edges count twice, as they have two sides), raised where the
-// cell would need more than `maximumVertices` vertices.
+// cell would need more than `maximumVertexCount` vertices.
 double InteriorEdgeLength(const CellBoundary& cell, double target, Index maximumVertexCount)
 {
   const std::size_t n = cell.Count;
