@@ -136,15 +136,10 @@ struct BoundaryGraph
   std::vector<std::pair<Index, Index>> Edges;
 };
 
-// Splits the walk into the outer loop and slits. A slit is retraced: ..., x, y, x, ... steps
-// out along edge xy and straight back. Cancelling such back-and-forth steps until none is left
-// (cyclically, since slits may wrap around the start of the sequence) leaves the outer loop,
-// which must visit distinct points. The cancelled edges must be traversed exactly once each
-// way and form trees hanging from the loop (as many edges as non-loop points: contracting the
-// loop to one vertex leaves a connected graph, so it is a tree). Geometry is checked later.
-bool AnalyzeBoundary(const double* xy, std::size_t n, BoundaryGraph& graph, std::string& error)
+// Numbers the distinct points of the walk and refuses zero-length edges. Exact comparison: a
+// slit retraces bit-identical samples.
+bool IdentifyEqualPoints(const double* xy, std::size_t n, BoundaryGraph& graph, std::string& error)
 {
-  // Exact comparison: a slit retraces bit-identical samples.
   std::vector<Index> order(n);
   std::iota(order.begin(), order.end(), 0);
   auto less = [xy](Index a, Index b) {
@@ -174,8 +169,14 @@ bool AnalyzeBoundary(const double* xy, std::size_t n, BoundaryGraph& graph, std:
       return false;
     }
   }
+  return true;
+}
 
-  // Cancel x y x -> x along the sequence, then across its wrap-around.
+// The outer loop: the walk with its back-and-forth steps x y x -> x cancelled along the
+// sequence, then across its wrap-around, until none is left. It must visit distinct points.
+bool FindOuterLoop(std::size_t n, BoundaryGraph& graph, std::string& error)
+{
+  const std::vector<Index>& point = graph.PointOf;
   std::vector<Index> stack;
   for (std::size_t i = 0; i < n; ++i)
   {
@@ -205,8 +206,7 @@ bool AnalyzeBoundary(const double* xy, std::size_t n, BoundaryGraph& graph, std:
     }
   }
   graph.Loop.assign(stack.begin() + head, stack.end());
-  const std::size_t loopSize = graph.Loop.size();
-  if (loopSize < 3)
+  if (graph.Loop.size() < 3)
   {
     error = "TwoCellParameterization: the boundary encloses no area (it only runs out and back along slits)";
     return false;
@@ -224,7 +224,16 @@ bool AnalyzeBoundary(const double* xy, std::size_t n, BoundaryGraph& graph, std:
     }
     onLoop[point[s]] = 1;
   }
+  return true;
+}
 
+// The loop edges, then the slit edges: the cancelled edges, which must be traversed exactly once
+// each way and form trees hanging from the loop (as many edges as non-loop points: contracting
+// the loop to one vertex leaves a connected graph, so it is a tree).
+bool CollectBoundaryEdges(std::size_t n, BoundaryGraph& graph, std::string& error)
+{
+  const std::vector<Index>& point = graph.PointOf;
+  const std::size_t loopSize = graph.Loop.size();
   // Every walk step, as (smaller point, larger point, forward): count the traversals per edge.
   std::vector<std::tuple<Index, Index, bool>> steps(n);
   for (std::size_t i = 0; i < n; ++i)
@@ -271,6 +280,14 @@ bool AnalyzeBoundary(const double* xy, std::size_t n, BoundaryGraph& graph, std:
     return false;
   }
   return true;
+}
+
+// Splits the walk into the outer loop and slits. A slit is retraced: ..., x, y, x, ... steps
+// out along edge xy and straight back. Geometry is checked later.
+bool AnalyzeBoundary(const double* xy, std::size_t n, BoundaryGraph& graph, std::string& error)
+{
+  return IdentifyEqualPoints(xy, n, graph, error) && FindOuterLoop(n, graph, error) &&
+    CollectBoundaryEdges(n, graph, error);
 }
 
 // Cuts the mesh open along the slits: gives every corner of a domain face at a boundary vertex
@@ -405,16 +422,23 @@ int SplitEdges(Triangulation& cdt, const std::vector<std::pair<VertexHandle, Ver
   }
   return inserted;
 }
-} // namespace
-
-bool TwoCellParameterization::Parameterize(
-  const std::vector<double>& boundaryPoints, const std::vector<double>& boundaryParameters, std::string& error)
+// The boundary walk of one cell as Parameterize checks and uses it.
+struct CellBoundary
 {
-  this->Mesh = TwoCellMesh();
-  this->PointGrid = BucketGrid();
-  this->ParameterGrid = BucketGrid();
+  const double* XY = nullptr; // (x, y) per sample
+  const double* UV = nullptr; // (u, v) per sample, on the border of the unit square
+  std::size_t Count = 0;      // samples, without a repeated first one at the end
+  std::vector<int> SideMasks; // SideMask of each sample's (u, v)
+  int ParameterOrientation = 1; // +1 if (u, v) go counter-clockwise around the square
+  BoundaryGraph Graph;
+  int PolygonOrientation = 1; // +1 if the outer loop is counter-clockwise in (x, y)
+  double Area = 0;            // enclosed by the outer loop
+};
 
-  // --- Validate the boundary ---------------------------------------------------------------
+// Pairs of equal count, finite, at least one sample per corner of the square.
+bool ReadBoundarySamples(const std::vector<double>& boundaryPoints, const std::vector<double>& boundaryParameters,
+  CellBoundary& cell, std::string& error)
+{
   if (boundaryPoints.size() % 2 != 0 || boundaryPoints.size() != boundaryParameters.size())
   {
     error = "TwoCellParameterization: boundary points and parameters must be (x, y) and (u, v) pairs of equal count";
@@ -443,10 +467,19 @@ bool TwoCellParameterization::Parameterize(
     error = message.str();
     return false;
   }
+  cell.XY = boundaryPoints.data();
+  cell.UV = boundaryParameters.data();
+  cell.Count = n;
+  return true;
+}
 
-  const double* xy = boundaryPoints.data();
-  const double* uv = boundaryParameters.data();
-  std::vector<int> sideMasks(n);
+// Every (u, v) on the border of the square, going monotonically once around it.
+bool CheckBorderParameters(CellBoundary& cell, std::string& error)
+{
+  const std::size_t n = cell.Count;
+  const double* uv = cell.UV;
+  cell.SideMasks.resize(n);
+  std::vector<int>& sideMasks = cell.SideMasks;
   double winding = 0;
   int steps[2] = { 0, 0 }; // forward, backward
   for (std::size_t i = 0; i < n; ++i)
@@ -491,23 +524,23 @@ bool TwoCellParameterization::Parameterize(
     error = "TwoCellParameterization: the parameters do not go monotonically once around the unit square";
     return false;
   }
-  const int parameterOrientation = winding > 0 ? 1 : -1;
+  cell.ParameterOrientation = winding > 0 ? 1 : -1;
+  return true;
+}
 
-  // --- Outer loop and slits -----------------------------------------------------------------
-  BoundaryGraph graph;
-  if (!AnalyzeBoundary(xy, n, graph, error))
-  {
-    return false;
-  }
+// The outer loop must be a simple polygon (exact predicates: touching or crossing edges and
+// collinear, zero-area loops are all "not simple"; repeated points were refused already unless
+// they are on slits). Sets its orientation and area.
+bool CheckOuterLoop(CellBoundary& cell, std::string& error)
+{
+  const BoundaryGraph& graph = cell.Graph;
   const std::size_t loopSize = graph.Loop.size();
-  const bool hasSlits = loopSize < n;
+  const bool hasSlits = loopSize < cell.Count;
   std::vector<Point> loop(loopSize);
   for (std::size_t k = 0; k < loopSize; ++k)
   {
-    loop[k] = Point(xy[2 * graph.Loop[k]], xy[2 * graph.Loop[k] + 1]);
+    loop[k] = Point(cell.XY[2 * graph.Loop[k]], cell.XY[2 * graph.Loop[k] + 1]);
   }
-  // Exact predicates: touching or crossing edges and collinear (zero-area) loops are all "not
-  // simple". (Repeated points were refused above unless they are on slits.)
   if (!CGAL::is_simple_2(loop.begin(), loop.end(), Kernel()))
   {
     std::ostringstream message;
@@ -538,7 +571,7 @@ bool TwoCellParameterization::Parameterize(
     error = message.str();
     return false;
   }
-  const int polygonOrientation = CGAL::orientation_2(loop.begin(), loop.end(), Kernel()) == CGAL::LEFT_TURN ? 1 : -1;
+  cell.PolygonOrientation = CGAL::orientation_2(loop.begin(), loop.end(), Kernel()) == CGAL::LEFT_TURN ? 1 : -1;
   double signedArea = 0;
   for (std::size_t k = 0; k < loopSize; ++k)
   {
@@ -546,259 +579,323 @@ bool TwoCellParameterization::Parameterize(
     const Point& q = loop[(k + 1) % loopSize];
     signedArea += p.x() * q.y() - q.x() * p.y();
   }
-  const double area = std::abs(signedArea) / 2;
-  double perimeter = 0; // of the whole walk: slit edges count twice, as they have two sides
+  cell.Area = std::abs(signedArea) / 2;
+  return true;
+}
+
+// The target edge length of the interior triangles: `target`, or (<= 0) the mean sample
+// spacing of the whole walk (slit edges count twice, as they have two sides), raised where the
+// cell would need more than `maximumVertexCount` vertices.
+double InteriorEdgeLength(const CellBoundary& cell, double target, Index maximumVertexCount)
+{
+  const std::size_t n = cell.Count;
+  const double* xy = cell.XY;
+  double perimeter = 0;
   for (std::size_t i = 0; i < n; ++i)
   {
     const std::size_t j = (i + 1) % n;
     perimeter += std::hypot(xy[2 * j] - xy[2 * i], xy[2 * j + 1] - xy[2 * i + 1]);
   }
-
-  double edgeLength = this->TargetEdgeLength > 0 ? this->TargetEdgeLength : perimeter / static_cast<double>(n);
+  double edgeLength = target > 0 ? target : perimeter / static_cast<double>(n);
   // An equilateral triangle of side s covers sqrt(3)/4 s^2, and there are about twice as many
   // triangles as vertices.
-  const double maximumVertices = std::max<double>(static_cast<double>(this->MaximumVertices), 2.0 * n);
-  const double expectedVertices = area / (0.5 * 0.4330127 * edgeLength * edgeLength);
+  const double maximumVertices = std::max<double>(static_cast<double>(maximumVertexCount), 2.0 * n);
+  const double expectedVertices = cell.Area / (0.5 * 0.4330127 * edgeLength * edgeLength);
   if (!(edgeLength > 0) || expectedVertices > maximumVertices)
   {
-    edgeLength = std::sqrt(area / (0.5 * 0.4330127 * maximumVertices));
+    edgeLength = std::sqrt(cell.Area / (0.5 * 0.4330127 * maximumVertices));
   }
+  return edgeLength;
+}
 
-  TwoCellMesh& mesh = this->Mesh;
-  try
+// One vertex per distinct point; the loop and slit edges are the constraints (slit edges are
+// interior constraints, with the domain on both sides). `boundary` gets the vertex of every
+// sample (the visits of a slit point share one).
+bool InsertBoundary(const CellBoundary& cell, Triangulation& cdt, std::vector<VertexHandle>& boundary, std::string& error)
+{
+  const BoundaryGraph& graph = cell.Graph;
+  const std::size_t n = cell.Count;
+  const double* xy = cell.XY;
+  std::vector<VertexHandle> pointVertex(graph.PointCount);
+  boundary.assign(n, VertexHandle());
+  VertexHandle hint;
+  for (std::size_t i = 0; i < n; ++i)
   {
-    // --- Constrained Delaunay triangulation and refinement ---------------------------------
-    // One vertex per distinct point; the loop and slit edges are the constraints (slit edges
-    // are interior constraints, with the domain on both sides).
-    Triangulation cdt;
-    std::vector<VertexHandle> pointVertex(graph.PointCount);
-    std::vector<VertexHandle> boundary(n); // per sample; the visits of a slit point share one
-    VertexHandle hint;
-    for (std::size_t i = 0; i < n; ++i)
+    VertexHandle& v = pointVertex[graph.PointOf[i]];
+    if (v == VertexHandle())
     {
-      VertexHandle& v = pointVertex[graph.PointOf[i]];
-      if (v == VertexHandle())
-      {
-        v = cdt.insert(Point(xy[2 * i], xy[2 * i + 1]), hint == VertexHandle() ? FaceHandle() : hint->face());
-        hint = v;
-      }
-      boundary[i] = v;
+      v = cdt.insert(Point(xy[2 * i], xy[2 * i + 1]), hint == VertexHandle() ? FaceHandle() : hint->face());
+      hint = v;
     }
-    for (const auto& edge : graph.Edges)
+    boundary[i] = v;
+  }
+  for (const auto& edge : graph.Edges)
+  {
+    cdt.insert_constraint(pointVertex[edge.first], pointVertex[edge.second]);
+  }
+  if (cdt.number_of_vertices() != graph.PointCount)
+  {
+    error = "TwoCellParameterization: boundary samples merged in the triangulation";
+    return false;
+  }
+  // A constraint through another sample is split there: a slit touching the loop or another
+  // slit, or (without slits) a sample on an edge, which is_simple_2 already refused.
+  for (const auto& edge : graph.Edges)
+  {
+    if (!cdt.is_edge(pointVertex[edge.first], pointVertex[edge.second]))
     {
-      cdt.insert_constraint(pointVertex[edge.first], pointVertex[edge.second]);
-    }
-    if (cdt.number_of_vertices() != graph.PointCount)
-    {
-      error = "TwoCellParameterization: boundary samples merged in the triangulation";
-      this->Mesh = TwoCellMesh();
+      error = "TwoCellParameterization: a slit touches the outer loop or another slit";
       return false;
     }
-    // A constraint through another sample is split there: a slit touching the loop or another
-    // slit, or (without slits) a sample on an edge, which is_simple_2 already refused.
-    for (const auto& edge : graph.Edges)
+  }
+  const std::size_t loopSize = graph.Loop.size();
+  if (loopSize < n)
+  {
+    // The domain is what the loop encloses (faces not reachable from the infinite face
+    // without crossing a constraint): a slit edge must have it on both sides.
+    Mesher::mark_convex_hull(cdt);
+    for (std::size_t e = loopSize; e < graph.Edges.size(); ++e)
     {
-      if (!cdt.is_edge(pointVertex[edge.first], pointVertex[edge.second]))
+      FaceHandle f;
+      int k;
+      cdt.is_edge(pointVertex[graph.Edges[e].first], pointVertex[graph.Edges[e].second], f, k);
+      if (!f->is_in_domain() || !f->neighbor(k)->is_in_domain())
       {
-        error = "TwoCellParameterization: a slit touches the outer loop or another slit";
-        this->Mesh = TwoCellMesh();
+        error = "TwoCellParameterization: a slit lies outside the outer loop of the boundary";
         return false;
       }
     }
-    if (hasSlits)
+  }
+  return true;
+}
+
+// Cuts the mesh open along the slits and removes dividing edges. Inserting a point on an edge
+// removes that edge, and every edge a Delaunay insertion creates ends at the new point: neither
+// the fix nor the re-refinement can create another dividing edge, so one round suffices (the
+// others are a guard).
+bool CutOpenAndFixDividingEdges(const CellBoundary& cell, const Criteria& criteria, int maximumFixRounds,
+  Triangulation& cdt, const std::vector<VertexHandle>& boundary, int& dividingEdgeFixes, std::string& error)
+{
+  for (int round = 0;; ++round)
+  {
+    ResetVertexIndices(cdt, boundary);
+    if (!AssignBoundaryCorners(cdt, boundary, cell.PolygonOrientation))
     {
-      // The domain is what the loop encloses (faces not reachable from the infinite face
-      // without crossing a constraint): a slit edge must have it on both sides.
-      Mesher::mark_convex_hull(cdt);
-      for (std::size_t e = loopSize; e < graph.Edges.size(); ++e)
+      error = "TwoCellParameterization: the mesh cannot be cut open along the slits so that its border is the "
+              "boundary walk (slits visited in an order that does not match their geometry)";
+      return false;
+    }
+    const std::vector<std::pair<VertexHandle, VertexHandle>> dividing = DividingEdges(cdt, cell.SideMasks);
+    if (dividing.empty())
+    {
+      return true;
+    }
+    if (round >= maximumFixRounds)
+    {
+      std::ostringstream message;
+      message << "TwoCellParameterization: " << dividing.size() << " dividing edges remain after "
+              << maximumFixRounds << " rounds of fixes";
+      error = message.str();
+      return false;
+    }
+    dividingEdgeFixes += SplitEdges(cdt, dividing);
+    // Re-marks the domain (new faces are not marked) and restores the size and shape.
+    Refine(cdt, criteria);
+  }
+}
+
+// The output mesh: boundary vertices first, in input order, with their given (u, v). Boundary
+// corners take the sample of their wedge (so each visit of a slit point is its own vertex),
+// Steiner points are numbered as they are met.
+void ExtractMesh(const CellBoundary& cell, Triangulation& cdt, TwoCellMesh& mesh)
+{
+  const std::size_t n = cell.Count;
+  mesh.BoundaryCount = static_cast<Index>(n);
+  mesh.Points.assign(cell.XY, cell.XY + 2 * n);
+  mesh.Parameters.assign(cell.UV, cell.UV + 2 * n);
+  for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f)
+  {
+    if (!f->is_in_domain())
+    {
+      continue;
+    }
+    for (int k = 0; k < 3; ++k)
+    {
+      Index corner = f->info()[k];
+      if (corner == InvalidIndex)
       {
-        FaceHandle f;
-        int k;
-        cdt.is_edge(pointVertex[graph.Edges[e].first], pointVertex[graph.Edges[e].second], f, k);
-        if (!f->is_in_domain() || !f->neighbor(k)->is_in_domain())
+        const VertexHandle v = f->vertex(k);
+        if (v->info() == InvalidIndex)
         {
-          error = "TwoCellParameterization: a slit lies outside the outer loop of the boundary";
-          this->Mesh = TwoCellMesh();
-          return false;
+          v->info() = mesh.NumberOfPoints();
+          mesh.Points.push_back(v->point().x());
+          mesh.Points.push_back(v->point().y());
         }
+        corner = v->info();
       }
+      mesh.Triangles.push_back(corner);
+    }
+  }
+  mesh.Parameters.resize(mesh.Points.size(), 0);
+}
+
+// Constrained Delaunay triangulation of the cell, refined without splitting the boundary,
+// cut open along the slits, without dividing edges, written to `mesh` (parameters of the
+// interior vertices still 0).
+bool TriangulateCell(const CellBoundary& cell, double edgeLength, double shapeBound, int maximumFixRounds,
+  TwoCellMesh& mesh, std::string& error)
+{
+  try
+  {
+    Triangulation cdt;
+    std::vector<VertexHandle> boundary;
+    if (!InsertBoundary(cell, cdt, boundary, error))
+    {
+      return false;
     }
     // Delaunay refinement is only guaranteed to end for a smallest angle up to ~20.7 degrees
     // (b = 0.125); a larger bound could refine forever. Points that would encroach upon a
     // constraint (boundary or slit) are not inserted, so constraints are never split.
-    const double shapeBound = this->ShapeBound > 0 ? std::min(this->ShapeBound, 0.125) : 0.0;
-    const Criteria criteria(shapeBound, edgeLength);
+    const Criteria criteria(shapeBound > 0 ? std::min(shapeBound, 0.125) : 0.0, edgeLength);
     Refine(cdt, criteria);
-
-    // --- Cut open along the slits, remove dividing edges ------------------------------------
-    // Inserting a point on an edge removes that edge, and every edge a Delaunay insertion
-    // creates ends at the new point: neither the fix nor the re-refinement can create another
-    // dividing edge, so one round suffices (the others are a guard).
-    int round = 0;
-    for (;; ++round)
+    if (!CutOpenAndFixDividingEdges(cell, criteria, maximumFixRounds, cdt, boundary, mesh.DividingEdgeFixes, error))
     {
-      ResetVertexIndices(cdt, boundary);
-      if (!AssignBoundaryCorners(cdt, boundary, polygonOrientation))
-      {
-        error = "TwoCellParameterization: the mesh cannot be cut open along the slits so that its border is the "
-                "boundary walk (slits visited in an order that does not match their geometry)";
-        this->Mesh = TwoCellMesh();
-        return false;
-      }
-      const std::vector<std::pair<VertexHandle, VertexHandle>> dividing = DividingEdges(cdt, sideMasks);
-      if (dividing.empty())
-      {
-        break;
-      }
-      if (round >= this->MaximumFixRounds)
-      {
-        std::ostringstream message;
-        message << "TwoCellParameterization: " << dividing.size() << " dividing edges remain after "
-                << this->MaximumFixRounds << " rounds of fixes";
-        error = message.str();
-        this->Mesh = TwoCellMesh();
-        return false;
-      }
-      mesh.DividingEdgeFixes += SplitEdges(cdt, dividing);
-      // Re-marks the domain (new faces are not marked) and restores the size and shape.
-      Refine(cdt, criteria);
+      return false;
     }
-
-    // --- Output: boundary vertices first, in input order ---------------------------------------
-    // Boundary corners take the sample of their wedge (so each visit of a slit point is its own
-    // vertex), Steiner points are numbered as they are met.
-    mesh.BoundaryCount = static_cast<Index>(n);
-    mesh.Points.assign(xy, xy + 2 * n);
-    mesh.Parameters.assign(uv, uv + 2 * n);
-    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f)
-    {
-      if (!f->is_in_domain())
-      {
-        continue;
-      }
-      for (int k = 0; k < 3; ++k)
-      {
-        Index corner = f->info()[k];
-        if (corner == InvalidIndex)
-        {
-          const VertexHandle v = f->vertex(k);
-          if (v->info() == InvalidIndex)
-          {
-            v->info() = mesh.NumberOfPoints();
-            mesh.Points.push_back(v->point().x());
-            mesh.Points.push_back(v->point().y());
-          }
-          corner = v->info();
-        }
-        mesh.Triangles.push_back(corner);
-      }
-    }
-    mesh.Parameters.resize(mesh.Points.size(), 0);
+    ExtractMesh(cell, cdt, mesh);
   }
   catch (const Triangulation::Intersection_of_constraints_exception&)
   {
     error = "TwoCellParameterization: the boundary crosses itself (a slit crosses the outer loop or another slit)";
-    this->Mesh = TwoCellMesh();
     return false;
   }
   catch (const std::exception& e)
   {
     error = std::string("TwoCellParameterization: triangulation failed: ") + e.what();
-    this->Mesh = TwoCellMesh();
     return false;
   }
-  mesh.Orientation = polygonOrientation * parameterOrientation;
+  return true;
+}
 
-  // --- Mean value coordinates -------------------------------------------------------------
-  // Interior vertex i: sum_j w_ij (uv_i - uv_j) = 0 with Floater's weights
-  // w_ij = (tan(a/2) + tan(b/2)) / |v_j - v_i|, a and b the angles at v_i beside edge ij.
+// The linear system of Floater's mean value coordinates (paper, section 5.1): interior vertex i
+// satisfies sum_j w_ij (uv_i - uv_j) = 0 with w_ij = (tan(a/2) + tan(b/2)) / |v_j - v_i|, a and
+// b the angles at v_i beside edge ij; the boundary (u, v) are fixed and go to the right side.
+struct MeanValueSystem
+{
+  std::vector<Eigen::Triplet<double>> OffDiagonal; // -w_ij between interior vertices
+  std::vector<double> Diagonal;                    // sum_j w_ij
+  Eigen::MatrixXd RightSide;                       // sum over boundary j of w_ij uv_j
+};
+
+// False if a weight is zero or not finite (a degenerate triangle).
+bool AssembleMeanValueSystem(const TwoCellMesh& mesh, MeanValueSystem& system)
+{
   const Index boundaryCount = mesh.BoundaryCount;
   const Index interiorCount = mesh.NumberOfPoints() - boundaryCount;
   const std::vector<double>& p = mesh.Points;
-  if (interiorCount > 0)
+  std::vector<Eigen::Triplet<double>>& entries = system.OffDiagonal;
+  entries.reserve(static_cast<std::size_t>(mesh.NumberOfTriangles()) * 6 + interiorCount);
+  std::vector<double>& diagonal = system.Diagonal;
+  diagonal.assign(interiorCount, 0);
+  Eigen::MatrixXd& rhs = system.RightSide;
+  rhs = Eigen::MatrixXd::Zero(interiorCount, 2);
+  bool finite = true;
+  for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
   {
-    std::vector<Eigen::Triplet<double>> entries;
-    entries.reserve(static_cast<std::size_t>(mesh.NumberOfTriangles()) * 6 + interiorCount);
-    std::vector<double> diagonal(interiorCount, 0);
-    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(interiorCount, 2);
-    bool finite = true;
-    for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
+    const Index* tri = &mesh.Triangles[3 * t];
+    for (int k = 0; k < 3; ++k)
     {
-      const Index* tri = &mesh.Triangles[3 * t];
-      for (int k = 0; k < 3; ++k)
+      const Index i = tri[k];
+      if (i < boundaryCount)
       {
-        const Index i = tri[k];
-        if (i < boundaryCount)
+        continue;
+      }
+      const Index j = tri[(k + 1) % 3], l = tri[(k + 2) % 3];
+      const double ax = p[2 * j] - p[2 * i], ay = p[2 * j + 1] - p[2 * i + 1];
+      const double bx = p[2 * l] - p[2 * i], by = p[2 * l + 1] - p[2 * i + 1];
+      const double tangent = HalfAngleTangent(ax, ay, bx, by);
+      const double weights[2] = { tangent / std::hypot(ax, ay), tangent / std::hypot(bx, by) };
+      const Index neighbors[2] = { j, l };
+      for (int s = 0; s < 2; ++s)
+      {
+        if (!std::isfinite(weights[s]) || !(weights[s] > 0))
         {
-          continue;
+          finite = false;
         }
-        const Index j = tri[(k + 1) % 3], l = tri[(k + 2) % 3];
-        const double ax = p[2 * j] - p[2 * i], ay = p[2 * j + 1] - p[2 * i + 1];
-        const double bx = p[2 * l] - p[2 * i], by = p[2 * l + 1] - p[2 * i + 1];
-        const double tangent = HalfAngleTangent(ax, ay, bx, by);
-        const double weights[2] = { tangent / std::hypot(ax, ay), tangent / std::hypot(bx, by) };
-        const Index neighbors[2] = { j, l };
-        for (int s = 0; s < 2; ++s)
+        diagonal[i - boundaryCount] += weights[s];
+        if (neighbors[s] < boundaryCount)
         {
-          if (!std::isfinite(weights[s]) || !(weights[s] > 0))
-          {
-            finite = false;
-          }
-          diagonal[i - boundaryCount] += weights[s];
-          if (neighbors[s] < boundaryCount)
-          {
-            rhs(i - boundaryCount, 0) += weights[s] * mesh.Parameters[2 * neighbors[s]];
-            rhs(i - boundaryCount, 1) += weights[s] * mesh.Parameters[2 * neighbors[s] + 1];
-          }
-          else
-          {
-            entries.emplace_back(i - boundaryCount, neighbors[s] - boundaryCount, -weights[s]);
-          }
+          rhs(i - boundaryCount, 0) += weights[s] * mesh.Parameters[2 * neighbors[s]];
+          rhs(i - boundaryCount, 1) += weights[s] * mesh.Parameters[2 * neighbors[s] + 1];
+        }
+        else
+        {
+          entries.emplace_back(i - boundaryCount, neighbors[s] - boundaryCount, -weights[s]);
         }
       }
     }
-    if (!finite)
-    {
-      error = "TwoCellParameterization: degenerate triangle (zero or non-finite mean value weight)";
-      this->Mesh = TwoCellMesh();
-      return false;
-    }
-    for (Index i = 0; i < interiorCount; ++i)
-    {
-      entries.emplace_back(i, i, diagonal[i]);
-    }
-    Eigen::SparseMatrix<double> matrix(interiorCount, interiorCount);
-    matrix.setFromTriplets(entries.begin(), entries.end());
-    // Rows scaled to unit diagonal: the weights scale like 1/length.
-    for (Index i = 0; i < interiorCount; ++i)
-    {
-      rhs.row(i) /= diagonal[i];
-    }
-    matrix = Eigen::SparseMatrix<double>(Eigen::VectorXd::Map(diagonal.data(), interiorCount).cwiseInverse().asDiagonal() * matrix);
-    matrix.makeCompressed();
-    Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> solver;
-    solver.compute(matrix);
-    if (solver.info() != Eigen::Success)
-    {
-      error = "TwoCellParameterization: the mean value system could not be factored";
-      this->Mesh = TwoCellMesh();
-      return false;
-    }
-    const Eigen::MatrixXd solution = solver.solve(rhs);
-    if (solver.info() != Eigen::Success)
-    {
-      error = "TwoCellParameterization: the mean value system could not be solved";
-      this->Mesh = TwoCellMesh();
-      return false;
-    }
-    for (Index i = 0; i < interiorCount; ++i)
-    {
-      mesh.Parameters[2 * (boundaryCount + i)] = solution(i, 0);
-      mesh.Parameters[2 * (boundaryCount + i) + 1] = solution(i, 1);
-    }
   }
+  return finite;
+}
 
-  // --- Check: one-to-one ----------------------------------------------------------------------
+// (u, v) of the interior vertices from the mean value system.
+bool SolveMeanValueCoordinates(TwoCellMesh& mesh, std::string& error)
+{
+  const Index boundaryCount = mesh.BoundaryCount;
+  const Index interiorCount = mesh.NumberOfPoints() - boundaryCount;
+  if (interiorCount <= 0)
+  {
+    return true;
+  }
+  MeanValueSystem system;
+  if (!AssembleMeanValueSystem(mesh, system))
+  {
+    error = "TwoCellParameterization: degenerate triangle (zero or non-finite mean value weight)";
+    return false;
+  }
+  std::vector<Eigen::Triplet<double>>& entries = system.OffDiagonal;
+  const std::vector<double>& diagonal = system.Diagonal;
+  Eigen::MatrixXd& rhs = system.RightSide;
+  for (Index i = 0; i < interiorCount; ++i)
+  {
+    entries.emplace_back(i, i, diagonal[i]);
+  }
+  Eigen::SparseMatrix<double> matrix(interiorCount, interiorCount);
+  matrix.setFromTriplets(entries.begin(), entries.end());
+  // Rows scaled to unit diagonal: the weights scale like 1/length.
+  for (Index i = 0; i < interiorCount; ++i)
+  {
+    rhs.row(i) /= diagonal[i];
+  }
+  matrix = Eigen::SparseMatrix<double>(Eigen::VectorXd::Map(diagonal.data(), interiorCount).cwiseInverse().asDiagonal() * matrix);
+  matrix.makeCompressed();
+  Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> solver;
+  solver.compute(matrix);
+  if (solver.info() != Eigen::Success)
+  {
+    error = "TwoCellParameterization: the mean value system could not be factored";
+    return false;
+  }
+  const Eigen::MatrixXd solution = solver.solve(rhs);
+  if (solver.info() != Eigen::Success)
+  {
+    error = "TwoCellParameterization: the mean value system could not be solved";
+    return false;
+  }
+  for (Index i = 0; i < interiorCount; ++i)
+  {
+    mesh.Parameters[2 * (boundaryCount + i)] = solution(i, 0);
+    mesh.Parameters[2 * (boundaryCount + i) + 1] = solution(i, 1);
+  }
+  return true;
+}
+
+// Phi is one-to-one if no triangle is degenerate or flipped in (u, v) and every interior vertex
+// lies strictly inside the square; records the smallest area and margin.
+bool CheckOneToOne(TwoCellMesh& mesh, std::string& error)
+{
+  const Index boundaryCount = mesh.BoundaryCount;
+  const Index interiorCount = mesh.NumberOfPoints() - boundaryCount;
   mesh.MinimumInteriorMargin = interiorCount > 0 ? std::numeric_limits<double>::infinity() : 0.5;
   for (Index i = boundaryCount; i < mesh.NumberOfPoints(); ++i)
   {
@@ -829,10 +926,38 @@ bool TwoCellParameterization::Parameterize(
             << mesh.NumberOfTriangles() << " triangles degenerate or flipped in (u, v), smallest interior margin "
             << mesh.MinimumInteriorMargin << ")";
     error = message.str();
+    return false;
+  }
+  return true;
+}
+} // namespace
+
+bool TwoCellParameterization::Parameterize(
+  const std::vector<double>& boundaryPoints, const std::vector<double>& boundaryParameters, std::string& error)
+{
+  this->Mesh = TwoCellMesh();
+  this->PointGrid = BucketGrid();
+  this->ParameterGrid = BucketGrid();
+
+  // The boundary: (u, v) once around the square, an outer loop with slits, a simple polygon;
+  // then the mesh of the cell (paper, section 5.1).
+  CellBoundary cell;
+  TwoCellMesh& mesh = this->Mesh;
+  if (!ReadBoundarySamples(boundaryPoints, boundaryParameters, cell, error) || !CheckBorderParameters(cell, error) ||
+    !AnalyzeBoundary(cell.XY, cell.Count, cell.Graph, error) || !CheckOuterLoop(cell, error) ||
+    !TriangulateCell(cell, InteriorEdgeLength(cell, this->TargetEdgeLength, this->MaximumVertices), this->ShapeBound,
+      this->MaximumFixRounds, mesh, error))
+  {
     this->Mesh = TwoCellMesh();
     return false;
   }
-
+  // Phi on the mesh.
+  mesh.Orientation = cell.PolygonOrientation * cell.ParameterOrientation;
+  if (!SolveMeanValueCoordinates(mesh, error) || !CheckOneToOne(mesh, error))
+  {
+    this->Mesh = TwoCellMesh();
+    return false;
+  }
   BuildGrid(mesh.Points, mesh.Triangles, this->PointGrid);
   BuildGrid(mesh.Parameters, mesh.Triangles, this->ParameterGrid);
   return true;

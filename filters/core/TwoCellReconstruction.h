@@ -17,7 +17,7 @@
 #pragma once
 
 #include "CoreTypes.h"
-#include "MonotoneSibsonPatch.h"
+#include "MonotoneSibsonSurface.h"
 #include "MorseSmaleComplex.h"
 #include "OneCellSmoothing.h"
 #include "TwoCellParameterization.h"

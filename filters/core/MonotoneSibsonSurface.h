@@ -1,0 +1,170 @@
+// Stage 4 of the paper (section 5.2): a C1 piecewise cubic surface on the unit square that
+// interpolates four monotone boundary curves and has no critical point inside, built from
+// "modified Sibson" elements (MonotoneSibsonPatch.h) on a uniform N x N grid: the boundary
+// Beziers fix the values and tangential derivatives at the boundary nodes, a Laplace equation
+// the interior values, and the free derivatives are chosen (and values moved where needed) so
+// that every cell meets the patch's sufficient monotonicity conditions (docs/Algorithms.md, 1.4).
+#pragma once
+
+#include "MonotoneSibsonPatch.h"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace topospline
+{
+// One cubic Bezier segment of a boundary height function: control values c0..c3.
+using CubicHeightSegment = std::array<double, 4>;
+using BezierSide = std::vector<CubicHeightSegment>;
+
+// de Casteljau split of one cubic at s in (0,1): `left` covers [0, s], `right` [s, 1].
+void SplitCubicSegment(const CubicHeightSegment& control, double s, CubicHeightSegment& left,
+  CubicHeightSegment& right);
+
+// Splits every segment of `side` into targetCount / side.size() equal parameter pieces, so that
+// the side has `targetCount` segments describing exactly the same function. The grid is
+// uniform, so the split must be uniform too (otherwise the parameter speed, hence the
+// tangential derivative at the grid nodes, would jump): targetCount must be a multiple of
+// side.size(). Returns false (and leaves `result` empty) otherwise.
+bool SubdivideSide(const BezierSide& side, int targetCount, BezierSide& result);
+
+// The smallest count all four sides can be uniformly subdivided to: the least common multiple
+// of their segment counts (0 if a side is empty).
+int CommonSegmentCount(const BezierSide& bottom, const BezierSide& right, const BezierSide& top,
+  const BezierSide& left);
+
+// Boundary of the unit square; every side is oriented from its lower corner to its upper one
+// and has the same number N of segments, segment j covering [j/N, (j+1)/N]:
+//   Bottom (0,0)->(1,0), Right (1,0)->(1,1), Top (0,1)->(1,1), Left (0,0)->(0,1)
+// (listed in the order of TwoCellSides, counter-clockwise, though Top and Left run against it).
+// Corners: minimum (0,0), saddles (1,0) and (0,1), maximum (1,1). Consecutive segments must
+// share their end value and (scaled) end derivative, 3 (c3 - c2) = 3 (c1' - c0'), and the
+// sides must agree at the corners.
+struct MonotoneSurfaceBoundary
+{
+  BezierSide Bottom;
+  BezierSide Right;
+  BezierSide Top;
+  BezierSide Left;
+};
+
+struct MonotoneSurfaceOptions
+{
+  // Mismatches between the sides at shared points (values and scaled derivatives) up to this
+  // fraction of the value range are averaged away; larger ones are an error.
+  double ConsistencyTolerance = 1e-9;
+  // Lower bound sigma of p + q at interior nodes (and at boundary nodes whose tangential
+  // derivative is below sigma), as this fraction of the smallest per-cell spare rise.
+  double MinimumSlopeFraction = 0.1;
+  // Fraction of the rise of each cell kept free when limiting derivatives (per cell, then per
+  // diagonal relative to the best achievable spare rise).
+  double LimiterMargin = 0.1;
+  // Share of a diagonal's spare rise that every cell of it gets on top of its requirement
+  // when values have to be moved.
+  double RiseShare = 0.05;
+  // Rounds of the per-cell derivative limiter (keeps the Laplace values where it can) and of
+  // the per-diagonal one (makes every diagonal fixable); if the latter does not settle, all
+  // free derivatives take the minimal choice, which always works when anything does.
+  int CellLimiterSweeps = 8;
+  // Cross-boundary derivatives: 0 (a flat valley floor or ridge top along the 1-cells, as a
+  // smooth field has there; raised only where the tangential derivative vanishes) instead of
+  // the one-sided difference into the interior values, which makes a crease whose sampling
+  // shows spurious critical points along the 1-cells.
+  bool FlatAcrossBoundary = false;
+  int DiagonalLimiterRounds = 8;
+};
+
+// What the construction had to do, for the filter's reports.
+struct MonotoneSurfaceReport
+{
+  int LinearizedDiagonals = 0;  // the paper's fallback: Laplace values not increasing
+  int LimitedNodes = 0;         // nodes whose estimated derivatives were scaled down
+  int AdjustedDiagonals = 0;    // diagonals whose interior values were moved
+  int GlobalFallback = 0;       // 1 when all free derivatives had to take the minimal choice
+  double MinimumSlope = 0;      // sigma, in h units
+  int ViolatingCells = 0;       // cells failing (C0)-(C3) in the end (0 unless infeasible)
+  double MaximumValueShift = 0; // largest change of an interior value from the Laplace one
+};
+
+// A cubic Bezier triangle of the output, control points (x, y, z) with (x, y) in the unit
+// square, in the ordinate order of BezierOrdinateIndex.
+struct SurfaceBezierTriangle
+{
+  std::array<std::array<double, 3>, 10> Points;
+};
+
+class MonotoneSibsonSurface
+{
+public:
+  // Builds the surface. Returns false with a message when the input is malformed or the
+  // sufficient conditions cannot hold for it (then the surface is still built, best effort,
+  // and Report().ViolatingCells says how many cells fail).
+  bool Build(const MonotoneSurfaceBoundary& boundary, std::string& error,
+    const MonotoneSurfaceOptions& options = MonotoneSurfaceOptions());
+
+  int GetGridSize() const { return this->N; }
+  const MonotoneSurfaceReport& Report() const { return this->BuildReport; }
+
+  // Node data on the (N+1) x (N+1) grid, node (i, j) at (i/N, j/N); P, Q are h * partials.
+  double NodeValue(int i, int j) const { return this->Z[this->Node(i, j)]; }
+  double NodeP(int i, int j) const { return this->P[this->Node(i, j)]; }
+  double NodeQ(int i, int j) const { return this->Q[this->Node(i, j)]; }
+  // The Laplace values before any correction (interior nodes), for diagnostics.
+  double LaplaceValue(int i, int j) const { return this->LaplaceZ[this->Node(i, j)]; }
+  SibsonCellData GetCellData(int i, int j) const;
+  const MonotoneSibsonPatch& GetPatch(int i, int j) const { return this->Patches[j * this->N + i]; }
+
+  // Checks (C0)-(C3) in every cell plus p + q > 0 at interior nodes; returns the number of
+  // failing cells (an interior node with p + q <= 0 counts as a failure of its cells).
+  int CountViolatingCells(double tolerance = 0) const;
+
+  // F and its gradient with respect to (u, v) at a point of the unit square (clamped to it).
+  double Evaluate(double u, double v) const;
+  void EvaluateWithGradient(double u, double v, double& value, double gradient[2]) const;
+
+  // All 4 N^2 Bezier triangles, cell by cell (row j, then column i), S, E, N, W in each.
+  std::vector<SurfaceBezierTriangle> GetBezierTriangles() const;
+
+private:
+  // A (1,1)-diagonal of the grid, and the state the steps of Build share (in the .cxx).
+  struct GridDiagonal;
+  struct Construction;
+
+  int Node(int i, int j) const { return j * (this->N + 1) + i; }
+  // Nodes of cell (i, j) in the corner order of SibsonCellData.
+  void CellNodes(int i, int j, int nodes[4]) const;
+  void Locate(double u, double v, int& i, int& j, double& X, double& Y) const;
+
+  // The steps of Build, in the order they run (paper, section 5.2).
+  bool SetBoundaryNodes(const MonotoneSurfaceBoundary& boundary, double allowedMismatch, std::string& error);
+  bool ComputeDiagonalRises(Construction& construction, std::string& error) const;
+  void SolveLaplaceValues();
+  void LinearizeNonIncreasingDiagonals(const Construction& construction);
+  void ClassifyNodes(Construction& construction) const;
+  void ChooseMinimumSlope(Construction& construction);
+  void SetMinimalDerivatives(Construction& construction, double sigma) const;
+  void EstimateDerivatives(Construction& construction) const;
+  void LimitDerivativesPerCell(Construction& construction) const;
+  void LimitDerivativesPerDiagonal(Construction& construction);
+  void AdjustDiagonalValues(Construction& construction);
+  void BuildPatches();
+
+  // max(LHS(C2), LHS(C3), 0) / 3 of cell (i, j) with derivatives p, q: the least rise
+  // z11 - z00 the cell needs; and its sum over the cells of a diagonal.
+  double CellRequirement(int i, int j, const std::vector<double>& p, const std::vector<double>& q) const;
+  double DiagonalRequirement(
+    const GridDiagonal& diagonal, const std::vector<double>& p, const std::vector<double>& q) const;
+  // Scales the lambdas of the given nodes of a diagonal to gamma times `base`; returns the
+  // diagonal's requirement then.
+  double ScaleDiagonalDerivatives(Construction& construction, const GridDiagonal& diagonal,
+    const std::vector<int>& touching, const std::vector<double>& base, double gamma) const;
+  // The nodes of the cells of a diagonal, sorted, each once.
+  void DiagonalCellNodes(const GridDiagonal& diagonal, std::vector<int>& nodes) const;
+
+  int N = 0;
+  std::vector<double> Z, P, Q, LaplaceZ;
+  std::vector<MonotoneSibsonPatch> Patches;
+  MonotoneSurfaceReport BuildReport;
+};
+} // namespace topospline
