@@ -37,9 +37,17 @@ struct ValueRange
   double Range = 0; // max - min, or a fallback scale when all values are equal
 };
 
-bool CheckRelations(const std::vector<JunctionValueNode>& nodes, const std::vector<std::array<Index, 2>>& lowerThan,
-  std::string& error)
+bool CheckNodesAndRelations(const std::vector<JunctionValueNode>& nodes,
+  const std::vector<std::array<Index, 2>>& lowerThan, std::string& error)
 {
+  for (const auto& node : nodes)
+  {
+    if (!std::isfinite(node.Value))
+    {
+      error = "the junction program got a non-finite node value";
+      return false;
+    }
+  }
   const Index count = static_cast<Index>(nodes.size());
   for (const auto& r : lowerThan)
   {
@@ -467,6 +475,32 @@ bool EnforceMargins(const std::vector<JunctionValueNode>& nodes, const RelationG
   }
   return true;
 }
+// The values of the free nodes: a lone junction in closed form, every other component by its
+// program. Counts the programs solved and the free nodes in the largest.
+bool SolveFreeNodes(const std::vector<JunctionValueNode>& nodes, const RelationGraph& graph,
+  const FreeNodeProblems& problems, double margin, const ValueRange& range, std::vector<double>& values,
+  int& numberOfPrograms, int& largestProgram, std::string& error)
+{
+  const Index count = static_cast<Index>(nodes.size());
+  std::vector<Index> variableOf(count, InvalidIndex);
+  for (const auto& component : problems.Components)
+  {
+    if (component.size() == 1)
+    {
+      // min |x - f| within [lower, upper]: the clamp (lower <= upper, see FindTightestChain).
+      const Index n = component[0];
+      values[n] = std::min(std::max(nodes[n].Value, problems.Lower[n]), problems.Upper[n]);
+      continue;
+    }
+    if (!SolveComponentProgram(component, nodes, graph, problems, margin, range, variableOf, values, error))
+    {
+      return false;
+    }
+    ++numberOfPrograms;
+    largestProgram = std::max(largestProgram, static_cast<int>(component.size()));
+  }
+  return true;
+}
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -480,15 +514,7 @@ bool JunctionValueProgram::Solve(const std::vector<JunctionValueNode>& originalN
     error = "the junction program needs MarginFraction > 0 and MarginSafety in (0, 1)";
     return false;
   }
-  for (const auto& node : nodes)
-  {
-    if (!std::isfinite(node.Value))
-    {
-      error = "the junction program got a non-finite node value";
-      return false;
-    }
-  }
-  if (!CheckRelations(nodes, lowerThan, error))
+  if (!CheckNodesAndRelations(nodes, lowerThan, error))
   {
     return false;
   }
@@ -528,22 +554,10 @@ bool JunctionValueProgram::Solve(const std::vector<JunctionValueNode>& originalN
   }
   this->NumberOfPrograms = 0;
   this->LargestProgram = 0;
-  std::vector<Index> variableOf(count, InvalidIndex);
-  for (const auto& component : problems.Components)
+  if (!SolveFreeNodes(
+        nodes, graph, problems, margin, range, values, this->NumberOfPrograms, this->LargestProgram, error))
   {
-    if (component.size() == 1)
-    {
-      // min |x - f| within [lower, upper]: the clamp (lower <= upper, see FindTightestChain).
-      const Index n = component[0];
-      values[n] = std::min(std::max(nodes[n].Value, problems.Lower[n]), problems.Upper[n]);
-      continue;
-    }
-    if (!SolveComponentProgram(component, nodes, graph, problems, margin, range, variableOf, values, error))
-    {
-      return false;
-    }
-    ++this->NumberOfPrograms;
-    this->LargestProgram = std::max(this->LargestProgram, static_cast<int>(component.size()));
+    return false;
   }
   if (!EnforceMargins(nodes, graph, margin, values, error))
   {

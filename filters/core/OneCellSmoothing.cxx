@@ -45,9 +45,13 @@ bool SegmentsIntersect(const Segment2& s, const Segment2& t)
   const double d3 = Cross(t.A, t.B, s.A), d4 = Cross(t.A, t.B, s.B);
   return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
 }
+
+// Where a 1-cell is cut: (position in its Points, node there).
+using Cut = std::pair<long, Index>;
+
 // Keeps, of the cuts of one 1-cell (source first, destination last), the longest chain whose
 // nodes rise strictly in (value, node index) from the source to the destination.
-void KeepRisingCuts(std::vector<std::pair<long, Index>>& at, const std::vector<SmoothingNode>& nodes)
+void KeepRisingCuts(std::vector<Cut>& at, const std::vector<SmoothingNode>& nodes)
 {
   auto below = [&nodes](Index x, Index y) {
     return nodes[x].Value != nodes[y].Value ? nodes[x].Value < nodes[y].Value : x < y;
@@ -71,7 +75,7 @@ void KeepRisingCuts(std::vector<std::pair<long, Index>>& at, const std::vector<S
   {
     return; // the ends themselves are out of order: left to the program's error
   }
-  std::vector<std::pair<long, Index>> kept;
+  std::vector<Cut> kept;
   for (size_t i = m - 1;; i = previous[i])
   {
     kept.push_back(at[i]);
@@ -83,18 +87,11 @@ void KeepRisingCuts(std::vector<std::pair<long, Index>>& at, const std::vector<S
   std::reverse(kept.begin(), kept.end());
   at = std::move(kept);
 }
-// Cuts every 1-cell at the nodes it passes (its junction points, and the domain corners it
-// meets, which are added to `nodes`) into pieces; identical pieces (merged 1-cells) are kept
-// once. With risingCutsOnly only the cuts KeepRisingCuts keeps (see
-// CutAndSolveJunctionValues). Node positions become the ends of the pieces that meet there.
-void CutIntoPieces(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
-  const std::vector<Index>& junctionNode, const double domainBounds[4], bool risingCutsOnly,
-  std::vector<SmoothingNode>& nodes, OneCellSmoothingResult& result)
+// The cuts of every 1-cell at the junction points it passes (not at its ends).
+std::vector<std::vector<Cut>> CutsAtJunctions(const MorseSmaleComplex& complex,
+  const std::vector<JunctionPoint>& junctions, const std::vector<Index>& junctionNode)
 {
-  std::map<std::pair<double, double>, Index> cornerNode;
-  const double corners[4][2] = { { domainBounds[0], domainBounds[2] }, { domainBounds[1], domainBounds[2] },
-    { domainBounds[1], domainBounds[3] }, { domainBounds[0], domainBounds[3] } };
-  std::vector<std::vector<std::pair<long, Index>>> cuts(complex.OneCells.size());
+  std::vector<std::vector<Cut>> cuts(complex.OneCells.size());
   for (size_t j = 0; j < junctions.size(); ++j)
   {
     for (Index a : junctions[j].OneCells)
@@ -106,89 +103,141 @@ void CutIntoPieces(const MorseSmaleComplex& complex, const std::vector<JunctionP
       }
     }
   }
-  std::map<std::vector<double>, Index> pieceOfGeometry;
-  result.PiecesOfOneCell.resize(complex.OneCells.size());
-  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
+  return cuts;
+}
+
+// The corners of the domain as nodes, made when a 1-cell first passes one, so that the
+// boundary keeps its corners.
+class DomainCornerNodes
+{
+public:
+  explicit DomainCornerNodes(const double domainBounds[4])
+    : Corners{ { domainBounds[0], domainBounds[2] }, { domainBounds[1], domainBounds[2] },
+      { domainBounds[1], domainBounds[3] }, { domainBounds[0], domainBounds[3] } }
   {
-    const OneCell& arc = complex.OneCells[a];
+  }
+
+  // Cuts `arc` at the corners it passes (not at its ends).
+  void AddCuts(const OneCell& arc, std::vector<SmoothingNode>& nodes, std::vector<Cut>& at)
+  {
+    const auto& corners = this->Corners;
     const long n = static_cast<long>(arc.Values.size());
-    auto& at = cuts[a];
     for (long p = 1; p + 1 < n; ++p)
     {
       for (int c = 0; c < 4; ++c)
       {
         if (arc.Points[2 * p] == corners[c][0] && arc.Points[2 * p + 1] == corners[c][1])
         {
-          auto found = cornerNode.find({ corners[c][0], corners[c][1] });
-          if (found == cornerNode.end())
+          auto found = this->NodeOfCorner.find({ corners[c][0], corners[c][1] });
+          if (found == this->NodeOfCorner.end())
           {
             SmoothingNode node;
             node.Type = SmoothingNode::DomainCorner;
             node.Position[0] = corners[c][0];
             node.Position[1] = corners[c][1];
             node.FieldValue = node.Value = arc.Values[p];
-            found = cornerNode.insert({ { corners[c][0], corners[c][1] }, static_cast<Index>(nodes.size()) }).first;
+            found =
+              this->NodeOfCorner.insert({ { corners[c][0], corners[c][1] }, static_cast<Index>(nodes.size()) }).first;
             nodes.push_back(node);
           }
           at.push_back({ p, found->second });
         }
       }
     }
-    // A merged 1-cell may pass its own end's vertex before it ends there (the trivial
-    // embedding): no cut at its own ends' nodes.
-    at.erase(std::remove_if(at.begin(), at.end(),
-               [&](const auto& cut) { return cut.second == arc.Source || cut.second == arc.Destination; }),
-      at.end());
-    at.push_back({ 0, arc.Source });
-    at.push_back({ n - 1, arc.Destination });
-    std::sort(at.begin(), at.end());
-    at.erase(std::unique(at.begin(), at.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
-      at.end());
-    // A node passed twice, in a row (which would make a piece from a node to itself) or after
-    // an excursion: a merged 1-cell can run out to a cancelled extremum and back along the
-    // same path, passing its nodes a second time in the opposite order, and pieces cut at both
-    // visits would order those nodes both ways (a cycle no values can satisfy). The excursion
-    // stays inside one piece, from the first visit to the node after the last one.
-    for (size_t k = 0; k < at.size(); ++k)
+  }
+
+private:
+  double Corners[4][2];
+  std::map<std::pair<double, double>, Index> NodeOfCorner;
+};
+
+// Adds the 1-cell's ends to its cuts and orders them along it, one cut per position.
+void AddEndsAndOrderCuts(const OneCell& arc, std::vector<Cut>& at)
+{
+  const long n = static_cast<long>(arc.Values.size());
+  // A merged 1-cell may pass its own end's vertex before it ends there (the trivial
+  // embedding): no cut at its own ends' nodes.
+  at.erase(std::remove_if(at.begin(), at.end(),
+             [&](const auto& cut) { return cut.second == arc.Source || cut.second == arc.Destination; }),
+    at.end());
+  at.push_back({ 0, arc.Source });
+  at.push_back({ n - 1, arc.Destination });
+  std::sort(at.begin(), at.end());
+  at.erase(std::unique(at.begin(), at.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
+    at.end());
+  // A node passed twice, in a row (which would make a piece from a node to itself) or after
+  // an excursion: a merged 1-cell can run out to a cancelled extremum and back along the
+  // same path, passing its nodes a second time in the opposite order, and pieces cut at both
+  // visits would order those nodes both ways (a cycle no values can satisfy). The excursion
+  // stays inside one piece, from the first visit to the node after the last one.
+  for (size_t k = 0; k < at.size(); ++k)
+  {
+    size_t last = k;
+    for (size_t m = k + 1; m < at.size(); ++m)
     {
-      size_t last = k;
-      for (size_t m = k + 1; m < at.size(); ++m)
-      {
-        last = at[m].second == at[k].second ? m : last;
-      }
-      at.erase(at.begin() + k + 1, at.begin() + last + 1);
+      last = at[m].second == at[k].second ? m : last;
     }
+    at.erase(at.begin() + k + 1, at.begin() + last + 1);
+  }
+}
+
+// The pieces of 1-cell `a` between consecutive cuts; a piece already made by another 1-cell
+// on the same points (merged 1-cells) is shared.
+void AddPiecesOfOneCell(Index a, const OneCell& arc, const std::vector<Cut>& at,
+  std::map<std::vector<double>, Index>& pieceOfGeometry, OneCellSmoothingResult& result)
+{
+  const long n = static_cast<long>(arc.Values.size());
+  for (size_t k = 0; k + 1 < at.size(); ++k)
+  {
+    const long from = at[k].first, to = at[k + 1].first;
+    std::vector<double> key(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
+    key.push_back(arc.Type);
+    auto found = pieceOfGeometry.find(key);
+    if (found == pieceOfGeometry.end())
+    {
+      SmoothedPiece piece;
+      piece.Type = arc.Type;
+      piece.StartNode = at[k].second;
+      piece.EndNode = at[k + 1].second;
+      piece.Points.assign(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
+      piece.Values.assign(arc.Values.begin() + from, arc.Values.begin() + to + 1);
+      if (arc.Type == OneCell::Ascending && to == n - 1 && piece.Values.size() > 2)
+      {
+        // Every ascending 1-cell into a maximum ends "centroid of the maximum's triangle,
+        // maximum's vertex": a segment they would all share. Go straight to the vertex.
+        piece.Points.erase(piece.Points.end() - 4, piece.Points.end() - 2);
+        piece.Values.erase(piece.Values.end() - 2);
+      }
+      found = pieceOfGeometry.insert({ key, static_cast<Index>(result.Pieces.size()) }).first;
+      result.Pieces.push_back(std::move(piece));
+    }
+    result.Pieces[found->second].OneCells.push_back(a);
+    result.PiecesOfOneCell[a].push_back(found->second);
+  }
+}
+
+// Cuts every 1-cell at the nodes it passes (its junction points, and the domain corners it
+// meets, which are added to `nodes`) into pieces; identical pieces (merged 1-cells) are kept
+// once. With risingCutsOnly only the cuts KeepRisingCuts keeps (see
+// CutAndSolveJunctionValues). Node positions become the ends of the pieces that meet there.
+void CutIntoPieces(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
+  const std::vector<Index>& junctionNode, const double domainBounds[4], bool risingCutsOnly,
+  std::vector<SmoothingNode>& nodes, OneCellSmoothingResult& result)
+{
+  std::vector<std::vector<Cut>> cuts = CutsAtJunctions(complex, junctions, junctionNode);
+  DomainCornerNodes corners(domainBounds);
+  std::map<std::vector<double>, Index> pieceOfGeometry;
+  result.PiecesOfOneCell.resize(complex.OneCells.size());
+  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
+  {
+    const OneCell& arc = complex.OneCells[a];
+    corners.AddCuts(arc, nodes, cuts[a]);
+    AddEndsAndOrderCuts(arc, cuts[a]);
     if (risingCutsOnly)
     {
-      KeepRisingCuts(at, nodes);
+      KeepRisingCuts(cuts[a], nodes);
     }
-    for (size_t k = 0; k + 1 < at.size(); ++k)
-    {
-      const long from = at[k].first, to = at[k + 1].first;
-      std::vector<double> key(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
-      key.push_back(arc.Type);
-      auto found = pieceOfGeometry.find(key);
-      if (found == pieceOfGeometry.end())
-      {
-        SmoothedPiece piece;
-        piece.Type = arc.Type;
-        piece.StartNode = at[k].second;
-        piece.EndNode = at[k + 1].second;
-        piece.Points.assign(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
-        piece.Values.assign(arc.Values.begin() + from, arc.Values.begin() + to + 1);
-        if (arc.Type == OneCell::Ascending && to == n - 1 && piece.Values.size() > 2)
-        {
-          // Every ascending 1-cell into a maximum ends "centroid of the maximum's triangle,
-          // maximum's vertex": a segment they would all share. Go straight to the vertex.
-          piece.Points.erase(piece.Points.end() - 4, piece.Points.end() - 2);
-          piece.Values.erase(piece.Values.end() - 2);
-        }
-        found = pieceOfGeometry.insert({ key, static_cast<Index>(result.Pieces.size()) }).first;
-        result.Pieces.push_back(std::move(piece));
-      }
-      result.Pieces[found->second].OneCells.push_back(a);
-      result.PiecesOfOneCell[a].push_back(found->second);
-    }
+    AddPiecesOfOneCell(a, arc, cuts[a], pieceOfGeometry, result);
   }
   // Node positions: the ends of the pieces that meet there.
   for (const SmoothedPiece& piece : result.Pieces)
