@@ -516,6 +516,75 @@ void MeasureHeightErrors(const std::vector<double>& parameters, const std::vecto
     fit.MaximumError = std::max(fit.MaximumError, e);
   }
 }
+// The normal equations of the planar curve fit for its free coefficients c_1..c_k (unknown
+// j - 1), in coordinates relative to `origin`; c_0 and c_k+1 are the end points.
+void AccumulateCurveNormalEquations(const std::vector<double>& parameters, const std::vector<double>& points,
+  const double origin[2], int k, Eigen::MatrixXd& normal, Eigen::MatrixXd& rhs)
+{
+  const std::size_t count = parameters.size();
+  const double end[2] = { points[2 * count - 2] - origin[0], points[2 * count - 1] - origin[1] };
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    int first = 0;
+    double w[3];
+    UniformQuadraticBSpline::BasisWeights(k, parameters[i], first, w);
+    double residual[2] = { points[2 * i] - origin[0], points[2 * i + 1] - origin[1] };
+    for (int m = 0; m < 3; ++m)
+    {
+      const int index = first + m;
+      if (index == k + 1)
+      {
+        residual[0] -= w[m] * end[0];
+        residual[1] -= w[m] * end[1];
+      }
+    }
+    for (int m = 0; m < 3; ++m)
+    {
+      const int row = first + m - 1;
+      if (row < 0 || row >= k || w[m] == 0.0)
+      {
+        continue;
+      }
+      for (int n = 0; n < 3; ++n)
+      {
+        const int column = first + n - 1;
+        if (column >= 0 && column < k)
+        {
+          normal(row, column) += w[m] * w[n];
+        }
+      }
+      rhs(row, 0) += w[m] * residual[0];
+      rhs(row, 1) += w[m] * residual[1];
+    }
+  }
+}
+
+// A ridge of 1e-6 of the mean diagonal pulls c_j towards the polyline at its Greville
+// abscissa (j - 1/2) / k (see FitPlanarCurve in the header).
+void AddGrevilleRidge(const std::vector<double>& parameters, const std::vector<double>& points,
+  const double origin[2], int k, Eigen::MatrixXd& normal, Eigen::MatrixXd& rhs)
+{
+  const std::size_t count = parameters.size();
+  // (With no sample inside the piece the normal matrix is zero: the ridge alone decides.)
+  const double meanDiagonal = normal.trace() / k;
+  const double ridge = meanDiagonal > 0 ? 1e-6 * meanDiagonal : 1.0;
+  for (int j = 1; j <= k; ++j)
+  {
+    const double tau = (j - 0.5) / k;
+    const auto upper = std::upper_bound(parameters.begin(), parameters.end(), tau);
+    std::size_t b = static_cast<std::size_t>(upper - parameters.begin());
+    b = std::min(std::max<std::size_t>(b, 1), count - 1);
+    const std::size_t a = b - 1;
+    const double span = parameters[b] - parameters[a];
+    const double u = span > 0 ? std::min(std::max((tau - parameters[a]) / span, 0.0), 1.0) : 0.0;
+    for (int d = 0; d < 2; ++d)
+    {
+      const double target = (1.0 - u) * (points[2 * a + d] - origin[d]) + u * (points[2 * b + d] - origin[d]);
+      rhs(j - 1, d) += ridge * target;
+    }
+    normal(j - 1, j - 1) += ridge;
+  }
+}
 } // namespace
 
 
@@ -663,67 +732,11 @@ bool MonotoneBSplineFit::FitPlanarCurve(
   // Relative to the start point: the solve then sees coordinates of the size of the piece,
   // not of the position of the piece in the domain.
   const double origin[2] = { points[0], points[1] };
-  const double end[2] = { points[2 * count - 2] - origin[0], points[2 * count - 1] - origin[1] };
 
-  // Normal equations for the free coefficients c_1..c_k (unknown j - 1).
   Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(k, k);
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(k, 2);
-  for (std::size_t i = 0; i < count; ++i)
-  {
-    int first = 0;
-    double w[3];
-    UniformQuadraticBSpline::BasisWeights(k, parameters[i], first, w);
-    double residual[2] = { points[2 * i] - origin[0], points[2 * i + 1] - origin[1] };
-    for (int m = 0; m < 3; ++m)
-    {
-      const int index = first + m;
-      if (index == k + 1)
-      {
-        residual[0] -= w[m] * end[0];
-        residual[1] -= w[m] * end[1];
-      }
-    }
-    for (int m = 0; m < 3; ++m)
-    {
-      const int row = first + m - 1;
-      if (row < 0 || row >= k || w[m] == 0.0)
-      {
-        continue;
-      }
-      for (int n = 0; n < 3; ++n)
-      {
-        const int column = first + n - 1;
-        if (column >= 0 && column < k)
-        {
-          normal(row, column) += w[m] * w[n];
-        }
-      }
-      rhs(row, 0) += w[m] * residual[0];
-      rhs(row, 1) += w[m] * residual[1];
-    }
-  }
-
-  // Ridge towards the polyline at the Greville abscissae (j - 1/2) / k of c_j.
-  // (With no sample inside the piece the normal matrix is zero: the ridge alone decides.)
-  const double meanDiagonal = normal.trace() / k;
-  const double ridge = meanDiagonal > 0 ? 1e-6 * meanDiagonal : 1.0;
-  for (int j = 1; j <= k; ++j)
-  {
-    const double tau = (j - 0.5) / k;
-    const auto upper = std::upper_bound(parameters.begin(), parameters.end(), tau);
-    std::size_t b = static_cast<std::size_t>(upper - parameters.begin());
-    b = std::min(std::max<std::size_t>(b, 1), count - 1);
-    const std::size_t a = b - 1;
-    const double span = parameters[b] - parameters[a];
-    const double u = span > 0 ? std::min(std::max((tau - parameters[a]) / span, 0.0), 1.0) : 0.0;
-    for (int d = 0; d < 2; ++d)
-    {
-      const double target = (1.0 - u) * (points[2 * a + d] - origin[d]) + u * (points[2 * b + d] - origin[d]);
-      rhs(j - 1, d) += ridge * target;
-    }
-    normal(j - 1, j - 1) += ridge;
-  }
-
+  AccumulateCurveNormalEquations(parameters, points, origin, k, normal, rhs);
+  AddGrevilleRidge(parameters, points, origin, k, normal, rhs);
   const Eigen::LDLT<Eigen::MatrixXd> factorization(normal);
   const Eigen::MatrixXd solution = factorization.solve(rhs);
   if (factorization.info() != Eigen::Success || !solution.allFinite())
