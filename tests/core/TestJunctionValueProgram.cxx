@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -238,6 +239,7 @@ TEST_CASE(ValueSpreading)
   {
     const std::vector<JunctionValueNode> nodes = { { 1.0, true }, { 1.0, false }, { 1.0 - 1e-6, true } };
     CHECK(!program.Solve(nodes, { { 0, 1 }, { 1, 2 } }, values, error) && !error.empty());
+    CHECK(program.FoundOrderConflict);
   }
 }
 
@@ -269,6 +271,95 @@ TEST_CASE(InfeasibleJunctionPrograms)
     CHECK(!ok && !error.empty());
     std::printf("  %s: \"%s\"\n", c.Name, error.c_str());
   }
+}
+
+//------------------------------------------------------------------------------
+// The optimum of the program against brute force on tiny graphs: with relations
+// x_high - x_low >= margin only, some optimum has every junction value at a node's value
+// plus a whole multiple of the margin (at most the longest chain), so trying all of those
+// finds the least total change.
+TEST_CASE(OptimalAgainstBruteForce)
+{
+  std::mt19937 random(23);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  JunctionValueProgram program;
+  program.MarginFraction = 0.05; // large enough for the margin to matter
+  int checked = 0;
+  for (int trial = 0; trial < 40; ++trial)
+  {
+    // Fixed 0 and 1, three junctions in a random order between them, each relation of that
+    // order present with probability 1/2 (fixed ends always linked to some junction).
+    std::vector<JunctionValueNode> nodes = { { 0.0, true }, { 1.0, true } };
+    for (int j = 0; j < 3; ++j)
+    {
+      nodes.push_back({ 1.4 * unit(random) - 0.2, false });
+    }
+    std::vector<Index> order = { 2, 3, 4 };
+    std::shuffle(order.begin(), order.end(), random);
+    std::vector<std::array<Index, 2>> relations = { { 0, order[0] }, { order[2], 1 } };
+    for (int x = 0; x < 3; ++x)
+    {
+      for (int y = x + 1; y < 3; ++y)
+      {
+        if (unit(random) < 0.5)
+        {
+          relations.push_back({ order[x], order[y] });
+        }
+      }
+      if (x > 0 && unit(random) < 0.5)
+      {
+        relations.push_back({ 0, order[x] });
+      }
+      if (x < 2 && unit(random) < 0.5)
+      {
+        relations.push_back({ order[x], 1 });
+      }
+    }
+    std::vector<double> values;
+    std::string error;
+    CHECK(program.Solve(nodes, relations, values, error));
+    if (values.size() != nodes.size())
+    {
+      continue;
+    }
+    CHECK(SatisfiesRelations(values, relations));
+    const double margin = program.Margin;
+    std::vector<double> candidates;
+    for (const auto& node : nodes)
+    {
+      for (int d = -4; d <= 4; ++d)
+      {
+        candidates.push_back(node.Value + d * margin);
+      }
+    }
+    double best = std::numeric_limits<double>::infinity();
+    std::vector<double> x = { 0.0, 1.0, 0.0, 0.0, 0.0 };
+    for (double a : candidates)
+    {
+      for (double b : candidates)
+      {
+        for (double c : candidates)
+        {
+          x[2] = a;
+          x[3] = b;
+          x[4] = c;
+          bool feasible = true;
+          for (const auto& r : relations)
+          {
+            feasible = feasible && x[r[1]] - x[r[0]] >= margin * (1 - 1e-12);
+          }
+          if (feasible)
+          {
+            best = std::min(best, Change(nodes, x));
+          }
+        }
+      }
+    }
+    CHECK(std::abs(program.TotalChange - best) <= 1e-9);
+    CHECK(std::abs(Change(nodes, values) - best) <= 1e-9);
+    ++checked;
+  }
+  CHECK(checked == 40);
 }
 
 //------------------------------------------------------------------------------
