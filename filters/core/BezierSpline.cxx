@@ -24,6 +24,15 @@ void CubicBernstein(double s, double b[4])
   b[2] = 3.0 * r * s * s;
   b[3] = s * s * s;
 }
+
+// The one component of a spline of Dimension 1 at t, through one of its evaluations.
+template <typename Spline>
+double ScalarAt(const Spline& spline, void (Spline::*evaluate)(double, double*) const, double t)
+{
+  double value = 0;
+  (spline.*evaluate)(t, &value);
+  return value;
+}
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -106,17 +115,13 @@ void CubicBezierSpline::EvaluateDerivative(double t, double* derivative) const
 //------------------------------------------------------------------------------
 double CubicBezierSpline::Value(double t) const
 {
-  double value = 0;
-  this->Evaluate(t, &value);
-  return value;
+  return ScalarAt(*this, &CubicBezierSpline::Evaluate, t);
 }
 
 //------------------------------------------------------------------------------
 double CubicBezierSpline::Slope(double t) const
 {
-  double slope = 0;
-  this->EvaluateDerivative(t, &slope);
-  return slope;
+  return ScalarAt(*this, &CubicBezierSpline::EvaluateDerivative, t);
 }
 
 //------------------------------------------------------------------------------
@@ -182,17 +187,13 @@ void UniformQuadraticBSpline::EvaluateDerivative(double t, double* derivative) c
 //------------------------------------------------------------------------------
 double UniformQuadraticBSpline::Value(double t) const
 {
-  double value = 0;
-  this->Evaluate(t, &value);
-  return value;
+  return ScalarAt(*this, &UniformQuadraticBSpline::Evaluate, t);
 }
 
 //------------------------------------------------------------------------------
 double UniformQuadraticBSpline::Slope(double t) const
 {
-  double slope = 0;
-  this->EvaluateDerivative(t, &slope);
-  return slope;
+  return ScalarAt(*this, &UniformQuadraticBSpline::EvaluateDerivative, t);
 }
 
 //------------------------------------------------------------------------------

@@ -13,12 +13,12 @@
 #include "OneCellSmoothing.h"
 #include "SyntheticFields.h"
 #include "TestHarness.h"
+#include "TestSupport.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
-#include <thread>
 #include <vector>
 
 using namespace topospline;
@@ -35,20 +35,8 @@ struct Stage3Input
 
 bool RunStages1And2(const GridField& grid, double percent, Stage3Input& input, std::string& error)
 {
-  PlanarScalarField field;
+  const PlanarScalarField field = StructuredFieldFromGrid(grid);
   const int nx = grid.Dimensions[0], ny = grid.Dimensions[1];
-  field.GridDimensions[0] = nx;
-  field.GridDimensions[1] = ny;
-  field.Points.resize(2 * static_cast<std::size_t>(nx) * ny);
-  for (int j = 0; j < ny; ++j)
-  {
-    for (int i = 0; i < nx; ++i)
-    {
-      field.Points[2 * (j * nx + i)] = grid.Origin[0] + i * grid.Spacing[0];
-      field.Points[2 * (j * nx + i) + 1] = grid.Origin[1] + j * grid.Spacing[1];
-    }
-  }
-  field.Values = grid.Values;
   MorseSmaleComplexExtraction extraction;
   MorseSmaleComplexSimplification simplification;
   if (!extraction.Extract(field, input.Input, error) || !simplification.ComputeHierarchy(input.Input, error) ||
@@ -63,21 +51,6 @@ bool RunStages1And2(const GridField& grid, double percent, Stage3Input& input, s
   input.Bounds[2] = grid.Origin[1];
   input.Bounds[3] = grid.Origin[1] + (ny - 1) * grid.Spacing[1];
   return true;
-}
-
-void ThreadedFor(Index begin, Index end, const RangeBody& body)
-{
-  const Index threads = 4;
-  std::vector<std::thread> pool;
-  const Index chunk = std::max<Index>(1, (end - begin + threads - 1) / threads);
-  for (Index b = begin; b < end; b += chunk)
-  {
-    pool.emplace_back([&body, b, end, chunk]() { body(b, std::min(end, b + chunk)); });
-  }
-  for (auto& thread : pool)
-  {
-    thread.join();
-  }
 }
 
 // The properties the paper asks of the smoothed 1-cells (section 4, steps 1-3).
