@@ -168,7 +168,7 @@ bool SortTopologically(const std::vector<JunctionValueNode>& nodes, RelationGrap
 ValueRange RangeOfValues(const std::vector<JunctionValueNode>& nodes)
 {
   const Index count = static_cast<Index>(nodes.size());
-  ValueRange values;
+  ValueRange result;
   double minimumValue = std::numeric_limits<double>::infinity();
   double maximumValue = -minimumValue;
   for (const auto& node : nodes)
@@ -183,10 +183,10 @@ ValueRange RangeOfValues(const std::vector<JunctionValueNode>& nodes)
     range = std::max(std::abs(minimumValue), 1.0);
     minimumValue = count > 0 ? minimumValue : 0.0;
   }
-  values.Minimum = minimumValue;
-  values.Maximum = maximumValue;
-  values.Range = range;
-  return values;
+  result.Minimum = minimumValue;
+  result.Maximum = maximumValue;
+  result.Range = range;
+  return result;
 }
 
 // Value spreading. The complex orders equal values by vertex id (simulation of simplicity),
@@ -196,7 +196,7 @@ ValueRange RangeOfValues(const std::vector<JunctionValueNode>& nodes)
 // constant field, values a few ulps apart in noise), the higher fixed values are raised to
 // the smallest values that leave that room, in topological order; nothing moves elsewhere.
 // Returns the gap; counts the raised values and the largest raise.
-double SpreadTiedFixedValues(std::vector<JunctionValueNode>& nodes, const RelationGraph& graph, ValueRange& values,
+double SpreadTiedFixedValues(std::vector<JunctionValueNode>& nodes, const RelationGraph& graph, ValueRange& range,
   int& spreadCount, double& maximumSpread)
 {
   const Index count = static_cast<Index>(nodes.size());
@@ -207,7 +207,7 @@ double SpreadTiedFixedValues(std::vector<JunctionValueNode>& nodes, const Relati
   }
   if (count > 0)
   {
-    scale = std::max(scale, values.Maximum - values.Minimum);
+    scale = std::max(scale, range.Maximum - range.Minimum);
   }
   const double gap = JunctionValueProgram::SpreadingGap * (scale > 0 ? scale : 1.0);
   // floor: the least value v can take with room below it; reached: the highest original
@@ -242,12 +242,12 @@ double SpreadTiedFixedValues(std::vector<JunctionValueNode>& nodes, const Relati
   }
   if (spreadCount > 0)
   {
-    values.Maximum = -std::numeric_limits<double>::infinity();
+    range.Maximum = -std::numeric_limits<double>::infinity();
     for (const auto& node : nodes)
     {
-      values.Maximum = std::max(values.Maximum, node.Value);
+      range.Maximum = std::max(range.Maximum, node.Value);
     }
-    values.Range = std::max(values.Range, values.Maximum - values.Minimum);
+    range.Range = std::max(range.Range, range.Maximum - range.Minimum);
   }
   return gap;
 }
@@ -433,6 +433,33 @@ bool SolveComponentProgram(const std::vector<Index>& component, const std::vecto
   return true;
 }
 
+// The values of the free nodes: a lone junction in closed form, every other component by its
+// program. Counts the programs solved and the free nodes in the largest.
+bool SolveFreeNodes(const std::vector<JunctionValueNode>& nodes, const RelationGraph& graph,
+  const FreeNodeProblems& problems, double margin, const ValueRange& range, std::vector<double>& values,
+  int& numberOfPrograms, int& largestProgram, std::string& error)
+{
+  const Index count = static_cast<Index>(nodes.size());
+  std::vector<Index> variableOf(count, InvalidIndex);
+  for (const auto& component : problems.Components)
+  {
+    if (component.size() == 1)
+    {
+      // min |x - f| within [lower, upper]: the clamp (lower <= upper, see FindTightestChain).
+      const Index n = component[0];
+      values[n] = std::min(std::max(nodes[n].Value, problems.Lower[n]), problems.Upper[n]);
+      continue;
+    }
+    if (!SolveComponentProgram(component, nodes, graph, problems, margin, range, variableOf, values, error))
+    {
+      return false;
+    }
+    ++numberOfPrograms;
+    largestProgram = std::max(largestProgram, static_cast<int>(component.size()));
+  }
+  return true;
+}
+
 // GLPK meets the constraints to its tolerance (1e-7 of the range), not exactly. Raise every
 // free node to its predecessors + margin (topological order), then lower it to its successors
 // - margin (reverse order): the second pass keeps the first one's lower bounds because the
@@ -472,32 +499,6 @@ bool EnforceMargins(const std::vector<JunctionValueNode>& nodes, const RelationG
         DescribeNode(nodes, r[1]) + " after solving";
       return false;
     }
-  }
-  return true;
-}
-// The values of the free nodes: a lone junction in closed form, every other component by its
-// program. Counts the programs solved and the free nodes in the largest.
-bool SolveFreeNodes(const std::vector<JunctionValueNode>& nodes, const RelationGraph& graph,
-  const FreeNodeProblems& problems, double margin, const ValueRange& range, std::vector<double>& values,
-  int& numberOfPrograms, int& largestProgram, std::string& error)
-{
-  const Index count = static_cast<Index>(nodes.size());
-  std::vector<Index> variableOf(count, InvalidIndex);
-  for (const auto& component : problems.Components)
-  {
-    if (component.size() == 1)
-    {
-      // min |x - f| within [lower, upper]: the clamp (lower <= upper, see FindTightestChain).
-      const Index n = component[0];
-      values[n] = std::min(std::max(nodes[n].Value, problems.Lower[n]), problems.Upper[n]);
-      continue;
-    }
-    if (!SolveComponentProgram(component, nodes, graph, problems, margin, range, variableOf, values, error))
-    {
-      return false;
-    }
-    ++numberOfPrograms;
-    largestProgram = std::max(largestProgram, static_cast<int>(component.size()));
   }
   return true;
 }

@@ -13,6 +13,76 @@ namespace topospline
 {
 namespace
 {
+// Nodes for every critical point, with the critical value as both field value and value.
+void AddCriticalNodes(const std::vector<CriticalPoint>& cps, std::vector<SmoothingNode>& nodes)
+{
+  for (Index c = 0; c < static_cast<Index>(cps.size()); ++c)
+  {
+    SmoothingNode node;
+    node.Type = SmoothingNode::Critical;
+    node.Source = c;
+    node.FieldValue = node.Value = cps[c].Value;
+    nodes.push_back(node);
+  }
+}
+
+// Ties between critical values (plateaus, broken by vertex id in stage 1) would make a
+// strictly increasing height impossible: separate tied values by at most 1e-9 of the range,
+// in the order of simulation of simplicity (value, then vertex, then index).
+void SeparateTiedCriticalValues(const std::vector<CriticalPoint>& cps, std::vector<SmoothingNode>& nodes)
+{
+  double low = cps.empty() ? 0 : cps[0].Value, high = low;
+  for (const auto& cp : cps)
+  {
+    low = std::min(low, cp.Value);
+    high = std::max(high, cp.Value);
+  }
+  std::vector<Index> order(cps.size());
+  for (Index i = 0; i < static_cast<Index>(order.size()); ++i)
+  {
+    order[i] = i;
+  }
+  // A vertex can hold several critical cells (a boundary corner: a saddle edge and a
+  // maximum triangle); the higher-dimensional cell is the higher one.
+  std::sort(order.begin(), order.end(), [&](Index x, Index y) {
+    if (cps[x].Value != cps[y].Value)
+    {
+      return cps[x].Value < cps[y].Value;
+    }
+    return cps[x].Vertex != cps[y].Vertex ? cps[x].Vertex < cps[y].Vertex : cps[x].MorseIndex < cps[y].MorseIndex;
+  });
+  const double step = 1e-9 * std::max(high - low, 1e-300) / std::max<size_t>(cps.size(), 1);
+  for (size_t i = 1; i < order.size(); ++i)
+  {
+    SmoothingNode& node = nodes[order[i]];
+    node.Value = std::max(node.Value, nodes[order[i - 1]].Value + step);
+  }
+}
+
+// Nodes for the junction points that are not on a critical point; returns the node of every
+// junction point (a saddle on it: the critical node).
+std::vector<Index> AddJunctionNodes(const std::vector<JunctionPoint>& junctions, std::vector<SmoothingNode>& nodes)
+{
+  std::vector<Index> junctionNode(junctions.size());
+  for (size_t j = 0; j < junctions.size(); ++j)
+  {
+    if (junctions[j].CriticalPoint != InvalidIndex)
+    {
+      junctionNode[j] = junctions[j].CriticalPoint;
+      continue;
+    }
+    SmoothingNode node;
+    node.Type = SmoothingNode::Junction;
+    node.Source = static_cast<Index>(j);
+    node.Position[0] = junctions[j].Position[0];
+    node.Position[1] = junctions[j].Position[1];
+    node.FieldValue = node.Value = junctions[j].Value;
+    junctionNode[j] = static_cast<Index>(nodes.size());
+    nodes.push_back(node);
+  }
+  return junctionNode;
+}
+
 // Where along a 1-cell its mesh cell `cell` sits, as an index into its Points; -1 if absent.
 long PointIndexOfCell(const OneCell& arc, Index cell)
 {
@@ -23,27 +93,6 @@ long PointIndexOfCell(const OneCell& arc, Index cell)
   }
   // Ascending 1-cells carry the saddle's vertex before their first triangle.
   return static_cast<long>(it - arc.MeshCells.begin()) + (arc.Type == OneCell::Ascending ? 1 : 0);
-}
-
-struct Segment2
-{
-  double A[2], B[2];
-  Index Piece;
-  int Index_;   // position along the piece's sampled polyline
-  int Count;    // number of segments of that polyline
-};
-
-double Cross(const double* o, const double* a, const double* b)
-{
-  return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
-}
-
-// Proper crossing or overlap of two segments (touching end points excluded by the caller).
-bool SegmentsIntersect(const Segment2& s, const Segment2& t)
-{
-  const double d1 = Cross(s.A, s.B, t.A), d2 = Cross(s.A, s.B, t.B);
-  const double d3 = Cross(t.A, t.B, s.A), d4 = Cross(t.A, t.B, s.B);
-  return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
 }
 
 // Where a 1-cell is cut: (position in its Points, node there).
@@ -287,76 +336,6 @@ bool SolveJunctionValues(std::vector<SmoothingNode>& nodes, OneCellSmoothingResu
   return true;
 }
 
-// Nodes for every critical point, with the critical value as both field value and value.
-void AddCriticalNodes(const std::vector<CriticalPoint>& cps, std::vector<SmoothingNode>& nodes)
-{
-  for (Index c = 0; c < static_cast<Index>(cps.size()); ++c)
-  {
-    SmoothingNode node;
-    node.Type = SmoothingNode::Critical;
-    node.Source = c;
-    node.FieldValue = node.Value = cps[c].Value;
-    nodes.push_back(node);
-  }
-}
-
-// Ties between critical values (plateaus, broken by vertex id in stage 1) would make a
-// strictly increasing height impossible: separate tied values by at most 1e-9 of the range,
-// in the order of simulation of simplicity (value, then vertex, then index).
-void SeparateTiedCriticalValues(const std::vector<CriticalPoint>& cps, std::vector<SmoothingNode>& nodes)
-{
-  double low = cps.empty() ? 0 : cps[0].Value, high = low;
-  for (const auto& cp : cps)
-  {
-    low = std::min(low, cp.Value);
-    high = std::max(high, cp.Value);
-  }
-  std::vector<Index> order(cps.size());
-  for (Index i = 0; i < static_cast<Index>(order.size()); ++i)
-  {
-    order[i] = i;
-  }
-  // A vertex can hold several critical cells (a boundary corner: a saddle edge and a
-  // maximum triangle); the higher-dimensional cell is the higher one.
-  std::sort(order.begin(), order.end(), [&](Index x, Index y) {
-    if (cps[x].Value != cps[y].Value)
-    {
-      return cps[x].Value < cps[y].Value;
-    }
-    return cps[x].Vertex != cps[y].Vertex ? cps[x].Vertex < cps[y].Vertex : cps[x].MorseIndex < cps[y].MorseIndex;
-  });
-  const double step = 1e-9 * std::max(high - low, 1e-300) / std::max<size_t>(cps.size(), 1);
-  for (size_t i = 1; i < order.size(); ++i)
-  {
-    SmoothingNode& node = nodes[order[i]];
-    node.Value = std::max(node.Value, nodes[order[i - 1]].Value + step);
-  }
-}
-
-// Nodes for the junction points that are not on a critical point; returns the node of every
-// junction point (a saddle on it: the critical node).
-std::vector<Index> AddJunctionNodes(const std::vector<JunctionPoint>& junctions, std::vector<SmoothingNode>& nodes)
-{
-  std::vector<Index> junctionNode(junctions.size());
-  for (size_t j = 0; j < junctions.size(); ++j)
-  {
-    if (junctions[j].CriticalPoint != InvalidIndex)
-    {
-      junctionNode[j] = junctions[j].CriticalPoint;
-      continue;
-    }
-    SmoothingNode node;
-    node.Type = SmoothingNode::Junction;
-    node.Source = static_cast<Index>(j);
-    node.Position[0] = junctions[j].Position[0];
-    node.Position[1] = junctions[j].Position[1];
-    node.FieldValue = node.Value = junctions[j].Value;
-    junctionNode[j] = static_cast<Index>(nodes.size());
-    nodes.push_back(node);
-  }
-  return junctionNode;
-}
-
 // A least-squares curve fitted to a 1-cell that runs along the boundary and then turns
 // inwards can overshoot the boundary slightly. A Bezier curve lies in the convex hull of its
 // control points: clamping them keeps it inside (the ends, data points, never move). Only a
@@ -395,6 +374,27 @@ void ClampCurveIntoDomain(SmoothedPiece& piece, const double bounds[4])
     piece.Clamped = piece.Clamped || clamped != coordinate;
     coordinate = clamped;
   }
+}
+
+struct Segment2
+{
+  double A[2], B[2];
+  Index Piece;
+  int Index_;   // position along the piece's sampled polyline
+  int Count;    // number of segments of that polyline
+};
+
+double Cross(const double* o, const double* a, const double* b)
+{
+  return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+}
+
+// Proper crossing or overlap of two segments (touching end points excluded by the caller).
+bool SegmentsIntersect(const Segment2& s, const Segment2& t)
+{
+  const double d1 = Cross(s.A, s.B, t.A), d2 = Cross(s.A, s.B, t.B);
+  const double d3 = Cross(t.A, t.B, s.A), d4 = Cross(t.A, t.B, s.B);
+  return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
 }
 
 // Finds the pairs of pieces whose smoothed curves cross: samples every curve, buckets the
@@ -560,7 +560,8 @@ private:
 };
 
 // Pieces whose curve leaves the domain's bounding box (to rounding) at one of its samples.
-int CountPiecesOutsideDomain(const std::vector<SmoothedPiece>& pieces, const double domainBounds[4], int samplesPerSegment)
+int CountPiecesOutsideDomain(
+  const std::vector<SmoothedPiece>& pieces, const double domainBounds[4], int samplesPerSegment)
 {
   int outsideCount = 0;
   for (const SmoothedPiece& piece : pieces)
