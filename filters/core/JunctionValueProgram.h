@@ -4,7 +4,7 @@
 // The nodes are the critical points (fixed values) and the junction points (free values with
 // their original field value f_j); a relation (lower, higher) says that two nodes follow each
 // other along some 1-cell, lower first. Relations from all 1-cells form a DAG. The program is
-// the paper's, written in inequality form (algorithms.md 3.4):
+// the paper's, written in inequality form (docs/Algorithms.md, 3.4):
 //   minimize sum_j |x_j - f_j| over the free nodes, subject to
 //   x_higher - x_lower >= margin for every relation, fixed nodes keeping their value.
 // A junction shared by several 1-cells is one node, hence one value for all of them.

@@ -11,25 +11,6 @@ namespace topospline
 {
 namespace
 {
-
-// Bernstein polynomials of degree 2 and 3 at s.
-void QuadraticBernstein(double s, double b[3])
-{
-  const double r = 1.0 - s;
-  b[0] = r * r;
-  b[1] = 2.0 * r * s;
-  b[2] = s * s;
-}
-
-void CubicBernstein(double s, double b[4])
-{
-  const double r = 1.0 - s;
-  b[0] = r * r * r;
-  b[1] = 3.0 * r * r * s;
-  b[2] = 3.0 * r * s * s;
-  b[3] = s * s * s;
-}
-
 bool AllFinite(const std::vector<double>& values)
 {
   for (double v : values)
@@ -133,50 +114,63 @@ bool SolvePrimal(const L1Program& l1, std::vector<double>& x, int& variables, in
   return true;
 }
 
-// The same optimum through the dual program, which has one row per unknown (k - 2) instead
-// of one per sample, so the simplex needs a few pivots instead of about as many as there are
-// samples (measured about 10 times faster for n = 200, k = 7):
-//   maximize sum_r Weight_r Target_r d_r + sum_s Target_s mu_s
-//   subject to sum_r Weight_r d_r a_r + sum_s mu_s c_s = 0, -1 <= d_r <= 1, mu_s >= 0.
-// CGAL's interface returns only the dual's variables, so x comes from complementary
-// slackness: |d_r| < 1 means residual r is zero, mu_s > 0 means constraint s is tight. The
-// x is accepted only with a certificate (feasible, and its objective equals the dual's, so
-// it is optimal by weak duality); otherwise (degenerate programs, e.g. many equal samples)
-// false without an error and the caller solves the primal.
-bool SolveThroughDual(const L1Program& l1, std::vector<double>& x, int& variables, int& constraints)
+// GLPK starts from its standard basis, where every d_r sits at a bound, and each sign it has
+// to flip costs an iteration. The dual is started instead from the signs of the residuals of
+// the least-squares fit (close to those of the L1 fit for most samples): d_r = sign_r + z_r
+// with z_r in [-1 - sign_r, 1 - sign_r], whose bound of smaller magnitude is z_r = 0.
+std::vector<double> LeastSquaresResidualSigns(const L1Program& l1)
 {
   const int p = l1.Unknowns;
-  // GLPK starts from its standard basis, where every d_r sits at a bound, and each sign it
-  // has to flip costs an iteration. Start instead from the signs of the residuals of the
-  // least-squares fit (close to those of the L1 fit for most samples): d_r = sign_r + z_r
-  // with z_r in [-1 - sign_r, 1 - sign_r], whose bound of smaller magnitude is z_r = 0.
   std::vector<double> sign(l1.Residuals.size(), 1.0);
+  Eigen::MatrixXd normal = Eigen::MatrixXd::Identity(p, p) * 1e-9;
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(p);
+  for (const SparseRow& row : l1.Residuals)
   {
-    Eigen::MatrixXd normal = Eigen::MatrixXd::Identity(p, p) * 1e-9;
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(p);
-    for (const SparseRow& row : l1.Residuals)
+    for (int e = 0; e < row.Count; ++e)
     {
-      for (int e = 0; e < row.Count; ++e)
+      for (int f = 0; f < row.Count; ++f)
       {
-        for (int f = 0; f < row.Count; ++f)
-        {
-          normal(row.Index[e], row.Index[f]) += row.Weight * row.Coefficient[e] * row.Coefficient[f];
-        }
-        rhs(row.Index[e]) += row.Weight * row.Coefficient[e] * row.Target;
+        normal(row.Index[e], row.Index[f]) += row.Weight * row.Coefficient[e] * row.Coefficient[f];
       }
-    }
-    const Eigen::VectorXd guess = normal.ldlt().solve(rhs);
-    if (guess.allFinite())
-    {
-      const std::vector<double> start(guess.data(), guess.data() + p);
-      for (std::size_t r = 0; r < l1.Residuals.size(); ++r)
-      {
-        sign[r] = l1.Residuals[r].Target - l1.Residuals[r].Dot(start) >= 0 ? 1.0 : -1.0;
-      }
+      rhs(row.Index[e]) += row.Weight * row.Coefficient[e] * row.Target;
     }
   }
+  const Eigen::VectorXd guess = normal.ldlt().solve(rhs);
+  if (guess.allFinite())
+  {
+    const std::vector<double> start(guess.data(), guess.data() + p);
+    for (std::size_t r = 0; r < l1.Residuals.size(); ++r)
+    {
+      sign[r] = l1.Residuals[r].Target - l1.Residuals[r].Dot(start) >= 0 ? 1.0 : -1.0;
+    }
+  }
+  return sign;
+}
 
-  LinearProgram program;
+// The dual program of an L1Program, with d_r = Sign_r + z_r (see LeastSquaresResidualSigns).
+struct DualProgram
+{
+  LinearProgram Program;
+  std::vector<double> Sign;
+  std::vector<LinearVariable*> ResidualDuals;   // z_r
+  std::vector<LinearVariable*> ConstraintDuals; // mu_s
+  double Scale = 1.0;                           // 1 + sum_r Weight_r |Target_r|
+
+  double ResidualDual(const std::vector<double>& solution, std::size_t r) const
+  {
+    return this->Sign[r] + solution[this->ResidualDuals[r]->index()];
+  }
+  double ConstraintDual(const std::vector<double>& solution, std::size_t s) const
+  {
+    return solution[this->ConstraintDuals[s]->index()];
+  }
+};
+
+void BuildDualProgram(const L1Program& l1, DualProgram& dual)
+{
+  const int p = l1.Unknowns;
+  LinearProgram& program = dual.Program;
+  const std::vector<double>& sign = dual.Sign;
   const double infinity = LinearVariable::infinity();
   auto* objective = program.create_objective(CGAL::Linear_objective<double>::MAXIMIZE);
   std::vector<double> rowTargets(static_cast<std::size_t>(p), 0.0);
@@ -193,8 +187,6 @@ bool SolveThroughDual(const L1Program& l1, std::vector<double>& x, int& variable
   {
     rows.push_back(program.create_constraint(rowTargets[q], rowTargets[q]));
   }
-  std::vector<LinearVariable*> residualDuals;
-  double scale = 1.0;
   for (std::size_t r = 0; r < l1.Residuals.size(); ++r)
   {
     const SparseRow& row = l1.Residuals[r];
@@ -204,10 +196,9 @@ bool SolveThroughDual(const L1Program& l1, std::vector<double>& x, int& variable
     {
       rows[row.Index[e]]->add_coefficient(z, row.Weight * row.Coefficient[e]);
     }
-    residualDuals.push_back(z);
-    scale += row.Weight * std::abs(row.Target);
+    dual.ResidualDuals.push_back(z);
+    dual.Scale += row.Weight * std::abs(row.Target);
   }
-  std::vector<LinearVariable*> constraintDuals;
   for (const SparseRow& row : l1.Constraints)
   {
     LinearVariable* mu = program.create_variable(LinearVariable::CONTINUOUS, 0.0, infinity);
@@ -216,23 +207,22 @@ bool SolveThroughDual(const L1Program& l1, std::vector<double>& x, int& variable
     {
       rows[row.Index[e]]->add_coefficient(mu, row.Coefficient[e]);
     }
-    constraintDuals.push_back(mu);
+    dual.ConstraintDuals.push_back(mu);
   }
-  variables = static_cast<int>(program.number_of_variables());
-  constraints = static_cast<int>(program.number_of_constraints());
-  std::string ignored;
-  if (!SolveLinearProgram(program, ignored))
-  {
-    return false; // leave it to the primal
-  }
-  const std::vector<double>& solution = program.solution();
+}
 
-  // Complementary slackness: the equations of the rows whose dual is strictly inside.
+// Complementary slackness: x solves the equations of the rows whose dual is strictly inside
+// (|d_r| < 1: residual r is zero; mu_s > 0: constraint s is tight). Sets the dual's objective;
+// false when those rows do not determine x.
+bool RecoverPrimalSolution(const L1Program& l1, const DualProgram& dual, const std::vector<double>& solution,
+  std::vector<double>& x, double& dualObjective)
+{
+  const int p = l1.Unknowns;
   std::vector<const SparseRow*> tight;
-  double dualObjective = 0;
+  dualObjective = 0;
   for (std::size_t r = 0; r < l1.Residuals.size(); ++r)
   {
-    const double d = sign[r] + solution[residualDuals[r]->index()];
+    const double d = dual.ResidualDual(solution, r);
     dualObjective += l1.Residuals[r].Weight * l1.Residuals[r].Target * d;
     if (d > -1.0 && d < 1.0)
     {
@@ -241,7 +231,7 @@ bool SolveThroughDual(const L1Program& l1, std::vector<double>& x, int& variable
   }
   for (std::size_t s = 0; s < l1.Constraints.size(); ++s)
   {
-    const double mu = solution[constraintDuals[s]->index()];
+    const double mu = dual.ConstraintDual(solution, s);
     dualObjective += l1.Constraints[s].Target * mu;
     if (mu > 0.0)
     {
@@ -269,20 +259,26 @@ bool SolveThroughDual(const L1Program& l1, std::vector<double>& x, int& variable
   }
   const Eigen::VectorXd solved = factorization.solve(targets);
   x.assign(solved.data(), solved.data() + p);
+  return true;
+}
 
-  // The certificate: P(x) - D(d, mu) = sum_r Weight_r (|res_r| - d_r res_r)
-  //   + sum_s mu_s (c_s . x - Target_s) - x . e,
-  // every term >= 0 but the last. GLPK meets the dual's rows only to its tolerance (row
-  // residual e = sum_r Weight_r d_r a_r + sum_s mu_s c_s) and stops when the reduced costs
-  // (here: residuals whose sign disagrees with d_r) are below 1e-7, so it leaves gaps of
-  // about 1e-7 even at its optimum; a wrong active set leaves gaps of the size of the
-  // residuals. Accept x when the gap is below x . e + 1e-7 * (1 + sum_r Weight_r |Target_r|):
-  // optimal to GLPK's own tolerance, in units of b - a.
+// The certificate: P(x) - D(d, mu) = sum_r Weight_r (|res_r| - d_r res_r)
+//   + sum_s mu_s (c_s . x - Target_s) - x . e,
+// every term >= 0 but the last. GLPK meets the dual's rows only to its tolerance (row
+// residual e = sum_r Weight_r d_r a_r + sum_s mu_s c_s) and stops when the reduced costs
+// (here: residuals whose sign disagrees with d_r) are below 1e-7, so it leaves gaps of
+// about 1e-7 even at its optimum; a wrong active set leaves gaps of the size of the
+// residuals. Accept x when the gap is below x . e + 1e-7 * (1 + sum_r Weight_r |Target_r|):
+// optimal to GLPK's own tolerance, in units of b - a.
+bool HasOptimalityCertificate(const L1Program& l1, const DualProgram& dual, const std::vector<double>& solution,
+  const std::vector<double>& x, double dualObjective)
+{
+  const int p = l1.Unknowns;
   std::vector<double> rowResidual(static_cast<std::size_t>(p), 0.0);
   for (std::size_t r = 0; r < l1.Residuals.size(); ++r)
   {
     const SparseRow& row = l1.Residuals[r];
-    const double d = sign[r] + solution[residualDuals[r]->index()];
+    const double d = dual.ResidualDual(solution, r);
     for (int e = 0; e < row.Count; ++e)
     {
       rowResidual[row.Index[e]] += row.Weight * d * row.Coefficient[e];
@@ -291,7 +287,7 @@ bool SolveThroughDual(const L1Program& l1, std::vector<double>& x, int& variable
   for (std::size_t s = 0; s < l1.Constraints.size(); ++s)
   {
     const SparseRow& row = l1.Constraints[s];
-    const double mu = solution[constraintDuals[s]->index()];
+    const double mu = dual.ConstraintDual(solution, s);
     for (int e = 0; e < row.Count; ++e)
     {
       rowResidual[row.Index[e]] += mu * row.Coefficient[e];
@@ -313,231 +309,284 @@ bool SolveThroughDual(const L1Program& l1, std::vector<double>& x, int& variable
       return false;
     }
   }
-  if (!(l1.Objective(x) <= dualObjective + perturbation + 1e-7 * scale))
+  return l1.Objective(x) <= dualObjective + perturbation + 1e-7 * dual.Scale;
+}
+
+// The same optimum through the dual program, which has one row per unknown (k - 2) instead
+// of one per sample, so the simplex needs a few pivots instead of about as many as there are
+// samples (measured about 10 times faster for n = 200, k = 7):
+//   maximize sum_r Weight_r Target_r d_r + sum_s Target_s mu_s
+//   subject to sum_r Weight_r d_r a_r + sum_s mu_s c_s = 0, -1 <= d_r <= 1, mu_s >= 0.
+// CGAL's interface returns only the dual's variables, so x comes from complementary
+// slackness. The x is accepted only with a certificate (feasible, and its objective equals
+// the dual's, so it is optimal by weak duality); otherwise (degenerate programs, e.g. many
+// equal samples) false without an error and the caller solves the primal.
+bool SolveThroughDual(const L1Program& l1, std::vector<double>& x, int& variables, int& constraints)
+{
+  DualProgram dual;
+  dual.Sign = LeastSquaresResidualSigns(l1);
+  BuildDualProgram(l1, dual);
+  variables = static_cast<int>(dual.Program.number_of_variables());
+  constraints = static_cast<int>(dual.Program.number_of_constraints());
+  std::string ignored;
+  if (!SolveLinearProgram(dual.Program, ignored))
+  {
+    return false; // leave it to the primal
+  }
+  const std::vector<double>& solution = dual.Program.solution();
+  double dualObjective = 0;
+  return RecoverPrimalSolution(l1, dual, solution, x, dualObjective) &&
+    HasOptimalityCertificate(l1, dual, solution, x, dualObjective);
+}
+// The height program of FitHeight in normalized values (a -> 0, b -> 1): its coefficients are
+// then of order one whatever the units of the field, which GLPK (run unscaled by CGAL) needs.
+struct NormalizedHeightProgram
+{
+  int Segments = 0;          // k
+  bool Monotone = false;
+  double MinimumStep = 0;    // delta, 0 when not monotone
+  double EvenStep = 0;       // 1 / (k - 1)
+  double TieBreakWeight = 0;
+  std::vector<double> Alpha; // alpha_0 .. alpha_k+1; alpha_0 = alpha_1 = 0, alpha_k = alpha_k+1 = 1
+
+  // Unknowns x_q = alpha_q+2 (q = 0..k-3); the fixed alpha_0, alpha_1, alpha_k, alpha_k+1
+  // move to the targets.
+  void AddTerm(SparseRow& row, int coefficient, double weight) const
+  {
+    if (coefficient >= 2 && coefficient < this->Segments)
+    {
+      row.Index[row.Count] = coefficient - 2;
+      row.Coefficient[row.Count] = weight;
+      ++row.Count;
+    }
+    else
+    {
+      row.Target -= weight * this->Alpha[coefficient];
+    }
+  }
+
+  // The paper's L1 objective (section 4, step 2) over the interior samples, the monotonicity
+  // constraints alpha_j+1 - alpha_j >= delta and the tie-break residuals.
+  L1Program Build(
+    const std::vector<double>& parameters, const std::vector<double>& values, double startValue, double range) const
+  {
+    const int k = this->Segments;
+    L1Program program;
+    program.Unknowns = k - 2;
+    for (std::size_t i = 1; i + 1 < parameters.size(); ++i)
+    {
+      int first = 0;
+      double w[3];
+      UniformQuadraticBSpline::BasisWeights(k, parameters[i], first, w);
+      SparseRow row;
+      row.Target = (values[i] - startValue) / range;
+      for (int m = 0; m < 3; ++m)
+      {
+        if (w[m] != 0.0)
+        {
+          this->AddTerm(row, first + m, w[m]);
+        }
+      }
+      if (row.Count > 0) // else a sample at t = 0 or 1: nothing to fit
+      {
+        program.Residuals.push_back(row);
+      }
+    }
+    if (this->Monotone)
+    {
+      // alpha_j+1 - alpha_j >= delta for j = 1..k-1.
+      for (int j = 1; j < k; ++j)
+      {
+        SparseRow step;
+        step.Target = this->MinimumStep;
+        this->AddTerm(step, j + 1, 1.0);
+        this->AddTerm(step, j, -1.0);
+        program.Constraints.push_back(step);
+      }
+      if (this->TieBreakWeight > 0)
+      {
+        // TieBreakWeight * |evenStep - (alpha_j+1 - alpha_j)| for j = 1..k-1.
+        for (int j = 1; j < k; ++j)
+        {
+          SparseRow spread;
+          spread.Weight = this->TieBreakWeight;
+          spread.Target = this->EvenStep;
+          this->AddTerm(spread, j + 1, 1.0);
+          this->AddTerm(spread, j, -1.0);
+          program.Residuals.push_back(spread);
+        }
+      }
+    }
+    return program;
+  }
+
+  // GLPK meets constraints to its feasibility tolerance (1e-7), not exactly: restore every
+  // step >= delta. Forward then backward keeps alpha_j >= (j - 1) delta and gives alpha_j <=
+  // alpha_j+1 - delta, hence both, because (k - 1) delta < 1 (it changes nothing when the
+  // solution is already feasible).
+  void RestoreMinimumSteps()
+  {
+    const int k = this->Segments;
+    std::vector<double>& alpha = this->Alpha;
+    for (int j = 2; j < k; ++j)
+    {
+      alpha[j] = std::max(alpha[j], alpha[j - 1] + this->MinimumStep);
+    }
+    for (int j = k - 1; j >= 2; --j)
+    {
+      alpha[j] = std::min(alpha[j], alpha[j + 1] - this->MinimumStep);
+    }
+  }
+};
+// Solves the program of `height` (through the dual when asked, else or when the dual gives
+// no certificate through the primal) into height.Alpha.
+bool SolveHeightProgram(NormalizedHeightProgram& height, const std::vector<double>& parameters,
+  const std::vector<double>& values, double startValue, double range, bool useDualProgram, HeightFit& fit,
+  std::string& error)
+{
+  const int k = height.Segments;
+  std::vector<double>& alpha = height.Alpha;
+  const L1Program program = height.Build(parameters, values, startValue, range);
+  std::vector<double> x;
+  bool solved = false;
+  if (useDualProgram)
+  {
+    solved = SolveThroughDual(program, x, fit.ProgramVariables, fit.ProgramConstraints);
+    fit.SolvedThroughDual = solved;
+  }
+  if (!solved && !SolvePrimal(program, x, fit.ProgramVariables, fit.ProgramConstraints, error))
   {
     return false;
   }
+  for (int j = 2; j < k; ++j)
+  {
+    alpha[j] = x[j - 2];
+    if (!std::isfinite(alpha[j]))
+    {
+      error = "the linear program of the height fit returned a non-finite coefficient";
+      return false;
+    }
+  }
+  if (height.Monotone)
+  {
+    height.RestoreMinimumSteps();
+  }
   return true;
+}
+
+// Back to field units; the ends are set, not computed, so they are exact. False when a
+// monotone fit lost its strict steps to rounding.
+bool StoreInFieldUnits(const std::vector<double>& alpha, double startValue, double endValue, bool monotone,
+  UniformQuadraticBSpline& spline, std::string& error)
+{
+  const int k = static_cast<int>(alpha.size()) - 2;
+  const double range = endValue - startValue;
+  spline.Segments = k;
+  spline.Dimension = 1;
+  spline.Coefficients.resize(static_cast<std::size_t>(k + 2));
+  spline.Coefficients[0] = spline.Coefficients[1] = startValue;
+  spline.Coefficients[k] = spline.Coefficients[k + 1] = endValue;
+  for (int j = 2; j < k; ++j)
+  {
+    spline.Coefficients[j] = startValue + range * alpha[j];
+  }
+  if (monotone)
+  {
+    for (int j = 1; j < k; ++j)
+    {
+      if (!(spline.Coefficients[j + 1] > spline.Coefficients[j]))
+      {
+        error = "the end values of the 1-cell piece are too close for a strictly increasing fit in double precision";
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+// The L1 and maximum error over the interior samples.
+void MeasureHeightErrors(const std::vector<double>& parameters, const std::vector<double>& values, HeightFit& fit)
+{
+  fit.L1Error = 0;
+  fit.MaximumError = 0;
+  for (std::size_t i = 1; i + 1 < parameters.size(); ++i)
+  {
+    const double e = std::abs(values[i] - fit.Spline.Value(parameters[i]));
+    fit.L1Error += e;
+    fit.MaximumError = std::max(fit.MaximumError, e);
+  }
+}
+// The normal equations of the planar curve fit for its free coefficients c_1..c_k (unknown
+// j - 1), in coordinates relative to `origin`; c_0 and c_k+1 are the end points.
+void AccumulateCurveNormalEquations(const std::vector<double>& parameters, const std::vector<double>& points,
+  const double origin[2], int k, Eigen::MatrixXd& normal, Eigen::MatrixXd& rhs)
+{
+  const std::size_t count = parameters.size();
+  const double end[2] = { points[2 * count - 2] - origin[0], points[2 * count - 1] - origin[1] };
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    int first = 0;
+    double w[3];
+    UniformQuadraticBSpline::BasisWeights(k, parameters[i], first, w);
+    double residual[2] = { points[2 * i] - origin[0], points[2 * i + 1] - origin[1] };
+    for (int m = 0; m < 3; ++m)
+    {
+      const int index = first + m;
+      if (index == k + 1)
+      {
+        residual[0] -= w[m] * end[0];
+        residual[1] -= w[m] * end[1];
+      }
+    }
+    for (int m = 0; m < 3; ++m)
+    {
+      const int row = first + m - 1;
+      if (row < 0 || row >= k || w[m] == 0.0)
+      {
+        continue;
+      }
+      for (int n = 0; n < 3; ++n)
+      {
+        const int column = first + n - 1;
+        if (column >= 0 && column < k)
+        {
+          normal(row, column) += w[m] * w[n];
+        }
+      }
+      rhs(row, 0) += w[m] * residual[0];
+      rhs(row, 1) += w[m] * residual[1];
+    }
+  }
+}
+
+// A ridge of 1e-6 of the mean diagonal pulls c_j towards the polyline at its Greville
+// abscissa (j - 1/2) / k (see FitPlanarCurve in the header).
+void AddGrevilleRidge(const std::vector<double>& parameters, const std::vector<double>& points,
+  const double origin[2], int k, Eigen::MatrixXd& normal, Eigen::MatrixXd& rhs)
+{
+  const std::size_t count = parameters.size();
+  // (With no sample inside the piece the normal matrix is zero: the ridge alone decides.)
+  const double meanDiagonal = normal.trace() / k;
+  const double ridge = meanDiagonal > 0 ? 1e-6 * meanDiagonal : 1.0;
+  for (int j = 1; j <= k; ++j)
+  {
+    const double tau = (j - 0.5) / k;
+    const auto upper = std::upper_bound(parameters.begin(), parameters.end(), tau);
+    std::size_t b = static_cast<std::size_t>(upper - parameters.begin());
+    b = std::min(std::max<std::size_t>(b, 1), count - 1);
+    const std::size_t a = b - 1;
+    const double span = parameters[b] - parameters[a];
+    const double u = span > 0 ? std::min(std::max((tau - parameters[a]) / span, 0.0), 1.0) : 0.0;
+    for (int d = 0; d < 2; ++d)
+    {
+      const double target = (1.0 - u) * (points[2 * a + d] - origin[d]) + u * (points[2 * b + d] - origin[d]);
+      rhs(j - 1, d) += ridge * target;
+    }
+    normal(j - 1, j - 1) += ridge;
+  }
 }
 } // namespace
 
-//------------------------------------------------------------------------------
-void CubicBezierSpline::EvaluateSegment(const double* control, int dimension, double s, double* value)
-{
-  double b[4];
-  CubicBernstein(s, b);
-  for (int d = 0; d < dimension; ++d)
-  {
-    value[d] = b[0] * control[d] + b[1] * control[dimension + d] + b[2] * control[2 * dimension + d] +
-      b[3] * control[3 * dimension + d];
-  }
-}
-
-//------------------------------------------------------------------------------
-void CubicBezierSpline::EvaluateSegmentDerivative(const double* control, int dimension, double s, double* derivative)
-{
-  double b[3];
-  QuadraticBernstein(s, b);
-  for (int d = 0; d < dimension; ++d)
-  {
-    derivative[d] = 3.0 *
-      (b[0] * (control[dimension + d] - control[d]) + b[1] * (control[2 * dimension + d] - control[dimension + d]) +
-        b[2] * (control[3 * dimension + d] - control[2 * dimension + d]));
-  }
-}
-
-//------------------------------------------------------------------------------
-void CubicBezierSpline::Subdivide(const double* control, int dimension, double s, double* left, double* right)
-{
-  for (int d = 0; d < dimension; ++d)
-  {
-    const double p0 = control[d];
-    const double p1 = control[dimension + d];
-    const double p2 = control[2 * dimension + d];
-    const double p3 = control[3 * dimension + d];
-    const double p01 = p0 + s * (p1 - p0);
-    const double p12 = p1 + s * (p2 - p1);
-    const double p23 = p2 + s * (p3 - p2);
-    const double p012 = p01 + s * (p12 - p01);
-    const double p123 = p12 + s * (p23 - p12);
-    const double p0123 = p012 + s * (p123 - p012);
-    left[d] = p0;
-    left[dimension + d] = p01;
-    left[2 * dimension + d] = p012;
-    left[3 * dimension + d] = p0123;
-    right[d] = p0123;
-    right[dimension + d] = p123;
-    right[2 * dimension + d] = p23;
-    right[3 * dimension + d] = p3;
-  }
-}
-
-//------------------------------------------------------------------------------
-void CubicBezierSpline::Evaluate(double t, double* value) const
-{
-  double s = 0;
-  const int j = UniformQuadraticBSpline::LocateSegment(this->Segments, t, s);
-  CubicBezierSpline::EvaluateSegment(this->Segment(j), this->Dimension, s, value);
-}
-
-//------------------------------------------------------------------------------
-void CubicBezierSpline::EvaluateDerivative(double t, double* derivative) const
-{
-  double s = 0;
-  const int j = UniformQuadraticBSpline::LocateSegment(this->Segments, t, s);
-  CubicBezierSpline::EvaluateSegmentDerivative(this->Segment(j), this->Dimension, s, derivative);
-  // ds/dt = k on every segment.
-  for (int d = 0; d < this->Dimension; ++d)
-  {
-    derivative[d] *= this->Segments;
-  }
-}
-
-//------------------------------------------------------------------------------
-double CubicBezierSpline::Value(double t) const
-{
-  double value = 0;
-  this->Evaluate(t, &value);
-  return value;
-}
-
-//------------------------------------------------------------------------------
-double CubicBezierSpline::Slope(double t) const
-{
-  double slope = 0;
-  this->EvaluateDerivative(t, &slope);
-  return slope;
-}
-
-//------------------------------------------------------------------------------
-int UniformQuadraticBSpline::LocateSegment(int segments, double t, double& s)
-{
-  const double x = std::min(std::max(t, 0.0), 1.0) * segments;
-  int j = static_cast<int>(std::floor(x));
-  j = std::min(std::max(j, 0), segments - 1);
-  s = x - j;
-  return j;
-}
-
-//------------------------------------------------------------------------------
-void UniformQuadraticBSpline::BasisWeights(int segments, double t, int& first, double weights[3])
-{
-  // Through the Bezier form of segment j (algorithms.md 2.4): b0 = alpha_j on the first
-  // segment and (alpha_j + alpha_j+1) / 2 elsewhere, b1 = alpha_j+1, b2 = alpha_k+1 on the
-  // last segment and (alpha_j+1 + alpha_j+2) / 2 elsewhere.
-  double s = 0;
-  first = UniformQuadraticBSpline::LocateSegment(segments, t, s);
-  double b[3];
-  QuadraticBernstein(s, b);
-  const double left = first == 0 ? 1.0 : 0.5;
-  const double right = first == segments - 1 ? 1.0 : 0.5;
-  weights[0] = b[0] * left;
-  weights[1] = b[0] * (1.0 - left) + b[1] + b[2] * (1.0 - right);
-  weights[2] = b[2] * right;
-}
-
-//------------------------------------------------------------------------------
-void UniformQuadraticBSpline::Evaluate(double t, double* value) const
-{
-  int first = 0;
-  double w[3];
-  UniformQuadraticBSpline::BasisWeights(this->Segments, t, first, w);
-  const int dim = this->Dimension;
-  const double* alpha = this->Coefficients.data() + first * dim;
-  for (int d = 0; d < dim; ++d)
-  {
-    value[d] = w[0] * alpha[d] + w[1] * alpha[dim + d] + w[2] * alpha[2 * dim + d];
-  }
-}
-
-//------------------------------------------------------------------------------
-void UniformQuadraticBSpline::EvaluateDerivative(double t, double* derivative) const
-{
-  // g'(t) = 2k [(b1 - b0)(1 - s) + (b2 - b1) s] on segment j, with b1 - b0 = left *
-  // (alpha_j+1 - alpha_j) and b2 - b1 = right * (alpha_j+2 - alpha_j+1).
-  double s = 0;
-  const int k = this->Segments;
-  const int j = UniformQuadraticBSpline::LocateSegment(k, t, s);
-  const double left = j == 0 ? 1.0 : 0.5;
-  const double right = j == k - 1 ? 1.0 : 0.5;
-  const int dim = this->Dimension;
-  const double* alpha = this->Coefficients.data() + j * dim;
-  for (int d = 0; d < dim; ++d)
-  {
-    derivative[d] = 2.0 * k *
-      (left * (1.0 - s) * (alpha[dim + d] - alpha[d]) + right * s * (alpha[2 * dim + d] - alpha[dim + d]));
-  }
-}
-
-//------------------------------------------------------------------------------
-double UniformQuadraticBSpline::Value(double t) const
-{
-  double value = 0;
-  this->Evaluate(t, &value);
-  return value;
-}
-
-//------------------------------------------------------------------------------
-double UniformQuadraticBSpline::Slope(double t) const
-{
-  double slope = 0;
-  this->EvaluateDerivative(t, &slope);
-  return slope;
-}
-
-//------------------------------------------------------------------------------
-std::vector<double> UniformQuadraticBSpline::ToQuadraticBezier() const
-{
-  const int k = this->Segments;
-  const int dim = this->Dimension;
-  std::vector<double> quadratic(static_cast<std::size_t>(3 * k * dim));
-  for (int j = 0; j < k; ++j)
-  {
-    const double* alpha = this->Coefficients.data() + j * dim;
-    double* b = quadratic.data() + 3 * j * dim;
-    for (int d = 0; d < dim; ++d)
-    {
-      // The blossom values g[u_j, u_j] (a double knot at u_j), g[u_j, u_j+1], g[u_j+1, u_j+1].
-      b[d] = j == 0 ? alpha[d] : 0.5 * (alpha[d] + alpha[dim + d]);
-      b[dim + d] = alpha[dim + d];
-      b[2 * dim + d] = j == k - 1 ? alpha[2 * dim + d] : 0.5 * (alpha[dim + d] + alpha[2 * dim + d]);
-    }
-  }
-  return quadratic;
-}
-
-//------------------------------------------------------------------------------
-CubicBezierSpline ElevateQuadraticBezier(const std::vector<double>& quadratic, int segments, int dimension)
-{
-  CubicBezierSpline cubic;
-  cubic.Segments = segments;
-  cubic.Dimension = dimension;
-  cubic.ControlPoints.resize(static_cast<std::size_t>(4 * segments * dimension));
-  for (int j = 0; j < segments; ++j)
-  {
-    const double* b = quadratic.data() + 3 * j * dimension;
-    double* c = cubic.ControlPoints.data() + 4 * j * dimension;
-    for (int d = 0; d < dimension; ++d)
-    {
-      const double b0 = b[d];
-      const double b1 = b[dimension + d];
-      const double b2 = b[2 * dimension + d];
-      c[d] = b0;
-      // Written as offsets from the ends so that b1 = b0 (b1 = b2) gives c1 = c0 (c2 = c3)
-      // exactly: the zero end derivatives survive rounding.
-      c[dimension + d] = b0 + 2.0 * (b1 - b0) / 3.0;
-      c[2 * dimension + d] = b2 + 2.0 * (b1 - b2) / 3.0;
-      c[3 * dimension + d] = b2;
-    }
-  }
-  return cubic;
-}
-
-//------------------------------------------------------------------------------
-CubicBezierSpline UniformQuadraticBSpline::ToCubicBezier() const
-{
-  return ElevateQuadraticBezier(this->ToQuadraticBezier(), this->Segments, this->Dimension);
-}
 
 //------------------------------------------------------------------------------
 std::vector<double> MonotoneBSplineFit::NormalizedArcLength(const std::vector<double>& points)
@@ -621,15 +670,18 @@ bool MonotoneBSplineFit::FitHeight(const std::vector<double>& parameters, const 
   const double range = endValue - startValue;
   const std::size_t interiorCount = parameters.size() - 2;
 
-  // The program works in normalized values (a -> 0, b -> 1): its coefficients are then of
-  // order one whatever the units of the field, which GLPK (run unscaled by CGAL) needs.
-  std::vector<double> alpha(static_cast<std::size_t>(k + 2), 0.0);
+  NormalizedHeightProgram height;
+  height.Segments = k;
+  height.Monotone = monotone;
+  height.Alpha.assign(static_cast<std::size_t>(k + 2), 0.0);
   for (int j = k; j <= k + 1; ++j)
   {
-    alpha[j] = 1.0;
+    height.Alpha[j] = 1.0;
   }
   const double delta = monotone ? this->MinimumSlopeFraction / k : 0.0;
-  const double evenStep = 1.0 / (k - 1);
+  height.MinimumStep = delta;
+  height.EvenStep = 1.0 / (k - 1);
+  height.TieBreakWeight = this->TieBreakWeight;
   fit.MinimumStep = delta * range;
   fit.ProgramVariables = 0;
   fit.ProgramConstraints = 0;
@@ -640,6 +692,7 @@ bool MonotoneBSplineFit::FitHeight(const std::vector<double>& parameters, const 
     return false;
   }
 
+  std::vector<double>& alpha = height.Alpha;
   if (k == 2)
   {
     // alpha_0 = alpha_1 = a, alpha_2 = alpha_3 = b: nothing left to fit.
@@ -649,140 +702,19 @@ bool MonotoneBSplineFit::FitHeight(const std::vector<double>& parameters, const 
     // No data between the ends: the evenly spaced coefficients (what the tie-break picks).
     for (int j = 2; j < k; ++j)
     {
-      alpha[j] = (j - 1) * evenStep;
+      alpha[j] = (j - 1) * height.EvenStep;
     }
   }
-  else
+  else if (!SolveHeightProgram(height, parameters, values, startValue, range, this->UseDualProgram, fit, error))
   {
-    // Unknowns x_q = alpha_q+2 (q = 0..k-3); the fixed alpha_0, alpha_1, alpha_k, alpha_k+1
-    // move to the targets.
-    L1Program program;
-    program.Unknowns = k - 2;
-    auto addTerm = [k](SparseRow& row, int coefficient, double weight, const std::vector<double>& fixed) {
-      if (coefficient >= 2 && coefficient < k)
-      {
-        row.Index[row.Count] = coefficient - 2;
-        row.Coefficient[row.Count] = weight;
-        ++row.Count;
-      }
-      else
-      {
-        row.Target -= weight * fixed[coefficient];
-      }
-    };
-    for (std::size_t i = 1; i + 1 < parameters.size(); ++i)
-    {
-      int first = 0;
-      double w[3];
-      UniformQuadraticBSpline::BasisWeights(k, parameters[i], first, w);
-      SparseRow row;
-      row.Target = (values[i] - startValue) / range;
-      for (int m = 0; m < 3; ++m)
-      {
-        if (w[m] != 0.0)
-        {
-          addTerm(row, first + m, w[m], alpha);
-        }
-      }
-      if (row.Count > 0) // else a sample at t = 0 or 1: nothing to fit
-      {
-        program.Residuals.push_back(row);
-      }
-    }
-    if (monotone)
-    {
-      // alpha_j+1 - alpha_j >= delta for j = 1..k-1.
-      for (int j = 1; j < k; ++j)
-      {
-        SparseRow step;
-        step.Target = delta;
-        addTerm(step, j + 1, 1.0, alpha);
-        addTerm(step, j, -1.0, alpha);
-        program.Constraints.push_back(step);
-      }
-      if (this->TieBreakWeight > 0)
-      {
-        // TieBreakWeight * |evenStep - (alpha_j+1 - alpha_j)| for j = 1..k-1.
-        for (int j = 1; j < k; ++j)
-        {
-          SparseRow spread;
-          spread.Weight = this->TieBreakWeight;
-          spread.Target = evenStep;
-          addTerm(spread, j + 1, 1.0, alpha);
-          addTerm(spread, j, -1.0, alpha);
-          program.Residuals.push_back(spread);
-        }
-      }
-    }
-
-    std::vector<double> x;
-    bool solved = false;
-    if (this->UseDualProgram)
-    {
-      solved = SolveThroughDual(program, x, fit.ProgramVariables, fit.ProgramConstraints);
-      fit.SolvedThroughDual = solved;
-    }
-    if (!solved && !SolvePrimal(program, x, fit.ProgramVariables, fit.ProgramConstraints, error))
-    {
-      return false;
-    }
-    for (int j = 2; j < k; ++j)
-    {
-      alpha[j] = x[j - 2];
-      if (!std::isfinite(alpha[j]))
-      {
-        error = "the linear program of the height fit returned a non-finite coefficient";
-        return false;
-      }
-    }
-
-    if (monotone)
-    {
-      // GLPK meets constraints to its feasibility tolerance (1e-7), not exactly: restore
-      // every step >= delta. Forward then backward keeps alpha_j >= (j - 1) delta and gives
-      // alpha_j <= alpha_j+1 - delta, hence both, because (k - 1) delta < 1 (it changes
-      // nothing when the solution is already feasible).
-      for (int j = 2; j < k; ++j)
-      {
-        alpha[j] = std::max(alpha[j], alpha[j - 1] + delta);
-      }
-      for (int j = k - 1; j >= 2; --j)
-      {
-        alpha[j] = std::min(alpha[j], alpha[j + 1] - delta);
-      }
-    }
+    return false;
   }
 
-  // Back to field units; the ends are set, not computed, so they are exact.
-  fit.Spline.Segments = k;
-  fit.Spline.Dimension = 1;
-  fit.Spline.Coefficients.resize(static_cast<std::size_t>(k + 2));
-  fit.Spline.Coefficients[0] = fit.Spline.Coefficients[1] = startValue;
-  fit.Spline.Coefficients[k] = fit.Spline.Coefficients[k + 1] = endValue;
-  for (int j = 2; j < k; ++j)
+  if (!StoreInFieldUnits(alpha, startValue, endValue, monotone, fit.Spline, error))
   {
-    fit.Spline.Coefficients[j] = startValue + range * alpha[j];
+    return false;
   }
-  if (monotone)
-  {
-    for (int j = 1; j < k; ++j)
-    {
-      if (!(fit.Spline.Coefficients[j + 1] > fit.Spline.Coefficients[j]))
-      {
-        error = "the end values of the 1-cell piece are too close for a strictly increasing fit in double precision";
-        return false;
-      }
-    }
-  }
-
-  fit.L1Error = 0;
-  fit.MaximumError = 0;
-  for (std::size_t i = 1; i + 1 < parameters.size(); ++i)
-  {
-    const double e = std::abs(values[i] - fit.Spline.Value(parameters[i]));
-    fit.L1Error += e;
-    fit.MaximumError = std::max(fit.MaximumError, e);
-  }
+  MeasureHeightErrors(parameters, values, fit);
   return true;
 }
 
@@ -800,67 +732,11 @@ bool MonotoneBSplineFit::FitPlanarCurve(
   // Relative to the start point: the solve then sees coordinates of the size of the piece,
   // not of the position of the piece in the domain.
   const double origin[2] = { points[0], points[1] };
-  const double end[2] = { points[2 * count - 2] - origin[0], points[2 * count - 1] - origin[1] };
 
-  // Normal equations for the free coefficients c_1..c_k (unknown j - 1).
   Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(k, k);
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(k, 2);
-  for (std::size_t i = 0; i < count; ++i)
-  {
-    int first = 0;
-    double w[3];
-    UniformQuadraticBSpline::BasisWeights(k, parameters[i], first, w);
-    double residual[2] = { points[2 * i] - origin[0], points[2 * i + 1] - origin[1] };
-    for (int m = 0; m < 3; ++m)
-    {
-      const int index = first + m;
-      if (index == k + 1)
-      {
-        residual[0] -= w[m] * end[0];
-        residual[1] -= w[m] * end[1];
-      }
-    }
-    for (int m = 0; m < 3; ++m)
-    {
-      const int row = first + m - 1;
-      if (row < 0 || row >= k || w[m] == 0.0)
-      {
-        continue;
-      }
-      for (int n = 0; n < 3; ++n)
-      {
-        const int column = first + n - 1;
-        if (column >= 0 && column < k)
-        {
-          normal(row, column) += w[m] * w[n];
-        }
-      }
-      rhs(row, 0) += w[m] * residual[0];
-      rhs(row, 1) += w[m] * residual[1];
-    }
-  }
-
-  // Ridge towards the polyline at the Greville abscissae (j - 1/2) / k of c_j.
-  // (With no sample inside the piece the normal matrix is zero: the ridge alone decides.)
-  const double meanDiagonal = normal.trace() / k;
-  const double ridge = meanDiagonal > 0 ? 1e-6 * meanDiagonal : 1.0;
-  for (int j = 1; j <= k; ++j)
-  {
-    const double tau = (j - 0.5) / k;
-    const auto upper = std::upper_bound(parameters.begin(), parameters.end(), tau);
-    std::size_t b = static_cast<std::size_t>(upper - parameters.begin());
-    b = std::min(std::max<std::size_t>(b, 1), count - 1);
-    const std::size_t a = b - 1;
-    const double span = parameters[b] - parameters[a];
-    const double u = span > 0 ? std::min(std::max((tau - parameters[a]) / span, 0.0), 1.0) : 0.0;
-    for (int d = 0; d < 2; ++d)
-    {
-      const double target = (1.0 - u) * (points[2 * a + d] - origin[d]) + u * (points[2 * b + d] - origin[d]);
-      rhs(j - 1, d) += ridge * target;
-    }
-    normal(j - 1, j - 1) += ridge;
-  }
-
+  AccumulateCurveNormalEquations(parameters, points, origin, k, normal, rhs);
+  AddGrevilleRidge(parameters, points, origin, k, normal, rhs);
   const Eigen::LDLT<Eigen::MatrixXd> factorization(normal);
   const Eigen::MatrixXd solution = factorization.solve(rhs);
   if (factorization.info() != Eigen::Success || !solution.allFinite())

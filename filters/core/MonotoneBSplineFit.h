@@ -1,15 +1,11 @@
 // Stage 3 of the paper (section 4, step 2 and 3), for one piece of a 1-cell between two
 // consecutive critical/junction points: a strictly increasing height function and a smooth
-// planar curve, both uniform quadratic B-splines with k segments on [0, 1], and their exact
-// conversion into k cubic Bezier segments (knot insertion, then degree elevation).
-//
-// Conventions shared by everything here (algorithms.md 2.2-2.4):
-// - knots 0 = u_-2 = u_-1 = u_0 < u_1 < ... < u_k = u_k+1 = u_k+2 = 1, u_j = j / k;
-// - coefficients alpha_0 .. alpha_k+1 (k + 2 of them); segment j covers [j / k, (j + 1) / k]
-//   and depends on alpha_j, alpha_j+1, alpha_j+2 only;
-// - multi-component splines (the planar curve) store coefficient i, component d at
-//   [i * Dimension + d].
+// planar curve, both uniform quadratic B-splines with k segments on [0, 1]. The splines, their
+// conventions (knots, coefficients, layout) and their conversion into k cubic Bezier segments
+// are in BezierSpline.h.
 #pragma once
+
+#include "BezierSpline.h"
 
 #include <cstddef>
 #include <string>
@@ -17,64 +13,6 @@
 
 namespace topospline
 {
-// k cubic Bezier segments of a curve on [0, 1], segment j on [j / k, (j + 1) / k]. Every
-// segment stores its own 4 control points (the end point of segment j repeats as the start
-// point of segment j + 1), which is the layout of one VTK_BEZIER_CURVE cell per segment.
-struct CubicBezierSpline
-{
-  int Segments = 0;
-  int Dimension = 1;
-  // Segment j, control point m (0..3), component d at [(j * 4 + m) * Dimension + d].
-  std::vector<double> ControlPoints;
-
-  const double* Segment(int j) const { return this->ControlPoints.data() + 4 * j * this->Dimension; }
-
-  // Value and derivative with respect to the global parameter t in [0, 1].
-  void Evaluate(double t, double* value) const;
-  void EvaluateDerivative(double t, double* derivative) const;
-  // Shortcuts for Dimension == 1.
-  double Value(double t) const;
-  double Slope(double t) const;
-
-  // One cubic (4 control points of `dimension` components) at its local parameter s.
-  static void EvaluateSegment(const double* control, int dimension, double s, double* value);
-  // d/ds of one cubic.
-  static void EvaluateSegmentDerivative(const double* control, int dimension, double s, double* derivative);
-  // de Casteljau split of one cubic at s: `left` covers [0, s], `right` [s, 1], each 4 points.
-  static void Subdivide(const double* control, int dimension, double s, double* left, double* right);
-};
-
-// A clamped uniform quadratic B-spline on [0, 1] with k segments (see the conventions above).
-struct UniformQuadraticBSpline
-{
-  int Segments = 0;  // k
-  int Dimension = 1; // 1 for a height, 2 for a planar curve
-  std::vector<double> Coefficients; // (k + 2) * Dimension
-
-  void Evaluate(double t, double* value) const;
-  void EvaluateDerivative(double t, double* derivative) const;
-  double Value(double t) const; // Dimension == 1
-  double Slope(double t) const; // Dimension == 1
-
-  // The weights of alpha_first, alpha_first+1, alpha_first+2 in the value at t, i.e.
-  // N_first^2(t), N_first+1^2(t), N_first+2^2(t); first is the segment that holds t.
-  static void BasisWeights(int segments, double t, int& first, double weights[3]);
-  // The segment j that holds t (the last one for t = 1) and the local parameter s in [0, 1].
-  static int LocateSegment(int segments, double t, double& s);
-
-  // Knot insertion (every interior knot to multiplicity 2): k quadratic Bezier segments,
-  // segment j, control point m (0..2), component d at [(j * 3 + m) * Dimension + d].
-  std::vector<double> ToQuadraticBezier() const;
-  // Knot insertion then degree elevation: the same curve as k cubic Bezier segments.
-  CubicBezierSpline ToCubicBezier() const;
-};
-
-// Degree elevation of quadratic Bezier segments (3 control points each, as produced by
-// UniformQuadraticBSpline::ToQuadraticBezier) to cubic ones: c0 = b0, c1 = (b0 + 2 b1) / 3,
-// c2 = (2 b1 + b2) / 3, c3 = b2 (evaluated as b0 + 2 (b1 - b0) / 3 and b2 + 2 (b1 - b2) / 3,
-// so that a zero end derivative stays exactly zero).
-CubicBezierSpline ElevateQuadraticBezier(const std::vector<double>& quadratic, int segments, int dimension);
-
 // The height fitted along one piece.
 struct HeightFit
 {

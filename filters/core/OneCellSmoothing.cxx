@@ -13,6 +13,76 @@ namespace topospline
 {
 namespace
 {
+// Nodes for every critical point, with the critical value as both field value and value.
+void AddCriticalNodes(const std::vector<CriticalPoint>& cps, std::vector<SmoothingNode>& nodes)
+{
+  for (Index c = 0; c < static_cast<Index>(cps.size()); ++c)
+  {
+    SmoothingNode node;
+    node.Type = SmoothingNode::Critical;
+    node.Source = c;
+    node.FieldValue = node.Value = cps[c].Value;
+    nodes.push_back(node);
+  }
+}
+
+// Ties between critical values (plateaus, broken by vertex id in stage 1) would make a
+// strictly increasing height impossible: separate tied values by at most 1e-9 of the range,
+// in the order of simulation of simplicity (value, then vertex, then index).
+void SeparateTiedCriticalValues(const std::vector<CriticalPoint>& cps, std::vector<SmoothingNode>& nodes)
+{
+  double low = cps.empty() ? 0 : cps[0].Value, high = low;
+  for (const auto& cp : cps)
+  {
+    low = std::min(low, cp.Value);
+    high = std::max(high, cp.Value);
+  }
+  std::vector<Index> order(cps.size());
+  for (Index i = 0; i < static_cast<Index>(order.size()); ++i)
+  {
+    order[i] = i;
+  }
+  // A vertex can hold several critical cells (a boundary corner: a saddle edge and a
+  // maximum triangle); the higher-dimensional cell is the higher one.
+  std::sort(order.begin(), order.end(), [&](Index x, Index y) {
+    if (cps[x].Value != cps[y].Value)
+    {
+      return cps[x].Value < cps[y].Value;
+    }
+    return cps[x].Vertex != cps[y].Vertex ? cps[x].Vertex < cps[y].Vertex : cps[x].MorseIndex < cps[y].MorseIndex;
+  });
+  const double step = 1e-9 * std::max(high - low, 1e-300) / std::max<size_t>(cps.size(), 1);
+  for (size_t i = 1; i < order.size(); ++i)
+  {
+    SmoothingNode& node = nodes[order[i]];
+    node.Value = std::max(node.Value, nodes[order[i - 1]].Value + step);
+  }
+}
+
+// Nodes for the junction points that are not on a critical point; returns the node of every
+// junction point (a saddle on it: the critical node).
+std::vector<Index> AddJunctionNodes(const std::vector<JunctionPoint>& junctions, std::vector<SmoothingNode>& nodes)
+{
+  std::vector<Index> junctionNode(junctions.size());
+  for (size_t j = 0; j < junctions.size(); ++j)
+  {
+    if (junctions[j].CriticalPoint != InvalidIndex)
+    {
+      junctionNode[j] = junctions[j].CriticalPoint;
+      continue;
+    }
+    SmoothingNode node;
+    node.Type = SmoothingNode::Junction;
+    node.Source = static_cast<Index>(j);
+    node.Position[0] = junctions[j].Position[0];
+    node.Position[1] = junctions[j].Position[1];
+    node.FieldValue = node.Value = junctions[j].Value;
+    junctionNode[j] = static_cast<Index>(nodes.size());
+    nodes.push_back(node);
+  }
+  return junctionNode;
+}
+
 // Where along a 1-cell its mesh cell `cell` sits, as an index into its Points; -1 if absent.
 long PointIndexOfCell(const OneCell& arc, Index cell)
 {
@@ -25,29 +95,12 @@ long PointIndexOfCell(const OneCell& arc, Index cell)
   return static_cast<long>(it - arc.MeshCells.begin()) + (arc.Type == OneCell::Ascending ? 1 : 0);
 }
 
-struct Segment2
-{
-  double A[2], B[2];
-  Index Piece;
-  int Index_;   // position along the piece's sampled polyline
-  int Count;    // number of segments of that polyline
-};
+// Where a 1-cell is cut: (position in its Points, node there).
+using Cut = std::pair<long, Index>;
 
-double Cross(const double* o, const double* a, const double* b)
-{
-  return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
-}
-
-// Proper crossing or overlap of two segments (touching end points excluded by the caller).
-bool SegmentsIntersect(const Segment2& s, const Segment2& t)
-{
-  const double d1 = Cross(s.A, s.B, t.A), d2 = Cross(s.A, s.B, t.B);
-  const double d3 = Cross(t.A, t.B, s.A), d4 = Cross(t.A, t.B, s.B);
-  return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
-}
 // Keeps, of the cuts of one 1-cell (source first, destination last), the longest chain whose
 // nodes rise strictly in (value, node index) from the source to the destination.
-void KeepRisingCuts(std::vector<std::pair<long, Index>>& at, const std::vector<SmoothingNode>& nodes)
+void KeepRisingCuts(std::vector<Cut>& at, const std::vector<SmoothingNode>& nodes)
 {
   auto below = [&nodes](Index x, Index y) {
     return nodes[x].Value != nodes[y].Value ? nodes[x].Value < nodes[y].Value : x < y;
@@ -71,7 +124,7 @@ void KeepRisingCuts(std::vector<std::pair<long, Index>>& at, const std::vector<S
   {
     return; // the ends themselves are out of order: left to the program's error
   }
-  std::vector<std::pair<long, Index>> kept;
+  std::vector<Cut> kept;
   for (size_t i = m - 1;; i = previous[i])
   {
     kept.push_back(at[i]);
@@ -83,18 +136,11 @@ void KeepRisingCuts(std::vector<std::pair<long, Index>>& at, const std::vector<S
   std::reverse(kept.begin(), kept.end());
   at = std::move(kept);
 }
-// Cuts every 1-cell at the nodes it passes (its junction points, and the domain corners it
-// meets, which are added to `nodes`) into pieces; identical pieces (merged 1-cells) are kept
-// once. With risingCutsOnly only the cuts KeepRisingCuts keeps (see Smooth). Node positions
-// become the ends of the pieces that meet there.
-void CutIntoPieces(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
-  const std::vector<Index>& junctionNode, const double domainBounds[4], bool risingCutsOnly,
-  std::vector<SmoothingNode>& nodes, OneCellSmoothingResult& result)
+// The cuts of every 1-cell at the junction points it passes (not at its ends).
+std::vector<std::vector<Cut>> CutsAtJunctions(const MorseSmaleComplex& complex,
+  const std::vector<JunctionPoint>& junctions, const std::vector<Index>& junctionNode)
 {
-  std::map<std::pair<double, double>, Index> cornerNode;
-  const double corners[4][2] = { { domainBounds[0], domainBounds[2] }, { domainBounds[1], domainBounds[2] },
-    { domainBounds[1], domainBounds[3] }, { domainBounds[0], domainBounds[3] } };
-  std::vector<std::vector<std::pair<long, Index>>> cuts(complex.OneCells.size());
+  std::vector<std::vector<Cut>> cuts(complex.OneCells.size());
   for (size_t j = 0; j < junctions.size(); ++j)
   {
     for (Index a : junctions[j].OneCells)
@@ -106,89 +152,141 @@ void CutIntoPieces(const MorseSmaleComplex& complex, const std::vector<JunctionP
       }
     }
   }
-  std::map<std::vector<double>, Index> pieceOfGeometry;
-  result.PiecesOfOneCell.resize(complex.OneCells.size());
-  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
+  return cuts;
+}
+
+// The corners of the domain as nodes, made when a 1-cell first passes one, so that the
+// boundary keeps its corners.
+class DomainCornerNodes
+{
+public:
+  explicit DomainCornerNodes(const double domainBounds[4])
+    : Corners{ { domainBounds[0], domainBounds[2] }, { domainBounds[1], domainBounds[2] },
+      { domainBounds[1], domainBounds[3] }, { domainBounds[0], domainBounds[3] } }
   {
-    const OneCell& arc = complex.OneCells[a];
+  }
+
+  // Cuts `arc` at the corners it passes (not at its ends).
+  void AddCuts(const OneCell& arc, std::vector<SmoothingNode>& nodes, std::vector<Cut>& at)
+  {
+    const auto& corners = this->Corners;
     const long n = static_cast<long>(arc.Values.size());
-    auto& at = cuts[a];
     for (long p = 1; p + 1 < n; ++p)
     {
       for (int c = 0; c < 4; ++c)
       {
         if (arc.Points[2 * p] == corners[c][0] && arc.Points[2 * p + 1] == corners[c][1])
         {
-          auto found = cornerNode.find({ corners[c][0], corners[c][1] });
-          if (found == cornerNode.end())
+          auto found = this->NodeOfCorner.find({ corners[c][0], corners[c][1] });
+          if (found == this->NodeOfCorner.end())
           {
             SmoothingNode node;
             node.Type = SmoothingNode::DomainCorner;
             node.Position[0] = corners[c][0];
             node.Position[1] = corners[c][1];
             node.FieldValue = node.Value = arc.Values[p];
-            found = cornerNode.insert({ { corners[c][0], corners[c][1] }, static_cast<Index>(nodes.size()) }).first;
+            found =
+              this->NodeOfCorner.insert({ { corners[c][0], corners[c][1] }, static_cast<Index>(nodes.size()) }).first;
             nodes.push_back(node);
           }
           at.push_back({ p, found->second });
         }
       }
     }
-    // A merged 1-cell may pass its own end's vertex before it ends there (the trivial
-    // embedding): no cut at its own ends' nodes.
-    at.erase(std::remove_if(at.begin(), at.end(),
-               [&](const auto& cut) { return cut.second == arc.Source || cut.second == arc.Destination; }),
-      at.end());
-    at.push_back({ 0, arc.Source });
-    at.push_back({ n - 1, arc.Destination });
-    std::sort(at.begin(), at.end());
-    at.erase(std::unique(at.begin(), at.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
-      at.end());
-    // A node passed twice, in a row (which would make a piece from a node to itself) or after
-    // an excursion: a merged 1-cell can run out to a cancelled extremum and back along the
-    // same path, passing its nodes a second time in the opposite order, and pieces cut at both
-    // visits would order those nodes both ways (a cycle no values can satisfy). The excursion
-    // stays inside one piece, from the first visit to the node after the last one.
-    for (size_t k = 0; k < at.size(); ++k)
+  }
+
+private:
+  double Corners[4][2];
+  std::map<std::pair<double, double>, Index> NodeOfCorner;
+};
+
+// Adds the 1-cell's ends to its cuts and orders them along it, one cut per position.
+void AddEndsAndOrderCuts(const OneCell& arc, std::vector<Cut>& at)
+{
+  const long n = static_cast<long>(arc.Values.size());
+  // A merged 1-cell may pass its own end's vertex before it ends there (the trivial
+  // embedding): no cut at its own ends' nodes.
+  at.erase(std::remove_if(at.begin(), at.end(),
+             [&](const auto& cut) { return cut.second == arc.Source || cut.second == arc.Destination; }),
+    at.end());
+  at.push_back({ 0, arc.Source });
+  at.push_back({ n - 1, arc.Destination });
+  std::sort(at.begin(), at.end());
+  at.erase(std::unique(at.begin(), at.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
+    at.end());
+  // A node passed twice, in a row (which would make a piece from a node to itself) or after
+  // an excursion: a merged 1-cell can run out to a cancelled extremum and back along the
+  // same path, passing its nodes a second time in the opposite order, and pieces cut at both
+  // visits would order those nodes both ways (a cycle no values can satisfy). The excursion
+  // stays inside one piece, from the first visit to the node after the last one.
+  for (size_t k = 0; k < at.size(); ++k)
+  {
+    size_t last = k;
+    for (size_t m = k + 1; m < at.size(); ++m)
     {
-      size_t last = k;
-      for (size_t m = k + 1; m < at.size(); ++m)
-      {
-        last = at[m].second == at[k].second ? m : last;
-      }
-      at.erase(at.begin() + k + 1, at.begin() + last + 1);
+      last = at[m].second == at[k].second ? m : last;
     }
+    at.erase(at.begin() + k + 1, at.begin() + last + 1);
+  }
+}
+
+// The pieces of 1-cell `a` between consecutive cuts; a piece already made by another 1-cell
+// on the same points (merged 1-cells) is shared.
+void AddPiecesOfOneCell(Index a, const OneCell& arc, const std::vector<Cut>& at,
+  std::map<std::vector<double>, Index>& pieceOfGeometry, OneCellSmoothingResult& result)
+{
+  const long n = static_cast<long>(arc.Values.size());
+  for (size_t k = 0; k + 1 < at.size(); ++k)
+  {
+    const long from = at[k].first, to = at[k + 1].first;
+    std::vector<double> key(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
+    key.push_back(arc.Type);
+    auto found = pieceOfGeometry.find(key);
+    if (found == pieceOfGeometry.end())
+    {
+      SmoothedPiece piece;
+      piece.Type = arc.Type;
+      piece.StartNode = at[k].second;
+      piece.EndNode = at[k + 1].second;
+      piece.Points.assign(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
+      piece.Values.assign(arc.Values.begin() + from, arc.Values.begin() + to + 1);
+      if (arc.Type == OneCell::Ascending && to == n - 1 && piece.Values.size() > 2)
+      {
+        // Every ascending 1-cell into a maximum ends "centroid of the maximum's triangle,
+        // maximum's vertex": a segment they would all share. Go straight to the vertex.
+        piece.Points.erase(piece.Points.end() - 4, piece.Points.end() - 2);
+        piece.Values.erase(piece.Values.end() - 2);
+      }
+      found = pieceOfGeometry.insert({ key, static_cast<Index>(result.Pieces.size()) }).first;
+      result.Pieces.push_back(std::move(piece));
+    }
+    result.Pieces[found->second].OneCells.push_back(a);
+    result.PiecesOfOneCell[a].push_back(found->second);
+  }
+}
+
+// Cuts every 1-cell at the nodes it passes (its junction points, and the domain corners it
+// meets, which are added to `nodes`) into pieces; identical pieces (merged 1-cells) are kept
+// once. With risingCutsOnly only the cuts KeepRisingCuts keeps (see
+// CutAndSolveJunctionValues). Node positions become the ends of the pieces that meet there.
+void CutIntoPieces(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
+  const std::vector<Index>& junctionNode, const double domainBounds[4], bool risingCutsOnly,
+  std::vector<SmoothingNode>& nodes, OneCellSmoothingResult& result)
+{
+  std::vector<std::vector<Cut>> cuts = CutsAtJunctions(complex, junctions, junctionNode);
+  DomainCornerNodes corners(domainBounds);
+  std::map<std::vector<double>, Index> pieceOfGeometry;
+  result.PiecesOfOneCell.resize(complex.OneCells.size());
+  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
+  {
+    const OneCell& arc = complex.OneCells[a];
+    corners.AddCuts(arc, nodes, cuts[a]);
+    AddEndsAndOrderCuts(arc, cuts[a]);
     if (risingCutsOnly)
     {
-      KeepRisingCuts(at, nodes);
+      KeepRisingCuts(cuts[a], nodes);
     }
-    for (size_t k = 0; k + 1 < at.size(); ++k)
-    {
-      const long from = at[k].first, to = at[k + 1].first;
-      std::vector<double> key(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
-      key.push_back(arc.Type);
-      auto found = pieceOfGeometry.find(key);
-      if (found == pieceOfGeometry.end())
-      {
-        SmoothedPiece piece;
-        piece.Type = arc.Type;
-        piece.StartNode = at[k].second;
-        piece.EndNode = at[k + 1].second;
-        piece.Points.assign(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
-        piece.Values.assign(arc.Values.begin() + from, arc.Values.begin() + to + 1);
-        if (arc.Type == OneCell::Ascending && to == n - 1 && piece.Values.size() > 2)
-        {
-          // Every ascending 1-cell into a maximum ends "centroid of the maximum's triangle,
-          // maximum's vertex": a segment they would all share. Go straight to the vertex.
-          piece.Points.erase(piece.Points.end() - 4, piece.Points.end() - 2);
-          piece.Values.erase(piece.Values.end() - 2);
-        }
-        found = pieceOfGeometry.insert({ key, static_cast<Index>(result.Pieces.size()) }).first;
-        result.Pieces.push_back(std::move(piece));
-      }
-      result.Pieces[found->second].OneCells.push_back(a);
-      result.PiecesOfOneCell[a].push_back(found->second);
-    }
+    AddPiecesOfOneCell(a, arc, cuts[a], pieceOfGeometry, result);
   }
   // Node positions: the ends of the pieces that meet there.
   for (const SmoothedPiece& piece : result.Pieces)
@@ -237,35 +335,16 @@ bool SolveJunctionValues(std::vector<SmoothingNode>& nodes, OneCellSmoothingResu
   result.JunctionTotalChange = program.TotalChange;
   return true;
 }
-} // namespace
 
-bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments,
-  const double bounds[4], std::string& error) const
+// A least-squares curve fitted to a 1-cell that runs along the boundary and then turns
+// inwards can overshoot the boundary slightly. A Bezier curve lies in the convex hull of its
+// control points: clamping them keeps it inside (the ends, data points, never move). Only a
+// piece that lies entirely on one side of the domain's box may touch that side: a boundary
+// stretch belongs to one piece at most (1-cells on the same vertices share their pieces),
+// and any other curve touching it would make the 2-cells of stage 4 pinch. Other pieces are
+// kept a hundredth of their sample spacing inside.
+void ClampCurveIntoDomain(SmoothedPiece& piece, const double bounds[4])
 {
-  MonotoneBSplineFit fitter;
-  fitter.Segments = segments;
-  HeightFit height, free;
-  const double a = nodes[piece.StartNode].Value, b = nodes[piece.EndNode].Value;
-  if (!fitter.FitHeight(piece.Parameters, piece.Values, a, b, true, height, error) ||
-    !fitter.FitHeight(piece.Parameters, piece.Values, a, b, false, free, error))
-  {
-    return false;
-  }
-  PlanarCurveFit curve;
-  if (!fitter.FitPlanarCurve(piece.Parameters, piece.Points, curve, error))
-  {
-    return false;
-  }
-  piece.Segments = segments;
-  piece.Height = height.Spline.ToCubicBezier();
-  piece.Curve = curve.Spline.ToCubicBezier();
-  // A least-squares curve fitted to a 1-cell that runs along the boundary and then turns
-  // inwards can overshoot the boundary slightly. A Bezier curve lies in the convex hull of its
-  // control points: clamping them keeps it inside (the ends, data points, never move). Only a
-  // piece that lies entirely on one side of the domain's box may touch that side: a boundary
-  // stretch belongs to one piece at most (1-cells on the same vertices share their pieces),
-  // and any other curve touching it would make the 2-cells of stage 4 pinch. Other pieces are
-  // kept a hundredth of their sample spacing inside.
   const std::size_t samples = piece.Points.size() / 2;
   double length = 0;
   for (std::size_t i = 1; i < samples; ++i)
@@ -295,92 +374,255 @@ bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<Smoothin
     piece.Clamped = piece.Clamped || clamped != coordinate;
     coordinate = clamped;
   }
+}
+
+struct Segment2
+{
+  double A[2], B[2];
+  Index Piece;
+  int Index_;   // position along the piece's sampled polyline
+  int Count;    // number of segments of that polyline
+};
+
+double Cross(const double* o, const double* a, const double* b)
+{
+  return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+}
+
+// Proper crossing or overlap of two segments (touching end points excluded by the caller).
+bool SegmentsIntersect(const Segment2& s, const Segment2& t)
+{
+  const double d1 = Cross(s.A, s.B, t.A), d2 = Cross(s.A, s.B, t.B);
+  const double d3 = Cross(t.A, t.B, s.A), d4 = Cross(t.A, t.B, s.B);
+  return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
+}
+
+// Finds the pairs of pieces whose smoothed curves cross: samples every curve, buckets the
+// segments in a grid, and tests pairs of segments of different pieces (and non-adjacent
+// segments of one piece). Pieces meeting at a node may touch there.
+// Curves that end at one point (the same node, or two nodes on one vertex: a boundary
+// saddle and a maximum share their vertex, and the 1-cell between them is a loop) meet
+// there: within two samples of such a shared end, a contact through that point (to rounding)
+// is their meeting. Any other contact is a crossing, however close to the node: two 1-cells
+// that leave a saddle almost tangentially and cross there leave a 2-cell without a simple
+// boundary.
+class CrossingDetector
+{
+public:
+  CrossingDetector(const OneCellSmoothingResult& result, const double domainBounds[4], int samplesPerSegment)
+    : Result(result)
+    , Bounds(domainBounds)
+    , SamplesPerSegment(samplesPerSegment)
+    , MeetingTolerance(1e-9 * std::max(domainBounds[1] - domainBounds[0], domainBounds[3] - domainBounds[2]))
+  {
+  }
+
+  // Inserts the pieces that cross another one into `crossing`; returns the number of pairs.
+  int FindCrossings(std::set<Index>& crossing) const
+  {
+    const std::vector<Segment2> segments = this->SampleCurves();
+    int pairs = 0;
+    std::set<std::pair<Index, Index>> reported;
+    for (const auto& entry : this->BucketSegments(segments))
+    {
+      const auto& list = entry.second;
+      for (size_t x = 0; x < list.size(); ++x)
+      {
+        for (size_t y = x + 1; y < list.size(); ++y)
+        {
+          const Segment2& s = segments[list[x]];
+          const Segment2& t = segments[list[y]];
+          if (s.Piece == t.Piece && std::abs(s.Index_ - t.Index_) <= 1)
+          {
+            continue;
+          }
+          if (!SegmentsIntersect(s, t) || this->MeetAtSharedEnd(s, t) || this->CloseALoop(s.Piece, t.Piece))
+          {
+            continue;
+          }
+          const auto key = std::make_pair(std::min(s.Piece, t.Piece), std::max(s.Piece, t.Piece));
+          if (reported.insert(key).second)
+          {
+            ++pairs;
+            crossing.insert(s.Piece);
+            crossing.insert(t.Piece);
+          }
+        }
+      }
+    }
+    return pairs;
+  }
+
+private:
+  // Every curve as a polyline of SamplesPerSegment segments per Bezier segment.
+  std::vector<Segment2> SampleCurves() const
+  {
+    std::vector<Segment2> segments;
+    for (Index p = 0; p < static_cast<Index>(this->Result.Pieces.size()); ++p)
+    {
+      const SmoothedPiece& piece = this->Result.Pieces[p];
+      const int count = piece.Segments * this->SamplesPerSegment;
+      double previous[2];
+      piece.Curve.Evaluate(0.0, previous);
+      for (int s = 1; s <= count; ++s)
+      {
+        Segment2 seg;
+        seg.A[0] = previous[0];
+        seg.A[1] = previous[1];
+        piece.Curve.Evaluate(static_cast<double>(s) / count, seg.B);
+        seg.Piece = p;
+        seg.Index_ = s - 1;
+        seg.Count = count;
+        previous[0] = seg.B[0];
+        previous[1] = seg.B[1];
+        segments.push_back(seg);
+      }
+    }
+    return segments;
+  }
+
+  // The segments in the cells of a uniform grid over the domain that their boxes overlap.
+  std::unordered_map<long, std::vector<Index>> BucketSegments(const std::vector<Segment2>& segments) const
+  {
+    const double* bounds = this->Bounds;
+    const double width = std::max(bounds[1] - bounds[0], 1e-12);
+    const double height = std::max(bounds[3] - bounds[2], 1e-12);
+    const double cell = std::max(std::sqrt(width * height / std::max<size_t>(segments.size(), 1)), 1e-12);
+    const long nx = static_cast<long>(width / cell) + 1, ny = static_cast<long>(height / cell) + 1;
+    std::unordered_map<long, std::vector<Index>> grid;
+    auto bucket = [&](double x, double y) {
+      const long i = std::clamp(static_cast<long>((x - bounds[0]) / cell), 0L, nx - 1);
+      const long j = std::clamp(static_cast<long>((y - bounds[2]) / cell), 0L, ny - 1);
+      return std::make_pair(i, j);
+    };
+    for (Index s = 0; s < static_cast<Index>(segments.size()); ++s)
+    {
+      const auto a = bucket(std::min(segments[s].A[0], segments[s].B[0]), std::min(segments[s].A[1], segments[s].B[1]));
+      const auto b = bucket(std::max(segments[s].A[0], segments[s].B[0]), std::max(segments[s].A[1], segments[s].B[1]));
+      for (long i = a.first; i <= b.first; ++i)
+      {
+        for (long j = a.second; j <= b.second; ++j)
+        {
+          grid[i * ny + j].push_back(s);
+        }
+      }
+    }
+    return grid;
+  }
+
+  bool PassesThrough(const Segment2& s, const double* q) const
+  {
+    double fraction;
+    return std::sqrt(SegmentDistance2(s.A, s.B, q[0], q[1], fraction)) <= this->MeetingTolerance;
+  }
+
+  const double* EndPosition(Index p, bool atEnd) const
+  {
+    const SmoothedPiece& piece = this->Result.Pieces[p];
+    return this->Result.Nodes[atEnd ? piece.EndNode : piece.StartNode].Position;
+  }
+
+  bool MeetAtSharedEnd(const Segment2& s, const Segment2& t) const
+  {
+    for (int es = 0; es < 2; ++es)
+    {
+      const bool nearS = es == 0 ? s.Index_ < 2 : s.Index_ >= s.Count - 2;
+      for (int et = 0; et < 2 && nearS; ++et)
+      {
+        const bool nearT = et == 0 ? t.Index_ < 2 : t.Index_ >= t.Count - 2;
+        const double* a = this->EndPosition(s.Piece, es == 1);
+        const double* b = this->EndPosition(t.Piece, et == 1);
+        if (nearT && a[0] == b[0] && a[1] == b[1] && this->PassesThrough(s, a) && this->PassesThrough(t, a))
+        {
+          return true;
+        }
+      }
+    }
+    return false;
+  }
+
+  // Two pieces that close a loop (a boundary saddle and a maximum on one vertex, joined by
+  // the saddle's only ascending 1-cell, cut at a junction) start where the other ends: often
+  // the loop has no area and both are one segment, traversed both ways. They may touch.
+  bool CloseALoop(Index p, Index q) const
+  {
+    const double* ps = this->EndPosition(p, false);
+    const double* pe = this->EndPosition(p, true);
+    const double* qs = this->EndPosition(q, false);
+    const double* qe = this->EndPosition(q, true);
+    return ps[0] == qe[0] && ps[1] == qe[1] && pe[0] == qs[0] && pe[1] == qs[1];
+  }
+
+  const OneCellSmoothingResult& Result;
+  const double* Bounds;
+  int SamplesPerSegment;
+  double MeetingTolerance;
+};
+
+// Pieces whose curve leaves the domain's bounding box (to rounding) at one of its samples.
+int CountPiecesOutsideDomain(
+  const std::vector<SmoothedPiece>& pieces, const double domainBounds[4], int samplesPerSegment)
+{
+  int outsideCount = 0;
+  for (const SmoothedPiece& piece : pieces)
+  {
+    bool outside = false;
+    const int count = piece.Segments * samplesPerSegment;
+    for (int s = 0; s <= count && !outside; ++s)
+    {
+      double xy[2];
+      piece.Curve.Evaluate(static_cast<double>(s) / count, xy);
+      const double tolerance = 1e-9 * std::max(domainBounds[1] - domainBounds[0], domainBounds[3] - domainBounds[2]);
+      outside = xy[0] < domainBounds[0] - tolerance || xy[0] > domainBounds[1] + tolerance ||
+        xy[1] < domainBounds[2] - tolerance || xy[1] > domainBounds[3] + tolerance;
+    }
+    outsideCount += outside;
+  }
+  return outsideCount;
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+// Paper, section 4, steps 2 and 3 for one piece: a strictly increasing height (and the
+// unconstrained one, for comparison) and a planar curve, both as k cubic Beziers.
+bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments,
+  const double bounds[4], std::string& error) const
+{
+  MonotoneBSplineFit fitter;
+  fitter.Segments = segments;
+  HeightFit height, free;
+  const double a = nodes[piece.StartNode].Value, b = nodes[piece.EndNode].Value;
+  if (!fitter.FitHeight(piece.Parameters, piece.Values, a, b, true, height, error) ||
+    !fitter.FitHeight(piece.Parameters, piece.Values, a, b, false, free, error))
+  {
+    return false;
+  }
+  PlanarCurveFit curve;
+  if (!fitter.FitPlanarCurve(piece.Parameters, piece.Points, curve, error))
+  {
+    return false;
+  }
+  piece.Segments = segments;
+  piece.Height = height.Spline.ToCubicBezier();
+  piece.Curve = curve.Spline.ToCubicBezier();
+  ClampCurveIntoDomain(piece, bounds);
   piece.L1Error = height.L1Error;
   piece.UnconstrainedL1Error = free.L1Error;
   return true;
 }
 
-bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
-  const double domainBounds[4], OneCellSmoothingResult& result, std::string& error) const
+//------------------------------------------------------------------------------
+bool OneCellSmoothing::CutAndSolveJunctionValues(const MorseSmaleComplex& complex,
+  const std::vector<JunctionPoint>& junctions, const std::vector<Index>& junctionNode, const double domainBounds[4],
+  OneCellSmoothingResult& result, std::string& error) const
 {
-  result = OneCellSmoothingResult();
-  if (this->Segments < 2 || this->Segments > MaximumCurveSegments)
-  {
-    error = "the number of curve segments must be in [2, " + std::to_string(MaximumCurveSegments) +
-      "], not " + std::to_string(this->Segments);
-    return false;
-  }
-  if (complex.OneCells.empty())
-  {
-    error = "the complex has no 1-cells";
-    return false;
-  }
-  const auto& cps = complex.CriticalPoints;
-
-  // Nodes: every critical point, every junction point, and the domain corners met.
-  auto& nodes = result.Nodes;
-  for (Index c = 0; c < static_cast<Index>(cps.size()); ++c)
-  {
-    SmoothingNode node;
-    node.Type = SmoothingNode::Critical;
-    node.Source = c;
-    node.FieldValue = node.Value = cps[c].Value;
-    nodes.push_back(node);
-  }
-  // Ties between critical values (plateaus, broken by vertex id in stage 1) would make a
-  // strictly increasing height impossible: separate tied values by at most 1e-9 of the range,
-  // in the order of simulation of simplicity (value, then vertex, then index).
-  {
-    double low = cps.empty() ? 0 : cps[0].Value, high = low;
-    for (const auto& cp : cps)
-    {
-      low = std::min(low, cp.Value);
-      high = std::max(high, cp.Value);
-    }
-    std::vector<Index> order(cps.size());
-    for (Index i = 0; i < static_cast<Index>(order.size()); ++i)
-    {
-      order[i] = i;
-    }
-    // A vertex can hold several critical cells (a boundary corner: a saddle edge and a
-    // maximum triangle); the higher-dimensional cell is the higher one.
-    std::sort(order.begin(), order.end(), [&](Index x, Index y) {
-      if (cps[x].Value != cps[y].Value)
-      {
-        return cps[x].Value < cps[y].Value;
-      }
-      return cps[x].Vertex != cps[y].Vertex ? cps[x].Vertex < cps[y].Vertex : cps[x].MorseIndex < cps[y].MorseIndex;
-    });
-    const double step = 1e-9 * std::max(high - low, 1e-300) / std::max<size_t>(cps.size(), 1);
-    for (size_t i = 1; i < order.size(); ++i)
-    {
-      SmoothingNode& node = nodes[order[i]];
-      node.Value = std::max(node.Value, nodes[order[i - 1]].Value + step);
-    }
-  }
-  std::vector<Index> junctionNode(junctions.size());
-  for (size_t j = 0; j < junctions.size(); ++j)
-  {
-    if (junctions[j].CriticalPoint != InvalidIndex)
-    {
-      junctionNode[j] = junctions[j].CriticalPoint; // a saddle on it: the critical node
-      continue;
-    }
-    SmoothingNode node;
-    node.Type = SmoothingNode::Junction;
-    node.Source = static_cast<Index>(j);
-    node.Position[0] = junctions[j].Position[0];
-    node.Position[1] = junctions[j].Position[1];
-    node.FieldValue = node.Value = junctions[j].Value;
-    junctionNode[j] = static_cast<Index>(nodes.size());
-    nodes.push_back(node);
-  }
   // Normally every 1-cell is cut at every node it passes. A 1-cell merged by cancellations
   // runs up and down; where it passes another 1-cell's node on its way down, the pieces order
   // nodes against each other's 1-cells: the relations hold a cycle, or put a critical value
   // above a lower one. Only then the pieces are cut again at the nodes that rise along each
   // 1-cell (KeepRisingCuts): the relations then follow one order of the nodes, so they hold
   // neither, and the passed nodes are merely crossed.
+  auto& nodes = result.Nodes;
   const size_t nodesBeforeCorners = nodes.size();
   for (const bool risingCutsOnly : { false, true })
   {
@@ -401,166 +643,56 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
       return false;
     }
   }
-  this->Hooks.Report(0.2);
+  return true;
+}
 
-  // Fit every piece, in parallel, in chunks between which progress is reported and an abort
-  // is seen (from this thread only); the first failing piece in order names the error.
+//------------------------------------------------------------------------------
+bool OneCellSmoothing::FitAllPieces(
+  OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const
+{
+  // In parallel, in chunks between which progress is reported and an abort is seen (from this
+  // thread only); the first failing piece in order names the error.
+  const Index count = static_cast<Index>(result.Pieces.size());
+  const Index chunk = std::max<Index>(256, count / 16);
+  std::vector<std::string> pieceErrors(static_cast<std::size_t>(count));
+  std::vector<unsigned char> failed(static_cast<std::size_t>(count), 0);
+  for (Index first = 0; first < count; first += chunk)
   {
-    const Index count = static_cast<Index>(result.Pieces.size());
-    const Index chunk = std::max<Index>(256, count / 16);
-    std::vector<std::string> pieceErrors(static_cast<std::size_t>(count));
-    std::vector<unsigned char> failed(static_cast<std::size_t>(count), 0);
-    for (Index first = 0; first < count; first += chunk)
-    {
-      const Index last = std::min(count, first + chunk);
-      this->Parallel(first, last, [&](Index begin, Index end) {
-        for (Index p = begin; p < end; ++p)
-        {
-          SmoothedPiece& piece = result.Pieces[p];
-          piece.Parameters = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
-          failed[p] = !this->FitPiece(piece, nodes, this->Segments, domainBounds, pieceErrors[p]);
-        }
-      });
-      for (Index p = first; p < last; ++p)
+    const Index last = std::min(count, first + chunk);
+    this->Parallel(first, last, [&](Index begin, Index end) {
+      for (Index p = begin; p < end; ++p)
       {
-        if (failed[p])
-        {
-          error = "1-cell piece " + std::to_string(p) + ": " + pieceErrors[p];
-          return false;
-        }
+        SmoothedPiece& piece = result.Pieces[p];
+        piece.Parameters = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
+        failed[p] = !this->FitPiece(piece, result.Nodes, this->Segments, domainBounds, pieceErrors[p]);
       }
-      this->Hooks.Report(0.2 + 0.5 * static_cast<double>(last) / count);
-      if (this->Hooks.Aborted())
+    });
+    for (Index p = first; p < last; ++p)
+    {
+      if (failed[p])
       {
-        error = "aborted";
+        error = "1-cell piece " + std::to_string(p) + ": " + pieceErrors[p];
         return false;
       }
     }
+    this->Hooks.Report(0.2 + 0.5 * static_cast<double>(last) / count);
+    if (this->Hooks.Aborted())
+    {
+      error = "aborted";
+      return false;
+    }
   }
+  return true;
+}
 
-  // Crossings: sample every curve, bucket the segments in a grid, test pairs of segments of
-  // different pieces (and non-adjacent segments of one piece). Pieces meeting at a node may
-  // touch there. Where pieces cross, raise their k and fit again.
-  // Curves that end at one point (the same node, or two nodes on one vertex: a boundary
-  // saddle and a maximum share their vertex, and the 1-cell between them is a loop) meet
-  // there: within two samples of such a shared end, a contact through that point (to rounding)
-  // is their meeting. Any other contact is a crossing, however close to the node: two 1-cells
-  // that leave a saddle almost tangentially and cross there leave a 2-cell without a simple
-  // boundary.
-  const double meetingTolerance =
-    1e-9 * std::max(domainBounds[1] - domainBounds[0], domainBounds[3] - domainBounds[2]);
-  auto passesThrough = [meetingTolerance](const Segment2& s, const double* q) {
-    double fraction;
-    return std::sqrt(SegmentDistance2(s.A, s.B, q[0], q[1], fraction)) <= meetingTolerance;
-  };
-  auto endPosition = [&](Index p, bool atEnd) {
-    return nodes[atEnd ? result.Pieces[p].EndNode : result.Pieces[p].StartNode].Position;
-  };
-  auto MeetAtSharedEnd = [&](const Segment2& s, const Segment2& t) {
-    for (int es = 0; es < 2; ++es)
-    {
-      const bool nearS = es == 0 ? s.Index_ < 2 : s.Index_ >= s.Count - 2;
-      for (int et = 0; et < 2 && nearS; ++et)
-      {
-        const bool nearT = et == 0 ? t.Index_ < 2 : t.Index_ >= t.Count - 2;
-        const double* a = endPosition(s.Piece, es == 1);
-        const double* b = endPosition(t.Piece, et == 1);
-        if (nearT && a[0] == b[0] && a[1] == b[1] && passesThrough(s, a) && passesThrough(t, a))
-        {
-          return true;
-        }
-      }
-    }
-    return false;
-  };
-  // Two pieces that close a loop (a boundary saddle and a maximum on one vertex, joined by
-  // the saddle's only ascending 1-cell, cut at a junction) start where the other ends: often
-  // the loop has no area and both are one segment, traversed both ways. They may touch.
-  auto closeALoop = [&](Index p, Index q) {
-    const double* ps = nodes[result.Pieces[p].StartNode].Position;
-    const double* pe = nodes[result.Pieces[p].EndNode].Position;
-    const double* qs = nodes[result.Pieces[q].StartNode].Position;
-    const double* qe = nodes[result.Pieces[q].EndNode].Position;
-    return ps[0] == qe[0] && ps[1] == qe[1] && pe[0] == qs[0] && pe[1] == qs[1];
-  };
-  auto findCrossings = [&](std::set<Index>& crossing) {
-    std::vector<Segment2> segments;
-    for (Index p = 0; p < static_cast<Index>(result.Pieces.size()); ++p)
-    {
-      const SmoothedPiece& piece = result.Pieces[p];
-      const int count = piece.Segments * this->SamplesPerSegment;
-      double previous[2];
-      piece.Curve.Evaluate(0.0, previous);
-      for (int s = 1; s <= count; ++s)
-      {
-        Segment2 seg;
-        seg.A[0] = previous[0];
-        seg.A[1] = previous[1];
-        piece.Curve.Evaluate(static_cast<double>(s) / count, seg.B);
-        seg.Piece = p;
-        seg.Index_ = s - 1;
-        seg.Count = count;
-        previous[0] = seg.B[0];
-        previous[1] = seg.B[1];
-        segments.push_back(seg);
-      }
-    }
-    const double width = std::max(domainBounds[1] - domainBounds[0], 1e-12);
-    const double height = std::max(domainBounds[3] - domainBounds[2], 1e-12);
-    const double cell = std::max(std::sqrt(width * height / std::max<size_t>(segments.size(), 1)), 1e-12);
-    const long nx = static_cast<long>(width / cell) + 1, ny = static_cast<long>(height / cell) + 1;
-    std::unordered_map<long, std::vector<Index>> grid;
-    auto bucket = [&](double x, double y) {
-      const long i = std::clamp(static_cast<long>((x - domainBounds[0]) / cell), 0L, nx - 1);
-      const long j = std::clamp(static_cast<long>((y - domainBounds[2]) / cell), 0L, ny - 1);
-      return std::make_pair(i, j);
-    };
-    for (Index s = 0; s < static_cast<Index>(segments.size()); ++s)
-    {
-      const auto a = bucket(std::min(segments[s].A[0], segments[s].B[0]), std::min(segments[s].A[1], segments[s].B[1]));
-      const auto b = bucket(std::max(segments[s].A[0], segments[s].B[0]), std::max(segments[s].A[1], segments[s].B[1]));
-      for (long i = a.first; i <= b.first; ++i)
-      {
-        for (long j = a.second; j <= b.second; ++j)
-        {
-          grid[i * ny + j].push_back(s);
-        }
-      }
-    }
-    int pairs = 0;
-    std::set<std::pair<Index, Index>> reported;
-    for (const auto& entry : grid)
-    {
-      const auto& list = entry.second;
-      for (size_t x = 0; x < list.size(); ++x)
-      {
-        for (size_t y = x + 1; y < list.size(); ++y)
-        {
-          const Segment2& s = segments[list[x]];
-          const Segment2& t = segments[list[y]];
-          if (s.Piece == t.Piece && std::abs(s.Index_ - t.Index_) <= 1)
-          {
-            continue;
-          }
-          if (!SegmentsIntersect(s, t) || MeetAtSharedEnd(s, t) || closeALoop(s.Piece, t.Piece))
-          {
-            continue;
-          }
-          const auto key = std::make_pair(std::min(s.Piece, t.Piece), std::max(s.Piece, t.Piece));
-          if (reported.insert(key).second)
-          {
-            ++pairs;
-            crossing.insert(s.Piece);
-            crossing.insert(t.Piece);
-          }
-        }
-      }
-    }
-    return pairs;
-  };
-
+//------------------------------------------------------------------------------
+bool OneCellSmoothing::RepairCrossings(
+  OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const
+{
+  // Where pieces cross, raise their k and fit again, until none cross or no k can rise.
+  const CrossingDetector detector(result, domainBounds, this->SamplesPerSegment);
   std::set<Index> crossing;
-  int pairs = findCrossings(crossing);
+  int pairs = detector.FindCrossings(crossing);
   std::set<Index> adapted;
   while (pairs > 0)
   {
@@ -578,7 +710,7 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
       const int next = 2 * piece.Segments;
       if (piece.Segments < cap && next <= MonotoneBSplineFit::MaximumSegments)
       {
-        if (!this->FitPiece(piece, nodes, next, domainBounds, error))
+        if (!this->FitPiece(piece, result.Nodes, next, domainBounds, error))
         {
           error = "1-cell piece " + std::to_string(p) + ": " + error;
           return false;
@@ -592,28 +724,59 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
       break;
     }
     crossing.clear();
-    pairs = findCrossings(crossing);
+    pairs = detector.FindCrossings(crossing);
   }
   result.AdaptedPieces = static_cast<int>(adapted.size());
+  result.RemainingCrossings = pairs;
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
+  const double domainBounds[4], OneCellSmoothingResult& result, std::string& error) const
+{
+  result = OneCellSmoothingResult();
+  if (this->Segments < 2 || this->Segments > MaximumCurveSegments)
+  {
+    error = "the number of curve segments must be in [2, " + std::to_string(MaximumCurveSegments) +
+      "], not " + std::to_string(this->Segments);
+    return false;
+  }
+  if (complex.OneCells.empty())
+  {
+    error = "the complex has no 1-cells";
+    return false;
+  }
+
+  // Nodes: every critical point, every junction point, and the domain corners met (added
+  // while cutting).
+  AddCriticalNodes(complex.CriticalPoints, result.Nodes);
+  SeparateTiedCriticalValues(complex.CriticalPoints, result.Nodes);
+  const std::vector<Index> junctionNode = AddJunctionNodes(junctions, result.Nodes);
+
+  // Paper, section 4, step 1: the pieces between nodes and the junction values.
+  if (!this->CutAndSolveJunctionValues(complex, junctions, junctionNode, domainBounds, result, error))
+  {
+    return false;
+  }
+  this->Hooks.Report(0.2);
+
+  // Steps 2 and 3: a monotone height and a planar curve on every piece.
+  if (!this->FitAllPieces(result, domainBounds, error))
+  {
+    return false;
+  }
+
+  // The smoothed curves must not cross, or the 2-cells of stage 4 would not be simple.
+  if (!this->RepairCrossings(result, domainBounds, error))
+  {
+    return false;
+  }
   for (const SmoothedPiece& piece : result.Pieces)
   {
     result.ClampedPieces += piece.Clamped;
   }
-  result.RemainingCrossings = pairs;
-  for (const SmoothedPiece& piece : result.Pieces)
-  {
-    bool outside = false;
-    const int count = piece.Segments * this->SamplesPerSegment;
-    for (int s = 0; s <= count && !outside; ++s)
-    {
-      double xy[2];
-      piece.Curve.Evaluate(static_cast<double>(s) / count, xy);
-      const double tolerance = 1e-9 * std::max(domainBounds[1] - domainBounds[0], domainBounds[3] - domainBounds[2]);
-      outside = xy[0] < domainBounds[0] - tolerance || xy[0] > domainBounds[1] + tolerance ||
-        xy[1] < domainBounds[2] - tolerance || xy[1] > domainBounds[3] + tolerance;
-    }
-    result.PiecesOutsideDomain += outside;
-  }
+  result.PiecesOutsideDomain = CountPiecesOutsideDomain(result.Pieces, domainBounds, this->SamplesPerSegment);
   this->Hooks.Report(1.0);
   return true;
 }

@@ -59,7 +59,7 @@ struct OneCellSmoothingResult
   int ClampedPieces = 0;       // pieces kept inside it by clamping control points
   double JunctionMargin = 0;
   double JunctionTotalChange = 0;
-  bool RisingCutsOnly = false;  // the pieces were cut only where nodes rise (see Smooth)
+  bool RisingCutsOnly = false;  // cut only where nodes rise (see CutAndSolveJunctionValues)
   int SpreadCriticalValues = 0; // critical values raised to make room for strict monotonicity
   double MaximumSpread = 0;     // the largest raise (see JunctionValueProgram)
 };
@@ -88,6 +88,15 @@ public:
   ParallelFor Parallel = SequentialFor;
 
 private:
+  // Paper, section 4, step 1: cuts the 1-cells into pieces at their nodes and solves the
+  // junction values; cuts again at rising nodes only when the first cut orders nodes both ways.
+  bool CutAndSolveJunctionValues(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
+    const std::vector<Index>& junctionNode, const double domainBounds[4], OneCellSmoothingResult& result,
+    std::string& error) const;
+  // Steps 2 and 3 on every piece with k = Segments.
+  bool FitAllPieces(OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const;
+  // Raises k on crossing pieces and fits them again (sets AdaptedPieces, RemainingCrossings).
+  bool RepairCrossings(OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const;
   bool FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments, const double bounds[4],
     std::string& error) const;
 };

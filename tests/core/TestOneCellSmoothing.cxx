@@ -1,1162 +1,238 @@
-// Tests of the core math of stage 3 (MonotoneBSplineFit, JunctionValueProgram): B-spline to
-// Bezier conversion against an independent Cox-de Boor evaluation, strictly monotone L1 fits
-// on noisy synthetic data (checked on the cubic Bezier coefficients), end conditions, C1
-// continuity, optimality against brute force, the unconstrained fit as a lower bound,
-// degenerate and bad input, planar least-squares curves, the junction program (shared
-// junctions, constraints, optimality, infeasible input), thread safety, and timings.
+// Tests of stage 3 as a whole (OneCellSmoothing; paper, section 4) on the output of the real
+// stages 1 and 2 for synthetic fields: the 1-cells cut into chains of pieces between nodes,
+// junction values strictly increasing along every piece, critical values kept, every height
+// strictly increasing on its cubic Bezier coefficients and interpolating its nodes' values
+// exactly, every curve from node to node inside the domain, no crossings left, the same result
+// with 1 and several threads, progress and abort, and bad input. The units of stage 3 have
+// their own tests: TestJunctionValueProgram, TestMonotoneBSplineFit, TestBezierSpline.
 //
 // Usage: TestOneCellSmoothing
-// Prints the fit errors and timings, then "N passed, N failed"; returns nonzero on failure.
-#include "JunctionValueProgram.h"
-#include "MonotoneBSplineFit.h"
+// Prints figures per field, then "N passed, N failed"; returns nonzero on failure.
+#include "MorseSmaleComplexExtraction.h"
+#include "MorseSmaleComplexSimplification.h"
+#include "OneCellSmoothing.h"
+#include "SyntheticFields.h"
 #include "TestHarness.h"
+#include "TestSupport.h"
 
 #include <algorithm>
-#include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <limits>
-#include <map>
-#include <random>
 #include <string>
-#include <thread>
 #include <vector>
 
 using namespace topospline;
 
 namespace
 {
-const int SegmentCounts[] = { 2, 3, 4, 7, 12 };
-const int SampleCounts[] = { 5, 10, 50, 200, 500 };
-
-// An independent evaluation: Cox-de Boor on the clamped knot vector
-// U = {0, 0, 0, 1/k, ..., (k-1)/k, 1, 1, 1}; the paper's N_i^2 is the standard N_i,2 on U.
-struct CoxDeBoor
+struct Stage3Input
 {
-  std::vector<double> Knots;
-  explicit CoxDeBoor(int k)
-  {
-    this->Knots = { 0.0, 0.0 };
-    for (int j = 0; j <= k; ++j)
-    {
-      this->Knots.push_back(static_cast<double>(j) / k);
-    }
-    this->Knots.push_back(1.0);
-    this->Knots.push_back(1.0);
-  }
-  double Basis(int i, int p, double t) const
-  {
-    const std::vector<double>& u = this->Knots;
-    if (p == 0)
-    {
-      if (u[i] <= t && t < u[i + 1])
-      {
-        return 1.0;
-      }
-      // t = 1 belongs to the last non-empty interval.
-      return (t == u.back() && u[i] < u[i + 1] && u[i + 1] == u.back()) ? 1.0 : 0.0;
-    }
-    double value = 0;
-    if (u[i + p] > u[i])
-    {
-      value += (t - u[i]) / (u[i + p] - u[i]) * this->Basis(i, p - 1, t);
-    }
-    if (u[i + p + 1] > u[i + 1])
-    {
-      value += (u[i + p + 1] - t) / (u[i + p + 1] - u[i + 1]) * this->Basis(i + 1, p - 1, t);
-    }
-    return value;
-  }
-  double BasisDerivative(int i, double t) const
-  {
-    const std::vector<double>& u = this->Knots;
-    double value = 0;
-    if (u[i + 2] > u[i])
-    {
-      value += 2.0 / (u[i + 2] - u[i]) * this->Basis(i, 1, t);
-    }
-    if (u[i + 3] > u[i + 1])
-    {
-      value -= 2.0 / (u[i + 3] - u[i + 1]) * this->Basis(i + 1, 1, t);
-    }
-    return value;
-  }
-  void Evaluate(const std::vector<double>& coefficients, int dimension, double t, double* value, bool derivative) const
-  {
-    const int count = static_cast<int>(coefficients.size()) / dimension;
-    for (int d = 0; d < dimension; ++d)
-    {
-      value[d] = 0;
-    }
-    for (int i = 0; i < count; ++i)
-    {
-      const double n = derivative ? this->BasisDerivative(i, t) : this->Basis(i, 2, t);
-      for (int d = 0; d < dimension; ++d)
-      {
-        value[d] += n * coefficients[i * dimension + d];
-      }
-    }
-  }
+  MorseSmaleComplex Input;
+  SimplificationOutput Simplified;
+  double Bounds[4] = { 0, 0, 0, 0 };
+  double Range = 0;
 };
 
-struct Samples
+bool RunStages1And2(const GridField& grid, double percent, Stage3Input& input, std::string& error)
 {
-  std::vector<double> Parameters;
-  std::vector<double> Values;
-  double Start = 0;
-  double End = 1;
-};
-
-// Non-uniform arc length parameters (random steps) and a field along them.
-std::vector<double> RandomParameters(int n, std::mt19937& random)
-{
-  std::uniform_real_distribution<double> step(0.2, 1.8);
-  std::vector<double> t(n + 1, 0.0);
-  for (int i = 1; i <= n; ++i)
+  const PlanarScalarField field = StructuredFieldFromGrid(grid);
+  const int nx = grid.Dimensions[0], ny = grid.Dimensions[1];
+  MorseSmaleComplexExtraction extraction;
+  MorseSmaleComplexSimplification simplification;
+  if (!extraction.Extract(field, input.Input, error) || !simplification.ComputeHierarchy(input.Input, error) ||
+    !simplification.Simplify(percent, input.Simplified, error))
   {
-    t[i] = t[i - 1] + step(random);
+    return false;
   }
-  for (int i = 1; i < n; ++i)
-  {
-    t[i] /= t[n];
-  }
-  t[n] = 1.0;
-  return t;
+  const auto [lo, hi] = std::minmax_element(grid.Values.begin(), grid.Values.end());
+  input.Range = *hi - *lo;
+  input.Bounds[0] = grid.Origin[0];
+  input.Bounds[1] = grid.Origin[0] + (nx - 1) * grid.Spacing[0];
+  input.Bounds[2] = grid.Origin[1];
+  input.Bounds[3] = grid.Origin[1] + (ny - 1) * grid.Spacing[1];
+  return true;
 }
 
-enum class Shape
+// The properties the paper asks of the smoothed 1-cells (section 4, steps 1-3).
+void CheckSmoothedOneCells(const Stage3Input& input, const OneCellSmoothingResult& result, int k)
 {
-  NoisyRamp,   // ramp plus sine noise plus random noise
-  Decreasing,  // the data go the wrong way
-  Constant,    // all samples equal
-  Step,        // a jump in the middle
-  Outliers,    // ramp with a few wild samples
-  HugeOffset   // noisy ramp at 1e6 with a rise of 0.01: units must not matter
-};
-const Shape AllShapes[] = { Shape::NoisyRamp, Shape::Decreasing, Shape::Constant, Shape::Step, Shape::Outliers,
-  Shape::HugeOffset };
-
-Samples MakeSamples(Shape shape, int n, std::mt19937& random)
-{
-  Samples s;
-  s.Parameters = RandomParameters(n, random);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  const double phase = 3.0 * unit(random);
-  s.Start = -0.3;
-  s.End = 1.7;
-  for (int i = 0; i <= n; ++i)
+  const MorseSmaleComplex& complex = input.Simplified.Complex;
+  const std::vector<SmoothingNode>& nodes = result.Nodes;
+  CHECK(!result.Pieces.empty());
+  CHECK(result.PiecesOfOneCell.size() == complex.OneCells.size());
+  // Critical values are kept (up to the separation of ties); junctions get new values.
+  for (Index c = 0; c < static_cast<Index>(complex.CriticalPoints.size()); ++c)
   {
-    const double t = s.Parameters[i];
-    const double ramp = s.Start + (s.End - s.Start) * t;
-    double f = 0;
-    switch (shape)
+    CHECK(nodes[c].Type == SmoothingNode::Critical && nodes[c].Source == c);
+    CHECK(std::abs(nodes[c].Value - complex.CriticalPoints[c].Value) <= 1e-9 * input.Range);
+  }
+  // Every 1-cell is a chain of pieces from its source to its destination.
+  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
+  {
+    const std::vector<Index>& chain = result.PiecesOfOneCell[a];
+    // A 1-cell of one point (a boundary saddle on its extremum's vertex) has no piece.
+    CHECK(chain.empty() == (complex.OneCells[a].Values.size() < 2));
+    if (chain.empty())
     {
-      case Shape::NoisyRamp:
-        f = ramp + 0.35 * std::sin(9.0 * t + phase) + 0.05 * unit(random);
-        break;
-      case Shape::Decreasing:
-        f = s.End - (s.End - s.Start) * t + 0.05 * unit(random);
-        break;
-      case Shape::Constant:
-        f = 0.4;
-        break;
-      case Shape::Step:
-        f = t < 0.5 ? s.Start + 0.1 : s.End - 0.1;
-        break;
-      case Shape::Outliers:
-        f = ramp + ((i % 7 == 3) ? 5.0 * unit(random) : 0.02 * unit(random));
-        break;
-      case Shape::HugeOffset:
-        f = 1e6 + 0.01 * (t + 0.35 * std::sin(9.0 * t + phase) + 0.05 * unit(random));
-        break;
+      continue;
     }
-    s.Values.push_back(f);
+    CHECK(result.Pieces[chain.front()].StartNode == complex.OneCells[a].Source);
+    CHECK(result.Pieces[chain.back()].EndNode == complex.OneCells[a].Destination);
+    for (std::size_t i = 0; i + 1 < chain.size(); ++i)
+    {
+      CHECK(result.Pieces[chain[i]].EndNode == result.Pieces[chain[i + 1]].StartNode);
+    }
+    for (Index p : chain)
+    {
+      const auto& cells = result.Pieces[p].OneCells;
+      CHECK(std::find(cells.begin(), cells.end(), a) != cells.end());
+    }
   }
-  if (shape == Shape::HugeOffset)
+  int badHeights = 0, badEnds = 0, outsideBox = 0;
+  for (const SmoothedPiece& piece : result.Pieces)
   {
-    s.Start = 1e6;
-    s.End = 1e6 + 0.01;
+    const double a = nodes[piece.StartNode].Value, b = nodes[piece.EndNode].Value;
+    CHECK(a < b);
+    CHECK(piece.Segments >= k && piece.Height.Segments == piece.Segments && piece.Curve.Segments == piece.Segments);
+    CHECK(piece.Height.Dimension == 1 && piece.Curve.Dimension == 2);
+    // Strictly increasing ordinates but for the zero slopes at both ends.
+    const int segments = piece.Height.Segments;
+    for (int j = 0; j < segments; ++j)
+    {
+      const double* c = piece.Height.Segment(j);
+      for (int m = 0; m < 3; ++m)
+      {
+        const bool end = (j == 0 && m == 0) || (j == segments - 1 && m == 2);
+        badHeights += end ? c[m + 1] != c[m] : !(c[m + 1] > c[m]);
+      }
+    }
+    badEnds += piece.Height.Value(0.0) != a || piece.Height.Value(1.0) != b;
+    double start[2], end[2];
+    piece.Curve.Evaluate(0.0, start);
+    piece.Curve.Evaluate(1.0, end);
+    badEnds += start[0] != piece.Points[0] || start[1] != piece.Points[1];
+    badEnds += end[0] != piece.Points[piece.Points.size() - 2] || end[1] != piece.Points.back();
+    // Clamped control points keep the curve in the domain's box.
+    for (std::size_t i = 0; i < piece.Curve.ControlPoints.size(); ++i)
+    {
+      const double value = piece.Curve.ControlPoints[i];
+      const int axis = static_cast<int>(i % 2);
+      outsideBox += value < input.Bounds[2 * axis] || value > input.Bounds[2 * axis + 1];
+    }
+    CHECK(piece.L1Error >= piece.UnconstrainedL1Error - 1e-6 * (b - a) * static_cast<double>(piece.Values.size()));
   }
-  return s;
+  CHECK(badHeights == 0);
+  CHECK(badEnds == 0);
+  CHECK(outsideBox == 0);
+  CHECK(result.RemainingCrossings == 0);
+  CHECK(result.PiecesOutsideDomain == 0);
+  CHECK(result.JunctionMargin > 0);
 }
 
-// The checks every monotone height must pass, on its B-spline and its cubic Beziers.
-void CheckMonotoneHeight(const HeightFit& fit, const Samples& s, int k, std::map<std::string, int>& failures)
+bool SameResult(const OneCellSmoothingResult& x, const OneCellSmoothingResult& y)
 {
-  auto check = [&failures](bool ok, const char* what) {
-    if (!ok)
-    {
-      ++failures[what];
-    }
-  };
-  const UniformQuadraticBSpline& g = fit.Spline;
-  const std::vector<double>& alpha = g.Coefficients;
-  const double magnitude = std::max(std::abs(s.Start), std::abs(s.End));
-  check(g.Segments == k && static_cast<int>(alpha.size()) == k + 2, "coefficient count");
-  check(alpha[0] == s.Start && alpha[1] == s.Start, "alpha_0 = alpha_1 = a exactly");
-  check(alpha[k] == s.End && alpha[k + 1] == s.End, "alpha_k = alpha_k+1 = b exactly");
-  for (int j = 1; j < k; ++j)
+  if (x.Pieces.size() != y.Pieces.size() || x.Nodes.size() != y.Nodes.size() ||
+    x.AdaptedPieces != y.AdaptedPieces || x.RemainingCrossings != y.RemainingCrossings)
   {
-    check(alpha[j + 1] > alpha[j], "alpha strictly increasing on 1..k");
-    // delta is met in normalized values; going back to field units rounds at |b|.
-    check(alpha[j + 1] - alpha[j] >= fit.MinimumStep - 1e-15 * magnitude, "steps >= delta");
+    return false;
   }
-  check(g.Value(0.0) == s.Start && g.Value(1.0) == s.End, "g(0) = a and g(1) = b exactly");
-
-  const CubicBezierSpline cubic = g.ToCubicBezier();
-  check(cubic.Segments == k && cubic.ControlPoints.size() == static_cast<std::size_t>(4 * k), "cubic layout");
-  const double scale = s.End - s.Start;
-  for (int j = 0; j < k; ++j)
+  for (std::size_t n = 0; n < x.Nodes.size(); ++n)
   {
-    const double* c = cubic.Segment(j);
-    for (int m = 0; m < 3; ++m)
+    if (x.Nodes[n].Value != y.Nodes[n].Value)
     {
-      const double rise = c[m + 1] - c[m];
-      const bool end = (j == 0 && m == 0) || (j == k - 1 && m == 2);
-      if (end)
-      {
-        check(rise == 0.0, "zero end derivative: 3 (c1 - c0) = 0 first, 3 (c3 - c2) = 0 last");
-      }
-      else
-      {
-        check(rise > 0.0, "cubic Bezier coefficients strictly increasing");
-      }
-    }
-    if (j + 1 < k)
-    {
-      const double* next = cubic.Segment(j + 1);
-      check(c[3] == next[0], "C0 between segments (exact)");
-      check(std::abs(3 * (c[3] - c[2]) - 3 * (next[1] - next[0])) <= 1e-12 * scale + 1e-14 * magnitude,
-        "C1 between segments");
+      return false;
     }
   }
-  check(cubic.Segment(0)[0] == s.Start && cubic.Segment(k - 1)[3] == s.End, "cubic end values exact");
-  check(g.Slope(0.0) == 0.0 && g.Slope(1.0) == 0.0, "g'(0) = g'(1) = 0");
-  for (int i = 1; i < 2000; ++i)
+  for (std::size_t p = 0; p < x.Pieces.size(); ++p)
   {
-    const double t = i / 2000.0;
-    check(g.Slope(t) > 0.0, "g' > 0 inside (0, 1) (B-spline)");
-    check(cubic.Slope(t) > 0.0, "g' > 0 inside (0, 1) (cubic Beziers)");
-  }
-}
-
-double L1ErrorBruteForceK3(const Samples& s, double lower, double upper)
-{
-  // k = 3: one free coefficient alpha_2, the objective is convex piecewise linear in it, so
-  // its minimum over [lower, upper] is at a breakpoint or a bound.
-  const int k = 3;
-  std::vector<double> residualBase;
-  std::vector<double> weight;
-  for (std::size_t i = 1; i + 1 < s.Parameters.size(); ++i)
-  {
-    int first = 0;
-    double w[3];
-    UniformQuadraticBSpline::BasisWeights(k, s.Parameters[i], first, w);
-    const double alpha[5] = { s.Start, s.Start, 0.0, s.End, s.End };
-    double fixed = 0;
-    double free = 0;
-    for (int m = 0; m < 3; ++m)
-    {
-      if (first + m == 2)
-      {
-        free = w[m];
-      }
-      else
-      {
-        fixed += w[m] * alpha[first + m];
-      }
-    }
-    residualBase.push_back(s.Values[i] - fixed);
-    weight.push_back(free);
-  }
-  auto objective = [&](double x) {
-    double e = 0;
-    for (std::size_t i = 0; i < weight.size(); ++i)
-    {
-      e += std::abs(residualBase[i] - weight[i] * x);
-    }
-    return e;
-  };
-  std::vector<double> candidates;
-  if (std::isfinite(lower))
-  {
-    candidates.push_back(lower);
-  }
-  if (std::isfinite(upper))
-  {
-    candidates.push_back(upper);
-  }
-  for (std::size_t i = 0; i < weight.size(); ++i)
-  {
-    if (weight[i] != 0)
-    {
-      candidates.push_back(std::min(std::max(residualBase[i] / weight[i], lower), upper));
-    }
-  }
-  double best = std::numeric_limits<double>::infinity();
-  for (double x : candidates)
-  {
-    best = std::min(best, objective(x));
-  }
-  if (candidates.empty())
-  {
-    best = objective(0.0);
-  }
-  return best;
-}
-} // namespace
-
-//------------------------------------------------------------------------------
-TEST_CASE(ConversionMatchesCoxDeBoor)
-{
-  std::mt19937 random(7);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  double worst = 0;
-  for (int k : { 2, 3, 4, 5, 7, 12, 31 })
-  {
-    const CoxDeBoor reference(k);
-    for (int dimension : { 1, 2 })
-    {
-      UniformQuadraticBSpline spline;
-      spline.Segments = k;
-      spline.Dimension = dimension;
-      for (int i = 0; i < (k + 2) * dimension; ++i)
-      {
-        spline.Coefficients.push_back(unit(random));
-      }
-      const CubicBezierSpline cubic = spline.ToCubicBezier();
-      const std::vector<double> quadratic = spline.ToQuadraticBezier();
-      for (int i = 0; i <= 200; ++i)
-      {
-        const double t = i / 200.0;
-        double expected[2], bspline[2], bezier[2], quad[2], expectedSlope[2], bsplineSlope[2], bezierSlope[2];
-        reference.Evaluate(spline.Coefficients, dimension, t, expected, false);
-        reference.Evaluate(spline.Coefficients, dimension, t, expectedSlope, true);
-        spline.Evaluate(t, bspline);
-        spline.EvaluateDerivative(t, bsplineSlope);
-        cubic.Evaluate(t, bezier);
-        cubic.EvaluateDerivative(t, bezierSlope);
-        double s = 0;
-        const int j = UniformQuadraticBSpline::LocateSegment(k, t, s);
-        for (int d = 0; d < dimension; ++d)
-        {
-          const double* b = quadratic.data() + 3 * j * dimension;
-          quad[d] = (1 - s) * (1 - s) * b[d] + 2 * s * (1 - s) * b[dimension + d] + s * s * b[2 * dimension + d];
-          worst = std::max(worst, std::abs(bezier[d] - expected[d]));
-          CHECK(std::abs(bspline[d] - expected[d]) <= 1e-12);
-          CHECK(std::abs(bezier[d] - expected[d]) <= 1e-12);
-          CHECK(std::abs(quad[d] - expected[d]) <= 1e-12);
-          CHECK(std::abs(bsplineSlope[d] - expectedSlope[d]) <= 1e-10 * k);
-          CHECK(std::abs(bezierSlope[d] - expectedSlope[d]) <= 1e-10 * k);
-        }
-      }
-      // Partition of unity of the basis weights.
-      for (int i = 0; i <= 50; ++i)
-      {
-        int first = 0;
-        double w[3];
-        UniformQuadraticBSpline::BasisWeights(k, i / 50.0, first, w);
-        CHECK(std::abs(w[0] + w[1] + w[2] - 1.0) <= 1e-15);
-        CHECK(first >= 0 && first + 2 <= k + 1);
-      }
-    }
-  }
-  std::printf("  conversion: max |cubic Bezier - Cox-de Boor| = %.2e over 201 parameters\n", worst);
-}
-
-//------------------------------------------------------------------------------
-TEST_CASE(DeCasteljauSubdivision)
-{
-  std::mt19937 random(11);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  for (int trial = 0; trial < 20; ++trial)
-  {
-    double control[8];
-    for (double& c : control)
-    {
-      c = unit(random);
-    }
-    for (double split : { 0.5, 0.25, 1.0 / 3.0, 0.9 })
-    {
-      double left[8], right[8];
-      CubicBezierSpline::Subdivide(control, 2, split, left, right);
-      for (int i = 0; i <= 50; ++i)
-      {
-        const double u = i / 50.0;
-        double whole[2], part[2];
-        CubicBezierSpline::EvaluateSegment(left, 2, u, part);
-        CubicBezierSpline::EvaluateSegment(control, 2, split * u, whole);
-        CHECK(std::abs(part[0] - whole[0]) <= 1e-14 && std::abs(part[1] - whole[1]) <= 1e-14);
-        CubicBezierSpline::EvaluateSegment(right, 2, u, part);
-        CubicBezierSpline::EvaluateSegment(control, 2, split + (1 - split) * u, whole);
-        CHECK(std::abs(part[0] - whole[0]) <= 1e-14 && std::abs(part[1] - whole[1]) <= 1e-14);
-      }
-      CHECK(left[0] == control[0] && right[6] == control[6] && left[6] == right[0]);
-    }
-  }
-}
-
-//------------------------------------------------------------------------------
-TEST_CASE(MonotoneFitsOnSyntheticData)
-{
-  std::mt19937 random(2015);
-  std::map<std::string, int> failures;
-  // Per (n, k) on the noisy ramp: mean absolute error of the monotone and unconstrained fits.
-  std::map<std::pair<int, int>, std::array<double, 3>> table;
-  int fits = 0;
-  int lowerBoundViolations = 0;
-  int throughDual = 0;
-  int dualMismatches = 0;
-  double worstGap = 0;
-  for (Shape shape : AllShapes)
-  {
-    for (int n : SampleCounts)
-    {
-      for (int k : SegmentCounts)
-      {
-        for (int trial = 0; trial < 3; ++trial)
-        {
-          const Samples s = MakeSamples(shape, n, random);
-          MonotoneBSplineFit fitter;
-          fitter.Segments = k;
-          HeightFit monotone, free;
-          std::string error;
-          const bool ok = fitter.FitHeight(s.Parameters, s.Values, s.Start, s.End, true, monotone, error);
-          CHECK(ok);
-          if (!ok)
-          {
-            std::printf("  fit failed (n=%d k=%d): %s\n", n, k, error.c_str());
-            continue;
-          }
-          CHECK(fitter.FitHeight(s.Parameters, s.Values, s.Start, s.End, false, free, error));
-          ++fits;
-          throughDual += monotone.SolvedThroughDual;
-          throughDual += free.SolvedThroughDual;
-          {
-            // The dual program with its recovered coefficients and the primal program reach
-            // the same optimum (up to the tie-break and GLPK's tolerances).
-            MonotoneBSplineFit primal = fitter;
-            primal.UseDualProgram = false;
-            HeightFit monotonePrimal, freePrimal;
-            CHECK(primal.FitHeight(s.Parameters, s.Values, s.Start, s.End, true, monotonePrimal, error));
-            CHECK(primal.FitHeight(s.Parameters, s.Values, s.Start, s.End, false, freePrimal, error));
-            CHECK(!monotonePrimal.SolvedThroughDual && !freePrimal.SolvedThroughDual);
-            const double same = 2 * fitter.TieBreakWeight * (s.End - s.Start) + 1e-7 * (s.End - s.Start) * n +
-              1e-14 * n * std::abs(s.End);
-            const double gap = std::max(
-              std::abs(monotone.L1Error - monotonePrimal.L1Error), std::abs(free.L1Error - freePrimal.L1Error));
-            worstGap = std::max(worstGap, gap / (s.End - s.Start));
-            if (!(gap <= same))
-            {
-              ++dualMismatches;
-              std::printf("  dual/primal differ: shape %d n=%d k=%d: %.12g/%.12g and %.12g/%.12g\n",
-                static_cast<int>(shape), n, k, monotone.L1Error, monotonePrimal.L1Error, free.L1Error,
-                freePrimal.L1Error);
-            }
-          }
-          CheckMonotoneHeight(monotone, s, k, failures);
-          // The unconstrained optimum is a lower bound; GLPK's tolerances allow a little slack.
-          const double range = s.End - s.Start;
-          const double slack = 1e-7 * range * n;
-          if (!(monotone.L1Error >= free.L1Error - slack))
-          {
-            ++lowerBoundViolations;
-            std::printf(
-              "  monotone error %.9g < unconstrained %.9g (n=%d k=%d)\n", monotone.L1Error, free.L1Error, n, k);
-          }
-          // The unconstrained fit keeps the end conditions too.
-          CHECK(free.Spline.Coefficients[0] == s.Start && free.Spline.Coefficients[1] == s.Start);
-          CHECK(free.Spline.Coefficients[k] == s.End && free.Spline.Coefficients[k + 1] == s.End);
-          if (k == 3)
-          {
-            const double lower = s.Start + monotone.MinimumStep;
-            const double upper = s.End - monotone.MinimumStep;
-            const double best = L1ErrorBruteForceK3(s, lower, upper);
-            const double bestFree = L1ErrorBruteForceK3(
-              s, -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
-            const double tolerance = 2 * fitter.TieBreakWeight * range + 1e-7 * range * n;
-            // (The brute force evaluates in field units: at 1e6 it rounds at 1e-10 per sample.)
-            const double rounding = 1e-9 * range * n + 1e-15 * n * std::abs(s.End);
-            const bool monotoneOptimal =
-              monotone.L1Error <= best + tolerance + rounding && monotone.L1Error >= best - rounding;
-            const bool freeOptimal = std::abs(free.L1Error - bestFree) <= 1e-7 * range * n + rounding;
-            CHECK(monotoneOptimal);
-            CHECK(freeOptimal);
-            if (!monotoneOptimal || !freeOptimal)
-            {
-              std::printf("  k=3 brute force: shape %d n=%d monotone %.12g vs %.12g, free %.12g vs %.12g\n",
-                static_cast<int>(shape), n, monotone.L1Error, best, free.L1Error, bestFree);
-            }
-          }
-          if (shape == Shape::NoisyRamp)
-          {
-            auto& row = table[{ n, k }];
-            row[0] += monotone.L1Error / (n - 1);
-            row[1] += free.L1Error / (n - 1);
-            row[2] += 1;
-          }
-        }
-      }
-    }
-  }
-  CHECK(lowerBoundViolations == 0);
-  CHECK(dualMismatches == 0);
-  std::printf("  %d of %d fits solved through the dual program (the others: primal); max |dual - primal| L1 error "
-              "%.2e (b - a)\n", throughDual, 2 * fits, worstGap);
-  for (const auto& f : failures)
-  {
-    std::printf("  FAILED %dx: %s\n", f.second, f.first.c_str());
-    CHECK(f.first.empty());
-  }
-  std::printf("  %d monotone + %d unconstrained fits on 6 data shapes\n", fits, fits);
-  std::printf("  noisy ramp (rise 2, sine noise 0.35): mean |f - g| per interior sample, monotone / unconstrained\n");
-  for (int n : SampleCounts)
-  {
-    std::printf("    n=%3d:", n);
-    for (int k : SegmentCounts)
-    {
-      const auto& row = table[{ n, k }];
-      std::printf("  k=%-2d %.4f/%.4f", k, row[0] / row[2], row[1] / row[2]);
-    }
-    std::printf("\n");
-  }
-}
-
-//------------------------------------------------------------------------------
-TEST_CASE(DegenerateHeightFits)
-{
-  MonotoneBSplineFit fitter;
-  HeightFit fit;
-  std::string error;
-  std::map<std::string, int> failures;
-
-  // k = 2: fully determined, no program.
-  {
-    std::mt19937 random(3);
-    Samples s = MakeSamples(Shape::NoisyRamp, 20, random);
-    fitter.Segments = 2;
-    CHECK(fitter.FitHeight(s.Parameters, s.Values, s.Start, s.End, true, fit, error));
-    CHECK(fit.ProgramVariables == 0);
-    CHECK((fit.Spline.Coefficients == std::vector<double>{ s.Start, s.Start, s.End, s.End }));
-    CheckMonotoneHeight(fit, s, 2, failures);
-  }
-  // No interior samples: evenly spaced coefficients.
-  for (int k : SegmentCounts)
-  {
-    Samples s;
-    s.Parameters = { 0.0, 1.0 };
-    s.Values = { 5.0, -5.0 };
-    s.Start = 2.0;
-    s.End = 3.0;
-    fitter.Segments = k;
-    CHECK(fitter.FitHeight(s.Parameters, s.Values, s.Start, s.End, true, fit, error));
-    CHECK(fit.L1Error == 0.0);
-    CheckMonotoneHeight(fit, s, k, failures);
-    for (int j = 1; j <= k; ++j)
-    {
-      CHECK(std::abs(fit.Spline.Coefficients[j] - (2.0 + (j - 1.0) / (k - 1))) <= 1e-15);
-    }
-    CHECK(fitter.FitHeight(s.Parameters, s.Values, s.Start, s.End, false, fit, error));
-  }
-  // All samples equal, equal to a, or sitting at the ends of the parameter range; few
-  // samples with many segments (coefficients without data: the tie-break spaces them).
-  for (int k : SegmentCounts)
-  {
-    fitter.Segments = k;
-    for (double level : { 0.5, 0.0, 1.0, -7.0, 9.0 })
-    {
-      Samples s;
-      s.Parameters = { 0.0, 0.1, 0.2, 0.5, 0.7, 1.0 };
-      s.Values.assign(6, level);
-      s.Start = 0.0;
-      s.End = 1.0;
-      CHECK(fitter.FitHeight(s.Parameters, s.Values, s.Start, s.End, true, fit, error));
-      CheckMonotoneHeight(fit, s, k, failures);
-    }
-    Samples ends;
-    ends.Parameters = { 0.0, 0.0, 0.0, 1.0, 1.0 };
-    ends.Values = { 0.0, 3.0, -3.0, 4.0, 1.0 };
-    CHECK(fitter.FitHeight(ends.Parameters, ends.Values, 0.0, 1.0, true, fit, error));
-    CheckMonotoneHeight(fit, ends, k, failures);
-    CHECK(std::abs(fit.L1Error - 9.0) <= 1e-12);
-
-    Samples sparse;
-    sparse.Parameters = { 0.0, 0.95, 1.0 };
-    sparse.Values = { 0.0, 0.99, 1.0 };
-    CHECK(fitter.FitHeight(sparse.Parameters, sparse.Values, 0.0, 1.0, true, fit, error));
-    CheckMonotoneHeight(fit, sparse, k, failures);
-    if (k >= 7)
-    {
-      // Only the last segments see the sample; the first steps are spread evenly, not
-      // squeezed to delta.
-      const double step = fit.Spline.Coefficients[2] - fit.Spline.Coefficients[1];
-      CHECK(step > 10 * fit.MinimumStep);
-    }
-  }
-  for (const auto& f : failures)
-  {
-    std::printf("  FAILED %dx: %s\n", f.second, f.first.c_str());
-    CHECK(f.first.empty());
-  }
-}
-
-//------------------------------------------------------------------------------
-TEST_CASE(BadHeightInput)
-{
-  MonotoneBSplineFit fitter;
-  HeightFit fit;
-  std::string error;
-  const std::vector<double> t = { 0.0, 0.5, 1.0 };
-  const std::vector<double> f = { 0.0, 0.5, 1.0 };
-  for (int k : { -1, 0, 1, 1001 })
-  {
-    fitter.Segments = k;
-    error.clear();
-    CHECK(!fitter.FitHeight(t, f, 0.0, 1.0, true, fit, error) && !error.empty());
-  }
-  fitter.Segments = 4;
-  CHECK(!fitter.FitHeight(t, f, 1.0, 1.0, true, fit, error));
-  CHECK(!fitter.FitHeight(t, f, 1.0, 0.0, true, fit, error));
-  CHECK(!fitter.FitHeight(t, f, 0.0, std::nan(""), true, fit, error));
-  CHECK(!fitter.FitHeight({ 0.0, 0.7, 0.5, 1.0 }, { 0, 0, 0, 0 }, 0.0, 1.0, true, fit, error));
-  CHECK(!fitter.FitHeight({ 0.0, 1.5 }, { 0, 0 }, 0.0, 1.0, true, fit, error));
-  CHECK(!fitter.FitHeight({ 0.0 }, { 0 }, 0.0, 1.0, true, fit, error));
-  CHECK(!fitter.FitHeight(t, { 0.0, 1.0 }, 0.0, 1.0, true, fit, error));
-  CHECK(!fitter.FitHeight(t, { 0.0, std::nan(""), 1.0 }, 0.0, 1.0, true, fit, error));
-  // End values closer than double precision can separate into k steps.
-  CHECK(!fitter.FitHeight(t, f, 1.0, std::nextafter(1.0, 2.0), true, fit, error));
-  std::printf("  e.g. \"%s\"\n", error.c_str());
-  CHECK(fitter.FitHeight(t, f, 1.0, 1.0 + 1e-9, true, fit, error));
-  fitter.MinimumSlopeFraction = 2.0;
-  CHECK(!fitter.FitHeight(t, f, 0.0, 1.0, true, fit, error));
-}
-
-//------------------------------------------------------------------------------
-TEST_CASE(RepeatableAndThreadSafe)
-{
-  // CGAL's interface keys the rows by pointers in unordered maps, so the order in which GLPK
-  // gets each row's entries may change from run to run; check the results do not.
-  std::mt19937 random(99);
-  std::vector<Samples> inputs;
-  for (int i = 0; i < 64; ++i)
-  {
-    inputs.push_back(MakeSamples(i % 2 ? Shape::NoisyRamp : Shape::Outliers, 200, random));
-  }
-  MonotoneBSplineFit fitter;
-  fitter.Segments = 7;
-  std::vector<std::vector<double>> serial(inputs.size());
-  std::string error;
-  for (std::size_t i = 0; i < inputs.size(); ++i)
-  {
-    HeightFit fit;
-    CHECK(fitter.FitHeight(inputs[i].Parameters, inputs[i].Values, inputs[i].Start, inputs[i].End, true, fit, error));
-    serial[i] = fit.Spline.Coefficients;
-  }
-  double worst = 0;
-  for (int repeat = 0; repeat < 2; ++repeat)
-  {
-    std::vector<std::vector<double>> parallel(inputs.size());
-    std::vector<std::thread> threads;
-    for (int w = 0; w < 4; ++w)
-    {
-      threads.emplace_back([&, w]() {
-        for (std::size_t i = w; i < inputs.size(); i += 4)
-        {
-          HeightFit fit;
-          std::string threadError;
-          if (fitter.FitHeight(
-                inputs[i].Parameters, inputs[i].Values, inputs[i].Start, inputs[i].End, true, fit, threadError))
-          {
-            parallel[i] = fit.Spline.Coefficients;
-          }
-        }
-      });
-    }
-    for (auto& thread : threads)
-    {
-      thread.join();
-    }
-    for (std::size_t i = 0; i < inputs.size(); ++i)
-    {
-      CHECK(parallel[i].size() == serial[i].size());
-      for (std::size_t j = 0; j < parallel[i].size() && j < serial[i].size(); ++j)
-      {
-        worst = std::max(worst, std::abs(parallel[i][j] - serial[i][j]));
-      }
-    }
-  }
-  std::printf("  4 threads x 64 fits, twice: max coefficient difference to the serial run %.2e\n", worst);
-  CHECK(worst <= 1e-9);
-}
-
-//------------------------------------------------------------------------------
-TEST_CASE(PlanarCurves)
-{
-  MonotoneBSplineFit fitter;
-  PlanarCurveFit fit;
-  std::string error;
-  std::mt19937 random(5);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  for (int k : SegmentCounts)
-  {
-    fitter.Segments = k;
-    // A straight polyline with uneven vertices: reproduced exactly (linear precision).
-    {
-      std::vector<double> points;
-      double x = 0;
-      for (int i = 0; i <= 30; ++i)
-      {
-        points.push_back(1000.0 + 3.0 * x);
-        points.push_back(-50.0 + 2.0 * x);
-        x += 0.5 + 0.5 * std::abs(unit(random));
-      }
-      const std::vector<double> t = MonotoneBSplineFit::NormalizedArcLength(points);
-      CHECK(t.front() == 0.0 && t.back() == 1.0);
-      CHECK(fitter.FitPlanarCurve(t, points, fit, error));
-      CHECK(fit.MaximumError <= 1e-9);
-    }
-    // A noisy circular arc, n from 5 to 500; a polyline shorter than the coefficient count;
-    // a polyline of two points; a polyline whose points all coincide.
-    for (int n : SampleCounts)
-    {
-      std::vector<double> points;
-      for (int i = 0; i <= n; ++i)
-      {
-        const double angle = 2.0 * i / n;
-        const double noise = (i == 0 || i == n) ? 0.0 : 0.01 * unit(random);
-        points.push_back(std::cos(angle) + noise);
-        points.push_back(std::sin(angle) + noise);
-      }
-      const std::vector<double> t = MonotoneBSplineFit::NormalizedArcLength(points);
-      CHECK(fitter.FitPlanarCurve(t, points, fit, error));
-      const std::vector<double>& c = fit.Spline.Coefficients;
-      CHECK(c[0] == points[0] && c[1] == points[1]);
-      CHECK(c[2 * k + 2] == points[2 * n] && c[2 * k + 3] == points[2 * n + 1]);
-      if (n >= 3 * k)
-      {
-        CHECK(fit.MaximumError <= 0.05);
-      }
-      CHECK(std::isfinite(fit.RootMeanSquareError));
-      const CubicBezierSpline cubic = fit.Spline.ToCubicBezier();
-      for (int j = 0; j + 1 < k; ++j)
-      {
-        const double* a = cubic.Segment(j);
-        const double* b = cubic.Segment(j + 1);
-        for (int d = 0; d < 2; ++d)
-        {
-          CHECK(a[6 + d] == b[d]);
-          CHECK(std::abs((a[6 + d] - a[4 + d]) - (b[2 + d] - b[d])) <= 1e-12);
-        }
-      }
-      double p[2];
-      cubic.Evaluate(0.0, p);
-      CHECK(p[0] == points[0] && p[1] == points[1]);
-      cubic.Evaluate(1.0, p);
-      CHECK(p[0] == points[2 * n] && p[1] == points[2 * n + 1]);
-    }
-    const std::vector<double> two = { 1.0, 2.0, 4.0, 6.0 };
-    CHECK(fitter.FitPlanarCurve(MonotoneBSplineFit::NormalizedArcLength(two), two, fit, error));
-    CHECK(fit.MaximumError <= 1e-12);
-    double mid[2];
-    fit.Spline.Evaluate(0.5, mid);
-    CHECK(std::abs(mid[0] - 2.5) <= 1e-9 && std::abs(mid[1] - 4.0) <= 1e-9);
-    const std::vector<double> same = { 1.0, 1.0, 1.0, 1.0, 1.0, 1.0 };
-    const std::vector<double> t = MonotoneBSplineFit::NormalizedArcLength(same);
-    CHECK((t == std::vector<double>{ 0.0, 0.5, 1.0 }));
-    CHECK(fitter.FitPlanarCurve(t, same, fit, error));
-    CHECK(fit.MaximumError == 0.0);
-  }
-  fitter.Segments = 1;
-  CHECK(!fitter.FitPlanarCurve({ 0.0, 1.0 }, { 0, 0, 1, 1 }, fit, error));
-  fitter.Segments = 4;
-  CHECK(!fitter.FitPlanarCurve({ 0.0, 1.0 }, { 0, 0, 1 }, fit, error));
-}
-
-//------------------------------------------------------------------------------
-namespace
-{
-bool SatisfiesRelations(const std::vector<double>& values, const std::vector<std::array<Index, 2>>& relations)
-{
-  for (const auto& r : relations)
-  {
-    if (!(values[r[1]] > values[r[0]]))
+    if (x.Pieces[p].Height.ControlPoints != y.Pieces[p].Height.ControlPoints ||
+      x.Pieces[p].Curve.ControlPoints != y.Pieces[p].Curve.ControlPoints)
     {
       return false;
     }
   }
   return true;
 }
-
-double Change(const std::vector<JunctionValueNode>& nodes, const std::vector<double>& values)
-{
-  double total = 0;
-  for (std::size_t n = 0; n < nodes.size(); ++n)
-  {
-    total += std::abs(values[n] - nodes[n].Value);
-  }
-  return total;
-}
-
-// Relations from 1-cells given as node paths, lowest first.
-std::vector<std::array<Index, 2>> RelationsOf(const std::vector<std::vector<Index>>& cells)
-{
-  std::vector<std::array<Index, 2>> relations;
-  for (const auto& cell : cells)
-  {
-    for (std::size_t i = 0; i + 1 < cell.size(); ++i)
-    {
-      relations.push_back({ cell[i], cell[i + 1] });
-    }
-  }
-  return relations;
-}
 } // namespace
 
-TEST_CASE(JunctionValues)
-{
-  JunctionValueProgram program;
-  std::vector<double> values;
-  std::string error;
-
-  // A chain min(0) - j1(0.5) - j2(0.3) - saddle(1): the optimum moves the pair by 0.2 + margin.
-  {
-    const std::vector<JunctionValueNode> nodes = { { 0.0, true }, { 0.5, false }, { 0.3, false }, { 1.0, true } };
-    const auto relations = RelationsOf({ { 0, 1, 2, 3 } });
-    CHECK(program.Solve(nodes, relations, values, error));
-    CHECK(std::abs(program.Margin - 1e-3) <= 1e-15);
-    CHECK(SatisfiesRelations(values, relations));
-    CHECK(values[0] == 0.0 && values[3] == 1.0);
-    CHECK(std::abs(program.TotalChange - (0.2 + program.Margin)) <= 1e-9);
-  }
-
-  // Three saddles descending to one minimum through two shared junctions (the paper's
-  // figure 3): one value per junction, all 1-cells strictly increasing.
-  {
-    // 0 min, 1..3 saddles, 4 = j1 (next to the min), 5 = j2.
-    const std::vector<JunctionValueNode> nodes = { { 0.0, true }, { 1.0, true }, { 0.8, true }, { 0.9, true },
-      { 0.3, false }, { 0.1, false } };
-    const std::vector<std::vector<Index>> cells = { { 0, 4, 5, 1 }, { 0, 4, 5, 2 }, { 0, 4, 3 } };
-    const auto relations = RelationsOf(cells);
-    CHECK(program.Solve(nodes, relations, values, error));
-    CHECK(values.size() == nodes.size());
-    CHECK(SatisfiesRelations(values, relations));
-    for (Index n = 0; n < 4; ++n)
-    {
-      CHECK(values[n] == nodes[n].Value);
-    }
-    // Optimum: |x4 - 0.3| + |x5 - 0.1| with x4 + m <= x5: 0.2 + m.
-    CHECK(std::abs(Change(nodes, values) - (0.2 + program.Margin)) <= 1e-9);
-    for (const auto& cell : cells)
-    {
-      for (std::size_t i = 0; i + 1 < cell.size(); ++i)
-      {
-        CHECK(values[cell[i + 1]] - values[cell[i]] >= program.Margin * (1 - 1e-9));
-      }
-    }
-  }
-
-  // Random forests of 1-cells like the ones of real complexes: saddles above, extrema below,
-  // merging into trees of junctions. Split and single programs reach the same optimum, which
-  // is no worse than a simple feasible reference (the repaired original values).
-  std::mt19937 random(42);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  for (int trial = 0; trial < 30; ++trial)
-  {
-    std::vector<JunctionValueNode> nodes;
-    std::vector<std::vector<Index>> cells;
-    const int minima = 1 + trial % 4;
-    for (int m = 0; m < minima; ++m)
-    {
-      const Index minimum = static_cast<Index>(nodes.size());
-      nodes.push_back({ 100.0 * unit(random), true });
-      // A tree of junctions above the minimum; every saddle reaches it through a path.
-      std::vector<Index> tree = { minimum };
-      std::vector<std::vector<Index>> pathTo = { { minimum } };
-      const int junctions = 2 + static_cast<int>(unit(random) * 15);
-      for (int j = 0; j < junctions; ++j)
-      {
-        const std::size_t parent = static_cast<std::size_t>(unit(random) * tree.size()) % tree.size();
-        const Index id = static_cast<Index>(nodes.size());
-        nodes.push_back({ nodes[minimum].Value + 40.0 * unit(random) - 5.0, false });
-        tree.push_back(id);
-        pathTo.push_back(pathTo[parent]);
-        pathTo.back().push_back(id);
-      }
-      const int saddles = 2 + static_cast<int>(unit(random) * 6);
-      for (int s = 0; s < saddles; ++s)
-      {
-        const std::size_t via = static_cast<std::size_t>(unit(random) * tree.size()) % tree.size();
-        const Index id = static_cast<Index>(nodes.size());
-        nodes.push_back({ nodes[minimum].Value + 30.0 + 30.0 * unit(random), true });
-        cells.push_back(pathTo[via]);
-        cells.back().push_back(id);
-      }
-    }
-    const auto relations = RelationsOf(cells);
-    std::vector<double> split, single;
-    program.SplitIntoComponents = true;
-    const bool okSplit = program.Solve(nodes, relations, split, error);
-    const double splitChange = program.TotalChange;
-    program.SplitIntoComponents = false;
-    const bool okSingle = program.Solve(nodes, relations, single, error);
-    program.SplitIntoComponents = true;
-    CHECK(okSplit && okSingle);
-    if (!okSplit || !okSingle)
-    {
-      std::printf("  junction trial %d: %s\n", trial, error.c_str());
-      continue;
-    }
-    CHECK(SatisfiesRelations(split, relations) && SatisfiesRelations(single, relations));
-    CHECK(std::abs(splitChange - program.TotalChange) <= 1e-6 * 100.0);
-    for (std::size_t n = 0; n < nodes.size(); ++n)
-    {
-      if (nodes[n].Fixed)
-      {
-        CHECK(split[n] == nodes[n].Value && single[n] == nodes[n].Value);
-      }
-    }
-    // Units: the same problem at another offset and scale gives the same answer, scaled.
-    std::vector<JunctionValueNode> scaled = nodes;
-    for (auto& node : scaled)
-    {
-      node.Value = 1e9 + 1e3 * node.Value;
-    }
-    std::vector<double> scaledValues;
-    CHECK(program.Solve(scaled, relations, scaledValues, error));
-    CHECK(std::abs(program.TotalChange - 1e3 * splitChange) <= 1e-6 * 1e5);
-  }
-
-  // Two critical points closer than MarginFraction * range allows along a chain: the
-  // margin shrinks instead of failing.
-  {
-    const std::vector<JunctionValueNode> nodes = { { 0.0, true }, { 0.5, false }, { 0.5, false }, { 0.5, false },
-      { 1e-6, true }, { 1.0, true } };
-    const auto relations = RelationsOf({ { 0, 1, 2, 3, 4 }, { 4, 5 } });
-    CHECK(program.Solve(nodes, relations, values, error));
-    CHECK(SatisfiesRelations(values, relations));
-    CHECK(program.Margin <= 0.5 * 1e-6 / 4 * (1 + 1e-12));
-  }
-  // Junctions without relations keep their values; an empty problem is fine.
-  {
-    const std::vector<JunctionValueNode> nodes = { { 3.0, false }, { -2.0, false } };
-    CHECK(program.Solve(nodes, {}, values, error));
-    CHECK(values[0] == 3.0 && values[1] == -2.0);
-    CHECK(program.Solve({}, {}, values, error) && values.empty());
-  }
-}
-
 //------------------------------------------------------------------------------
-// Equal or nearly equal critical values (plateaus, constant fields, noise a few ulps apart),
-// which the complex orders by vertex id, are spread just enough to rise strictly; values
-// that are far enough apart are never touched.
-TEST_CASE(ValueSpreading)
+TEST_CASE(SmoothedOneCellsOfSyntheticFields)
 {
-  JunctionValueProgram program;
-  std::vector<double> values;
-  std::string error;
-  const double gap = JunctionValueProgram::SpreadingGap;
-  // A constant field: min = saddle = max = 1 through a junction.
-  {
-    const std::vector<JunctionValueNode> nodes = { { 1.0, true }, { 1.0, false }, { 1.0, true } };
-    CHECK(program.Solve(nodes, { { 0, 1 }, { 1, 2 } }, values, error));
-    CHECK(values[0] == 1.0);
-    CHECK(values[0] < values[1] && values[1] < values[2]);
-    CHECK(program.SpreadCriticalValues == 1);
-    // two relations of room above the scale 1
-    CHECK(std::abs(program.MaximumSpread - 2 * gap) < 1e-3 * gap);
-  }
-  // A constant field at 0 (no scale from the values: 1 is used).
-  {
-    const std::vector<JunctionValueNode> nodes = { { 0.0, true }, { 0.0, true }, { 0.0, true } };
-    CHECK(program.Solve(nodes, { { 0, 1 }, { 1, 2 }, { 0, 2 } }, values, error));
-    CHECK(values[0] == 0.0 && values[0] < values[1] && values[1] < values[2]);
-    CHECK(program.SpreadCriticalValues == 2);
-  }
-  // Values 1 ulp apart in a chain of 3 relations: spread; the lowest one stays.
-  {
-    const double a = 0.4, b = std::nextafter(a, 1.0);
-    const std::vector<JunctionValueNode> nodes = { { a, true }, { 0.3, false }, { 0.5, false }, { b, true } };
-    CHECK(program.Solve(nodes, { { 0, 1 }, { 1, 2 }, { 2, 3 } }, values, error));
-    CHECK(values[0] == a && values[0] < values[1] && values[1] < values[2] && values[2] < values[3]);
-    CHECK(program.SpreadCriticalValues == 1 && program.MaximumSpread < 4 * gap);
-  }
-  // Well separated values: nothing spread, fixed values exact.
-  {
-    const std::vector<JunctionValueNode> nodes = { { 0.0, true }, { 0.5, false }, { 1.0, true } };
-    CHECK(program.Solve(nodes, { { 0, 1 }, { 1, 2 } }, values, error));
-    CHECK(values[0] == 0.0 && values[2] == 1.0 && program.SpreadCriticalValues == 0 && program.MaximumSpread == 0);
-  }
-  // An inversion is not a tie: still an error.
-  {
-    const std::vector<JunctionValueNode> nodes = { { 1.0, true }, { 1.0, false }, { 1.0 - 1e-6, true } };
-    CHECK(!program.Solve(nodes, { { 0, 1 }, { 1, 2 } }, values, error) && !error.empty());
-  }
-}
-
-//------------------------------------------------------------------------------
-TEST_CASE(InfeasibleJunctionPrograms)
-{
-  JunctionValueProgram program;
-  std::vector<double> values;
   struct Case
   {
     const char* Name;
-    std::vector<JunctionValueNode> Nodes;
-    std::vector<std::array<Index, 2>> Relations;
+    GridField Grid;
+    double Percent;
+    int Segments;
   };
-  const std::vector<Case> cases = {
-    { "fixed nodes in the wrong order", { { 1.0, true }, { 0.0, true } }, { { 0, 1 } } },
-    { "fixed nodes in the wrong order through junctions",
-      { { 1.0, true }, { 0.5, false }, { 0.7, false }, { 0.0, true } }, { { 0, 1 }, { 1, 2 }, { 2, 3 } } },
-    { "a cycle of junctions", { { 0.0, true }, { 0.5, false }, { 0.6, false }, { 1.0, true } },
-      { { 0, 1 }, { 1, 2 }, { 2, 1 }, { 2, 3 } } },
-    { "a self relation", { { 0.0, false } }, { { 0, 0 } } },
-    { "an index out of range", { { 0.0, false } }, { { 0, 1 } } },
-    { "a non-finite value", { { std::nan(""), false }, { 1.0, true } }, { { 0, 1 } } },
+  const Case cases[] = {
+    { "trigonometric 100x100, 1%, k=4", TrigonometricField(10, 100, -49), 1.0, 4 },
+    { "trigonometric 100x100, 1%, k=7", TrigonometricField(10, 100, -49), 1.0, 7 },
+    { "Shepard 40 sites 120x120, 5%, k=4", ShepardField(40, 2.0, 120, 3), 5.0, 4 },
+    { "Shepard 40 sites 120x120, 0%, k=2", ShepardField(40, 2.0, 120, 3), 0.0, 2 },
   };
   for (const Case& c : cases)
   {
+    Stage3Input input;
     std::string error;
-    const bool ok = program.Solve(c.Nodes, c.Relations, values, error);
-    CHECK(!ok && !error.empty());
-    std::printf("  %s: \"%s\"\n", c.Name, error.c_str());
+    CHECK(RunStages1And2(c.Grid, c.Percent, input, error));
+    OneCellSmoothing smoothing;
+    smoothing.Segments = c.Segments;
+    OneCellSmoothingResult result;
+    const bool ok =
+      smoothing.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, result, error);
+    CHECK(ok);
+    if (!ok)
+    {
+      std::printf("  %s: %s\n", c.Name, error.c_str());
+      continue;
+    }
+    CheckSmoothedOneCells(input, result, c.Segments);
+    std::printf("  %s: %zu 1-cells, %zu nodes, %zu pieces, %d adapted, %d clamped, margin %.2e\n", c.Name,
+      input.Simplified.Complex.OneCells.size(), result.Nodes.size(), result.Pieces.size(), result.AdaptedPieces,
+      result.ClampedPieces, result.JunctionMargin);
+
+    // The pieces are fitted in parallel: the same result with several threads.
+    OneCellSmoothing threaded = smoothing;
+    threaded.Parallel = ThreadedFor;
+    OneCellSmoothingResult again;
+    CHECK(threaded.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, again, error));
+    CHECK(SameResult(result, again));
   }
 }
 
 //------------------------------------------------------------------------------
-TEST_CASE(Timings)
+TEST_CASE(ProgressAbortAndBadInput)
 {
-  std::mt19937 random(1);
-  std::vector<Samples> inputs;
-  for (int i = 0; i < 1000; ++i)
-  {
-    inputs.push_back(MakeSamples(Shape::NoisyRamp, 200, random));
-  }
-  MonotoneBSplineFit fitter;
-  fitter.Segments = 7;
+  Stage3Input input;
   std::string error;
-  HeightFit fit;
-  PlanarCurveFit curve;
-  int failures = 0;
-  auto time = [](auto&& body) {
-    const auto start = std::chrono::steady_clock::now();
-    body();
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  };
-  const double monotone = time([&]() {
-    for (const Samples& s : inputs)
-    {
-      failures += !fitter.FitHeight(s.Parameters, s.Values, s.Start, s.End, true, fit, error);
-    }
-  });
-  const double programSize[2] = { static_cast<double>(fit.ProgramVariables),
-    static_cast<double>(fit.ProgramConstraints) };
-  MonotoneBSplineFit primalOnly = fitter;
-  primalOnly.UseDualProgram = false;
-  const double primal = time([&]() {
-    for (std::size_t i = 0; i < 100; ++i)
-    {
-      const Samples& s = inputs[i];
-      failures += !primalOnly.FitHeight(s.Parameters, s.Values, s.Start, s.End, true, fit, error);
-    }
-  });
-  const double unconstrained = time([&]() {
-    for (const Samples& s : inputs)
-    {
-      failures += !fitter.FitHeight(s.Parameters, s.Values, s.Start, s.End, false, fit, error);
-    }
-  });
-  std::vector<double> points;
-  for (int i = 0; i <= 200; ++i)
-  {
-    points.push_back(std::cos(i / 100.0));
-    points.push_back(std::sin(i / 100.0));
-  }
-  const std::vector<double> t = MonotoneBSplineFit::NormalizedArcLength(points);
-  const double planar = time([&]() {
-    for (int i = 0; i < 1000; ++i)
-    {
-      failures += !fitter.FitPlanarCurve(t, points, curve, error);
-    }
-  });
-  const double conversion = time([&]() {
-    double sum = 0;
-    for (int i = 0; i < 1000; ++i)
-    {
-      sum += fit.Spline.ToCubicBezier().ControlPoints[1];
-      sum += curve.Spline.ToCubicBezier().ControlPoints[1];
-    }
-    failures += !std::isfinite(sum);
-  });
-  CHECK(failures == 0);
-  std::printf("  1000 monotone height fits, n=200, k=7 (%g variables, %g rows): %.3f s (%.2f ms each)\n",
-    programSize[0], programSize[1], monotone, monotone);
-  std::printf("  100 monotone height fits through the primal program only (UseDualProgram off): %.3f s "
-              "(%.2f ms each)\n",
-    primal, 10 * primal);
-  std::printf("  1000 unconstrained height fits, n=200, k=7: %.3f s\n", unconstrained);
-  std::printf("  1000 planar curve fits, n=200, k=7: %.3f s\n", planar);
-  std::printf("  1000 x 2 conversions to cubic Beziers, k=7: %.4f s\n", conversion);
+  CHECK(RunStages1And2(TrigonometricField(10, 60, -29), 1.0, input, error));
+  const MorseSmaleComplex& complex = input.Simplified.Complex;
+  const auto& junctions = input.Simplified.JunctionPoints;
+  OneCellSmoothingResult result;
 
-  // The junction program on many trees of junctions (like the 1-cells of real complexes),
-  // as split components and as one program, and on a long chain (one big component).
+  OneCellSmoothing smoothing;
+  std::vector<double> reported;
+  smoothing.Hooks.Progress = [&reported](double fraction) { reported.push_back(fraction); };
+  CHECK(smoothing.Smooth(complex, junctions, input.Bounds, result, error));
+  CHECK(!reported.empty() && reported.back() == 1.0);
+  CHECK(std::is_sorted(reported.begin(), reported.end()));
+
+  smoothing.Hooks.AbortRequested = []() { return true; };
+  error.clear();
+  CHECK(!smoothing.Smooth(complex, junctions, input.Bounds, result, error) && error == "aborted");
+  smoothing.Hooks = ProgressHooks();
+
+  for (int k : { 1, OneCellSmoothing::MaximumCurveSegments + 1 })
   {
-    std::vector<JunctionValueNode> nodes;
-    std::vector<std::vector<Index>> cells;
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
-    for (int m = 0; m < 100; ++m)
-    {
-      const Index minimum = static_cast<Index>(nodes.size());
-      nodes.push_back({ unit(random), true });
-      std::vector<std::vector<Index>> pathTo = { { minimum } };
-      for (int j = 0; j < 20; ++j)
-      {
-        const std::size_t parent = static_cast<std::size_t>(unit(random) * pathTo.size()) % pathTo.size();
-        pathTo.push_back(pathTo[parent]);
-        pathTo.back().push_back(static_cast<Index>(nodes.size()));
-        nodes.push_back({ nodes[minimum].Value + 0.5 * unit(random) - 0.1, false });
-      }
-      for (int s = 0; s < 8; ++s)
-      {
-        cells.push_back(pathTo[1 + static_cast<std::size_t>(unit(random) * 20) % 20]);
-        cells.back().push_back(static_cast<Index>(nodes.size()));
-        nodes.push_back({ nodes[minimum].Value + 0.5 + unit(random), true });
-      }
-    }
-    const auto relations = RelationsOf(cells);
-    JunctionValueProgram program;
-    std::vector<double> values;
-    const double split = time([&]() { failures += !program.Solve(nodes, relations, values, error); });
-    CHECK(SatisfiesRelations(values, relations));
-    const int programs = program.NumberOfPrograms;
-    const int largest = program.LargestProgram;
-    program.SplitIntoComponents = false;
-    const double single = time([&]() { failures += !program.Solve(nodes, relations, values, error); });
-    CHECK(SatisfiesRelations(values, relations));
-    std::printf("  junction program, 100 trees of 20 junctions (%zu relations): split %.3f s (%d programs, largest %d "
-                "junctions), single program %.3f s\n",
-      relations.size(), split, programs, largest, single);
+    smoothing.Segments = k;
+    error.clear();
+    CHECK(!smoothing.Smooth(complex, junctions, input.Bounds, result, error) && !error.empty());
   }
-  for (int size : { 200, 2000 })
-  {
-    std::vector<JunctionValueNode> nodes = { { 0.0, true } };
-    std::vector<std::array<Index, 2>> relations;
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
-    for (int j = 1; j <= size; ++j)
-    {
-      nodes.push_back({ unit(random), false });
-      relations.push_back({ j - 1, j });
-    }
-    nodes.push_back({ 1.0, true });
-    relations.push_back({ size, size + 1 });
-    JunctionValueProgram program;
-    std::vector<double> values;
-    const double chain = time([&]() { failures += !program.Solve(nodes, relations, values, error); });
-    CHECK(SatisfiesRelations(values, relations));
-    std::printf("  junction program, one chain of %d junctions: %.3f s (margin %.2e)\n", size, chain, program.Margin);
-  }
-  CHECK(failures == 0);
+  smoothing.Segments = 4;
+  error.clear();
+  CHECK(!smoothing.Smooth(MorseSmaleComplex(), {}, input.Bounds, result, error));
+  CHECK(error == "the complex has no 1-cells");
 }
 
 int main()
