@@ -1,5 +1,7 @@
 #include "MonotoneSibsonSurface.h"
 
+#include "BezierSpline.h"
+
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 
@@ -13,19 +15,6 @@ namespace topospline
 {
 //------------------------------------------------------------------------------------------
 // Boundary curves
-void SplitCubicSegment(const CubicHeightSegment& c, double s, CubicHeightSegment& left, CubicHeightSegment& right)
-{
-  const double r = 1 - s;
-  const double c01 = r * c[0] + s * c[1];
-  const double c12 = r * c[1] + s * c[2];
-  const double c23 = r * c[2] + s * c[3];
-  const double c012 = r * c01 + s * c12;
-  const double c123 = r * c12 + s * c23;
-  const double c0123 = r * c012 + s * c123;
-  left = { { c[0], c01, c012, c0123 } };
-  right = { { c0123, c123, c23, c[3] } };
-}
-
 bool SubdivideSide(const BezierSide& side, int targetCount, BezierSide& result)
 {
   result.clear();
@@ -44,7 +33,8 @@ bool SubdivideSide(const BezierSide& side, int targetCount, BezierSide& result)
     for (int k = 0; k < pieces - 1; ++k)
     {
       CubicHeightSegment left, right;
-      SplitCubicSegment(remainder, 1.0 / (pieces - k), left, right);
+      CubicBezierSpline::Subdivide(
+        remainder.data(), 1, 1.0 / (pieces - k), left.data(), right.data(), DeCasteljauStep::Weighted);
       result.push_back(left);
       remainder = right;
     }

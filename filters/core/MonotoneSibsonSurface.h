@@ -18,10 +18,6 @@ namespace topospline
 using CubicHeightSegment = std::array<double, 4>;
 using BezierSide = std::vector<CubicHeightSegment>;
 
-// de Casteljau split of one cubic at s in (0,1): `left` covers [0, s], `right` [s, 1].
-void SplitCubicSegment(const CubicHeightSegment& control, double s, CubicHeightSegment& left,
-  CubicHeightSegment& right);
-
 // Splits every segment of `side` into targetCount / side.size() equal parameter pieces, so that
 // the side has `targetCount` segments describing exactly the same function. The grid is
 // uniform, so the split must be uniform too (otherwise the parameter speed, hence the

@@ -1,5 +1,7 @@
 #include "TwoCellReconstruction.h"
 
+#include "BezierSpline.h"
+
 #include "PlanarGeometry.h"
 
 #include <Eigen/Dense>
@@ -404,7 +406,8 @@ std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const
       CubicBezierSpline::Subdivide(whole.Curve[0].data(), 2, 0.5, left.data(), right.data());
       halved.Curve = { left, right };
       CubicHeightSegment lower, upper;
-      SplitCubicSegment(whole.Height[0], 0.5, lower, upper);
+      CubicBezierSpline::Subdivide(
+        whole.Height[0].data(), 1, 0.5, lower.data(), upper.data(), DeCasteljauStep::Weighted);
       halved.Height = { lower, upper };
       halved.Pieces = { 2 };
       whole = std::move(halved);

@@ -12,7 +12,7 @@
 // Usage: TestFieldReconstruction
 // Prints figures per case, then "N passed, N failed"; returns nonzero on failure.
 #include "FieldReconstruction.h"
-#include "PipelineFixture.h"
+#include "TestSupport.h"
 #include "TestHarness.h"
 
 #include <algorithm>

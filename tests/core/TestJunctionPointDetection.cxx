@@ -173,24 +173,6 @@ std::vector<JunctionKey> ExpectedJunctions(const MorseSmaleComplex& c)
   return expected;
 }
 
-PlanarScalarField FieldFromGrid(const GridField& grid)
-{
-  PlanarScalarField field;
-  const int nx = grid.Dimensions[0], ny = grid.Dimensions[1];
-  for (int j = 0; j < ny; ++j)
-  {
-    for (int i = 0; i < nx; ++i)
-    {
-      field.Points.push_back(grid.Origin[0] + i * grid.Spacing[0]);
-      field.Points.push_back(grid.Origin[1] + j * grid.Spacing[1]);
-    }
-  }
-  field.GridDimensions[0] = nx;
-  field.GridDimensions[1] = ny;
-  field.Values = grid.Values;
-  return field;
-}
-
 void CheckAgainstDefinition(const MorseSmaleComplex& complex, const std::string& name)
 {
   const auto found = Keys(DetectJunctionPoints(complex));
@@ -287,7 +269,7 @@ TEST_CASE(ComplexesOfRandomFields)
   int compared = 0, nonEmpty = 0;
   for (std::uint64_t seed = 1; seed <= 6; ++seed)
   {
-    const PlanarScalarField field = FieldFromGrid(ShepardField(8 + 4 * static_cast<int>(seed), 2, 40 + 10 * static_cast<int>(seed), seed));
+    const PlanarScalarField field = FieldOnGrid(ShepardField(8 + 4 * static_cast<int>(seed), 2, 40 + 10 * static_cast<int>(seed), seed));
     MorseSmaleComplexExtraction extraction;
     MorseSmaleComplex input;
     std::string error;

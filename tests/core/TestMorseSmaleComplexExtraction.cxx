@@ -3,6 +3,7 @@
 #include "MorseSmaleComplexExtraction.h"
 #include "SyntheticFields.h"
 #include "TestHarness.h"
+#include "TestSupport.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,26 +15,9 @@ using namespace topospline;
 
 namespace
 {
-PlanarScalarField FieldFromGrid(const GridField& grid)
-{
-  PlanarScalarField field;
-  const int nx = grid.Dimensions[0], ny = grid.Dimensions[1];
-  for (int j = 0; j < ny; ++j)
-  {
-    for (int i = 0; i < nx; ++i)
-    {
-      field.Points.push_back(grid.Origin[0] + i);
-      field.Points.push_back(grid.Origin[1] + j);
-    }
-  }
-  field.Values = grid.Values;
-  field.Triangles = GridTriangles(nx, ny);
-  return field;
-}
-
 // A ParallelFor over real threads with a deliberately uneven split, to show the result does
 // not depend on the partition.
-void ThreadedFor(Index begin, Index end, const RangeBody& body)
+void UnevenThreadedFor(Index begin, Index end, const RangeBody& body)
 {
   const Index n = end - begin;
   const Index cuts[] = { begin, begin + n / 7, begin + n / 2, begin + (5 * n) / 6, end };
@@ -143,7 +127,7 @@ TEST_CASE(TrigonometricFieldCounts)
   // 10 maxima along this boundary loop): 8 interior minima + 10 boundary minima, 9 interior
   // saddles + 10 boundary saddles + 8 where the boundary meets a lower interior, 8 interior
   // maxima + 2 corner maxima. See docs/MorseSmaleComplex.md.
-  const auto field = FieldFromGrid(TrigonometricField(10, 100, -49));
+  const auto field = MeshFieldOnGrid(TrigonometricField(10, 100, -49));
   const auto c = Extract(field);
   const auto n = c.CountByIndex();
   CHECK_EQ(n[0], 18);
@@ -165,16 +149,16 @@ TEST_CASE(ShepardFieldsSeveralSeeds)
 {
   for (int seed = 1; seed <= 6; ++seed)
   {
-    const auto field = FieldFromGrid(ShepardField(50, 2, 150 + 20 * seed, seed));
+    const auto field = MeshFieldOnGrid(ShepardField(50, 2, 150 + 20 * seed, seed));
     CheckInvariants(field, Extract(field));
   }
 }
 
 TEST_CASE(SequentialAndThreadedAgree)
 {
-  const auto field = FieldFromGrid(ShepardField(60, 2, 300, 7));
+  const auto field = MeshFieldOnGrid(ShepardField(60, 2, 300, 7));
   const auto a = Extract(field);
-  const auto b = Extract(field, ThreadedFor);
+  const auto b = Extract(field, UnevenThreadedFor);
   CHECK_EQ(a.CriticalPoints.size(), b.CriticalPoints.size());
   CHECK_EQ(a.OneCells.size(), b.OneCells.size());
   CHECK(a.TwoCellId == b.TwoCellId);
@@ -195,7 +179,7 @@ TEST_CASE(CriticalPointsOnlyWithAGivenMesh)
   // extraction, and no 1-cells.
   for (int seed : { 3, 8 })
   {
-    const auto field = FieldFromGrid(ShepardField(60, 2, 300, seed));
+    const auto field = MeshFieldOnGrid(ShepardField(60, 2, 300, seed));
     const auto full = Extract(field);
     std::string error;
     TriangleMeshTopology mesh;
@@ -231,7 +215,7 @@ TEST_CASE(GridTopologyEqualsGeneralBuild)
     TriangleMeshTopology general, grid;
     std::string error;
     CHECK(general.Build(size[0] * size[1], GridTriangles(size[0], size[1]), SequentialFor, error));
-    grid.BuildGrid(size[0], size[1], ThreadedFor);
+    grid.BuildGrid(size[0], size[1], UnevenThreadedFor);
     CHECK(grid.NumberOfVertices() == general.NumberOfVertices());
     CHECK(grid.EdgeVertices == general.EdgeVertices);
     CHECK(grid.EdgeTriangles == general.EdgeTriangles);
@@ -265,7 +249,7 @@ TEST_CASE(PlateausAreBrokenByVertexId)
   GridField flat;
   flat.Dimensions[0] = flat.Dimensions[1] = 40;
   flat.Values.assign(1600, 3.0);
-  const auto field = FieldFromGrid(flat);
+  const auto field = MeshFieldOnGrid(flat);
   const auto c = Extract(field);
   CheckInvariants(field, c);
   // A field with a large flat area and a bump.
@@ -274,7 +258,7 @@ TEST_CASE(PlateausAreBrokenByVertexId)
   {
     v = std::max(v, 0.0);
   }
-  const auto mesaField = FieldFromGrid(mesa);
+  const auto mesaField = MeshFieldOnGrid(mesa);
   CheckInvariants(mesaField, Extract(mesaField));
 }
 
@@ -309,7 +293,7 @@ TEST_CASE(PouchCellsLieInsideTheirLoop)
     {
       v = std::round(v * 12) / 12;
     }
-    const auto field = FieldFromGrid(terraces);
+    const auto field = MeshFieldOnGrid(terraces);
     const auto c = Extract(field);
     CheckInvariants(field, c);
     for (const TwoCell& cell : c.TwoCells)
@@ -338,7 +322,7 @@ TEST_CASE(InteriorCriticalPointsArePiecewiseLinearOnes)
 {
   // Away from the boundary the discrete gradient's critical cells are the PL critical points:
   // count them independently from the lower links (components of lower neighbours).
-  const auto field = FieldFromGrid(ShepardField(40, 2, 120, 3));
+  const auto field = MeshFieldOnGrid(ShepardField(40, 2, 120, 3));
   const auto c = Extract(field);
   const int n = 120;
   auto lower = [&](Index a, Index b) {
@@ -431,7 +415,7 @@ TEST_CASE(BadInputIsRefusedWithAMessage)
       std::printf("  got \"%s\", expected \"%s\"\n", error.c_str(), expected.c_str());
     }
   };
-  auto field = FieldFromGrid(TrigonometricField(10, 20, 0));
+  auto field = MeshFieldOnGrid(TrigonometricField(10, 20, 0));
   auto nan = field;
   nan.Values[17] = std::numeric_limits<double>::quiet_NaN();
   refuse(nan, "non-finite");

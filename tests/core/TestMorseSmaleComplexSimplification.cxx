@@ -10,6 +10,7 @@
 #include "MorseSmaleComplexSimplification.h"
 #include "SyntheticFields.h"
 #include "TestHarness.h"
+#include "TestSupport.h"
 
 #include <algorithm>
 #include <array>
@@ -57,24 +58,6 @@ struct Failures
     }
   }
 };
-
-PlanarScalarField FieldFromGrid(const GridField& grid)
-{
-  PlanarScalarField field;
-  const int nx = grid.Dimensions[0], ny = grid.Dimensions[1];
-  field.Points.reserve(2 * static_cast<size_t>(nx) * ny);
-  for (int j = 0; j < ny; ++j)
-  {
-    for (int i = 0; i < nx; ++i)
-    {
-      field.Points.push_back(grid.Origin[0] + i * grid.Spacing[0]);
-      field.Points.push_back(grid.Origin[1] + j * grid.Spacing[1]);
-    }
-  }
-  field.Triangles = GridTriangles(nx, ny);
-  field.Values = grid.Values;
-  return field;
-}
 
 double Milliseconds(std::chrono::steady_clock::time_point start)
 {
@@ -469,7 +452,7 @@ struct FieldCase
 void RunField(const FieldCase& fieldCase)
 {
   Failures failures;
-  const PlanarScalarField field = FieldFromGrid(fieldCase.Grid);
+  const PlanarScalarField field = MeshFieldOnGrid(fieldCase.Grid);
   MorseSmaleComplexExtraction extraction;
   MorseSmaleComplex input;
   std::string error;
@@ -648,7 +631,7 @@ TEST_CASE(BadInput)
   error.clear();
   CHECK(!simplification.ComputeHierarchy(MorseSmaleComplex(), error) && !error.empty());
 
-  const PlanarScalarField field = FieldFromGrid(ShepardField(10, 2, 30, 7));
+  const PlanarScalarField field = MeshFieldOnGrid(ShepardField(10, 2, 30, 7));
   MorseSmaleComplexExtraction extraction;
   MorseSmaleComplex input;
   CHECK(extraction.Extract(field, input, error));
@@ -684,7 +667,7 @@ TEST_CASE(BadInput)
 // A simplified complex is again a valid input (two simplification filters in a row).
 TEST_CASE(ChainedSimplification)
 {
-  const PlanarScalarField field = FieldFromGrid(ShepardField(50, 2, 120, 2));
+  const PlanarScalarField field = MeshFieldOnGrid(ShepardField(50, 2, 120, 2));
   MorseSmaleComplexExtraction extraction;
   MorseSmaleComplex input, half, same, chained, direct;
   std::string error;
@@ -706,7 +689,7 @@ TEST_CASE(ChainedSimplification)
 void Benchmark()
 {
   auto start = std::chrono::steady_clock::now();
-  const PlanarScalarField field = FieldFromGrid(ShepardField(50, 2, 1000, 1));
+  const PlanarScalarField field = MeshFieldOnGrid(ShepardField(50, 2, 1000, 1));
   const double generate = Milliseconds(start);
   MorseSmaleComplexExtraction extraction;
   MorseSmaleComplex input;

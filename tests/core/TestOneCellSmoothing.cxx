@@ -35,7 +35,7 @@ struct Stage3Input
 
 bool RunStages1And2(const GridField& grid, double percent, Stage3Input& input, std::string& error)
 {
-  const PlanarScalarField field = StructuredFieldFromGrid(grid);
+  const PlanarScalarField field = FieldOnGrid(grid);
   const int nx = grid.Dimensions[0], ny = grid.Dimensions[1];
   MorseSmaleComplexExtraction extraction;
   MorseSmaleComplexSimplification simplification;

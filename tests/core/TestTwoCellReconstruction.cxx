@@ -14,7 +14,7 @@
 #include "MorseSmaleComplexExtraction.h"
 #include "MorseSmaleComplexSimplification.h"
 #include "OneCellSmoothing.h"
-#include "PipelineFixture.h"
+#include "TestSupport.h"
 #include "SyntheticFields.h"
 #include "TestHarness.h"
 #include "TopologicalSampling.h"
