@@ -461,7 +461,8 @@ void vtkTopoSplineReconstructTwoCells::WarnAbout(const topospline::FieldReconstr
     else if (judged && !c.Identical())
     {
       vtkWarningMacro("Reconstruct 2-Cells: the " << prefix << " sampling of the reconstruction has "
-                      << c.Spurious.size() << " spurious and " << c.Missing.size() << " missing critical point(s) (found "
+                      << c.Spurious.size() << " spurious and " << c.Missing.size()
+                      << " missing critical point(s) (found "
                       << c.Found[0] << "/" << c.Found[1] << "/" << c.Found[2] << ", expected " << c.Expected[0] << "/"
                       << c.Expected[1] << "/" << c.Expected[2] << ").");
     }

@@ -58,7 +58,8 @@ protected:
   int SamplesPerSegment = 16;
 
 private:
-  void ReportAdjustments(const topospline::MorseSmaleComplex& complex, const topospline::OneCellSmoothingResult& result);
+  void ReportAdjustments(
+    const topospline::MorseSmaleComplex& complex, const topospline::OneCellSmoothingResult& result);
 
   vtkTopoSplineSmoothOneCells(const vtkTopoSplineSmoothOneCells&) = delete;
   void operator=(const vtkTopoSplineSmoothOneCells&) = delete;

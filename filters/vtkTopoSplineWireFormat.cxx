@@ -54,130 +54,133 @@ vtkSmartPointer<vtkPolyData> CriticalPointsBlock(const topospline::MorseSmaleCom
 {
   const auto& cps = complex.CriticalPoints;
   auto critical = vtkSmartPointer<vtkPolyData>::New();
-    const vtkIdType n = static_cast<vtkIdType>(cps.size());
-    vtkNew<vtkPoints> points;
-    points->SetDataTypeToDouble();
-    points->SetNumberOfPoints(n);
-    vtkNew<vtkCellArray> verts;
-    auto id = conversion::NewArray<vtkIntArray>(names::CriticalPointId, 1, n);
-    auto index = conversion::NewArray<vtkIntArray>(names::CriticalIndex, 1, n);
-    auto value = conversion::NewArray<vtkDoubleArray>(names::CriticalValue, 1, n);
-    auto vertex = conversion::NewArray<vtkIdTypeArray>(names::VertexId, 1, n);
-    auto cell = conversion::NewArray<vtkIdTypeArray>(names::CriticalCellId, 1, n);
-    auto boundary = conversion::NewArray<vtkCharArray>(names::IsOnBoundary, 1, n);
-    for (vtkIdType i = 0; i < n; ++i)
-    {
-      points->SetPoint(i, domain->GetPoint(cps[i].Vertex));
-      verts->InsertNextCell(1, &i);
-      id->SetValue(i, cps[i].Id);
-      index->SetValue(i, cps[i].MorseIndex);
-      value->SetValue(i, cps[i].Value);
-      vertex->SetValue(i, cps[i].Vertex);
-      cell->SetValue(i, cps[i].Cell);
-      boundary->SetValue(i, cps[i].OnBoundary ? 1 : 0);
-    }
-    critical->SetPoints(points);
-    critical->SetVerts(verts);
-    conversion::AddArrays(critical->GetPointData(), { id, index, value, vertex, cell, boundary });
-    critical->GetPointData()->SetActiveScalars(names::CriticalIndex);
+  const vtkIdType n = static_cast<vtkIdType>(cps.size());
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(n);
+  vtkNew<vtkCellArray> verts;
+  auto id = conversion::NewArray<vtkIntArray>(names::CriticalPointId, 1, n);
+  auto index = conversion::NewArray<vtkIntArray>(names::CriticalIndex, 1, n);
+  auto value = conversion::NewArray<vtkDoubleArray>(names::CriticalValue, 1, n);
+  auto vertex = conversion::NewArray<vtkIdTypeArray>(names::VertexId, 1, n);
+  auto cell = conversion::NewArray<vtkIdTypeArray>(names::CriticalCellId, 1, n);
+  auto boundary = conversion::NewArray<vtkCharArray>(names::IsOnBoundary, 1, n);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    points->SetPoint(i, domain->GetPoint(cps[i].Vertex));
+    verts->InsertNextCell(1, &i);
+    id->SetValue(i, cps[i].Id);
+    index->SetValue(i, cps[i].MorseIndex);
+    value->SetValue(i, cps[i].Value);
+    vertex->SetValue(i, cps[i].Vertex);
+    cell->SetValue(i, cps[i].Cell);
+    boundary->SetValue(i, cps[i].OnBoundary ? 1 : 0);
+  }
+  critical->SetPoints(points);
+  critical->SetVerts(verts);
+  conversion::AddArrays(critical->GetPointData(), { id, index, value, vertex, cell, boundary });
+  critical->GetPointData()->SetActiveScalars(names::CriticalIndex);
   return critical;
 }
 
 // Block 1: the 1-cells as polylines, from source to destination.
-vtkSmartPointer<vtkPolyData> OneCellsBlock(const topospline::MorseSmaleComplex& complex, const conversion::DomainPlane& embedding)
+vtkSmartPointer<vtkPolyData> OneCellsBlock(
+  const topospline::MorseSmaleComplex& complex, const conversion::DomainPlane& embedding)
 {
   const auto& cps = complex.CriticalPoints;
   auto oneCells = vtkSmartPointer<vtkPolyData>::New();
-    vtkIdType nPoints = 0;
-    for (const auto& arc : complex.OneCells)
+  vtkIdType nPoints = 0;
+  for (const auto& oneCell : complex.OneCells)
+  {
+    nPoints += static_cast<vtkIdType>(oneCell.Values.size());
+  }
+  const vtkIdType n = static_cast<vtkIdType>(complex.OneCells.size());
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(nPoints);
+  vtkNew<vtkCellArray> lines;
+  auto along = conversion::NewArray<vtkDoubleArray>(names::ScalarAlong, 1, nPoints);
+  auto meshCell = conversion::NewArray<vtkIdTypeArray>(names::MeshCellId, 1, nPoints);
+  auto id = conversion::NewArray<vtkIntArray>(names::SeparatrixId, 1, n);
+  auto source = conversion::NewArray<vtkIntArray>(names::SourceId, 1, n);
+  auto destination = conversion::NewArray<vtkIntArray>(names::DestinationId, 1, n);
+  auto type = conversion::NewArray<vtkIntArray>(names::SeparatrixType, 1, n);
+  vtkIdType next = 0;
+  std::vector<vtkIdType> ids;
+  for (vtkIdType a = 0; a < n; ++a)
+  {
+    const auto& oneCell = complex.OneCells[a];
+    const vtkIdType count = static_cast<vtkIdType>(oneCell.Values.size());
+    // Ascending sides carry one more point at each end than mesh cells (saddle, maximum).
+    const vtkIdType offset = oneCell.Type == topospline::OneCell::Ascending ? 1 : 0;
+    ids.resize(count);
+    for (vtkIdType p = 0; p < count; ++p)
     {
-      nPoints += static_cast<vtkIdType>(arc.Values.size());
+      double xyz[3];
+      embedding.To3D(&oneCell.Points[2 * p], xyz);
+      points->SetPoint(next, xyz);
+      along->SetValue(next, oneCell.Values[p]);
+      const vtkIdType c = p - offset;
+      const bool inMesh = c >= 0 && c < static_cast<vtkIdType>(oneCell.MeshCells.size());
+      meshCell->SetValue(next, inMesh ? oneCell.MeshCells[c] : -1);
+      ids[p] = next++;
     }
-    const vtkIdType n = static_cast<vtkIdType>(complex.OneCells.size());
-    vtkNew<vtkPoints> points;
-    points->SetDataTypeToDouble();
-    points->SetNumberOfPoints(nPoints);
-    vtkNew<vtkCellArray> lines;
-    auto along = conversion::NewArray<vtkDoubleArray>(names::ScalarAlong, 1, nPoints);
-    auto meshCell = conversion::NewArray<vtkIdTypeArray>(names::MeshCellId, 1, nPoints);
-    auto id = conversion::NewArray<vtkIntArray>(names::SeparatrixId, 1, n);
-    auto source = conversion::NewArray<vtkIntArray>(names::SourceId, 1, n);
-    auto destination = conversion::NewArray<vtkIntArray>(names::DestinationId, 1, n);
-    auto type = conversion::NewArray<vtkIntArray>(names::SeparatrixType, 1, n);
-    vtkIdType next = 0;
-    std::vector<vtkIdType> ids;
-    for (vtkIdType a = 0; a < n; ++a)
-    {
-      const auto& arc = complex.OneCells[a];
-      const vtkIdType count = static_cast<vtkIdType>(arc.Values.size());
-      // Ascending arcs carry one more point at each end than mesh cells (saddle, maximum).
-      const vtkIdType offset = arc.Type == topospline::OneCell::Ascending ? 1 : 0;
-      ids.resize(count);
-      for (vtkIdType p = 0; p < count; ++p)
-      {
-        double xyz[3];
-        embedding.To3D(&arc.Points[2 * p], xyz);
-        points->SetPoint(next, xyz);
-        along->SetValue(next, arc.Values[p]);
-        const vtkIdType c = p - offset;
-        meshCell->SetValue(next, c >= 0 && c < static_cast<vtkIdType>(arc.MeshCells.size()) ? arc.MeshCells[c] : -1);
-        ids[p] = next++;
-      }
-      lines->InsertNextCell(count, ids.data());
-      id->SetValue(a, static_cast<int>(a));
-      source->SetValue(a, cps[arc.Source].Id);
-      destination->SetValue(a, cps[arc.Destination].Id);
-      type->SetValue(a, arc.Type);
-    }
-    oneCells->SetPoints(points);
-    oneCells->SetLines(lines);
-    oneCells->GetPointData()->AddArray(along);
-    oneCells->GetPointData()->AddArray(meshCell);
-    oneCells->GetPointData()->SetActiveScalars(names::ScalarAlong);
-    conversion::AddArrays(oneCells->GetCellData(), { id, source, destination, type });
+    lines->InsertNextCell(count, ids.data());
+    id->SetValue(a, static_cast<int>(a));
+    source->SetValue(a, cps[oneCell.Source].Id);
+    destination->SetValue(a, cps[oneCell.Destination].Id);
+    type->SetValue(a, oneCell.Type);
+  }
+  oneCells->SetPoints(points);
+  oneCells->SetLines(lines);
+  oneCells->GetPointData()->AddArray(along);
+  oneCells->GetPointData()->AddArray(meshCell);
+  oneCells->GetPointData()->SetActiveScalars(names::ScalarAlong);
+  conversion::AddArrays(oneCells->GetCellData(), { id, source, destination, type });
   return oneCells;
 }
 
 // Block 2: one point per 2-cell at its centroid, carrying its corners and sides.
-vtkSmartPointer<vtkPolyData> TwoCellsBlock(const topospline::MorseSmaleComplex& complex, const conversion::DomainPlane& embedding)
+vtkSmartPointer<vtkPolyData> TwoCellsBlock(
+  const topospline::MorseSmaleComplex& complex, const conversion::DomainPlane& embedding)
 {
   const auto& cps = complex.CriticalPoints;
   auto twoCells = vtkSmartPointer<vtkPolyData>::New();
-    const vtkIdType n = static_cast<vtkIdType>(complex.TwoCells.size());
-    vtkNew<vtkPoints> points;
-    points->SetDataTypeToDouble();
-    points->SetNumberOfPoints(n);
-    vtkNew<vtkCellArray> verts;
-    auto id = conversion::NewArray<vtkIntArray>(names::TwoCellId, 1, n);
-    auto minimum = conversion::NewArray<vtkIntArray>(names::MinimumId, 1, n);
-    auto maximum = conversion::NewArray<vtkIntArray>(names::MaximumId, 1, n);
-    auto saddles = conversion::NewArray<vtkIntArray>(names::SaddleIds, 2, n);
-    auto arcs = conversion::NewArray<vtkIntArray>(names::BoundarySeparatrices, 4, n);
-    auto pouch = conversion::NewArray<vtkCharArray>(names::IsPouch, 1, n);
-    auto size = conversion::NewArray<vtkIdTypeArray>(names::NumberOfVertices, 1, n);
-    auto stable = [&](Index cp) { return cp == topospline::InvalidIndex ? -1 : cps[cp].Id; };
-    for (vtkIdType c = 0; c < n; ++c)
+  const vtkIdType n = static_cast<vtkIdType>(complex.TwoCells.size());
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(n);
+  vtkNew<vtkCellArray> verts;
+  auto id = conversion::NewArray<vtkIntArray>(names::TwoCellId, 1, n);
+  auto minimum = conversion::NewArray<vtkIntArray>(names::MinimumId, 1, n);
+  auto maximum = conversion::NewArray<vtkIntArray>(names::MaximumId, 1, n);
+  auto saddles = conversion::NewArray<vtkIntArray>(names::SaddleIds, 2, n);
+  auto sides = conversion::NewArray<vtkIntArray>(names::BoundarySeparatrices, 4, n);
+  auto pouch = conversion::NewArray<vtkCharArray>(names::IsPouch, 1, n);
+  auto size = conversion::NewArray<vtkIdTypeArray>(names::NumberOfVertices, 1, n);
+  auto stable = [&](Index cp) { return cp == topospline::InvalidIndex ? -1 : cps[cp].Id; };
+  for (vtkIdType c = 0; c < n; ++c)
+  {
+    const auto& cell = complex.TwoCells[c];
+    double xyz[3];
+    embedding.To3D(cell.Centroid, xyz);
+    points->SetPoint(c, xyz);
+    verts->InsertNextCell(1, &c);
+    id->SetValue(c, static_cast<int>(c));
+    minimum->SetValue(c, stable(cell.Minimum));
+    maximum->SetValue(c, stable(cell.Maximum));
+    saddles->SetTypedComponent(c, 0, stable(cell.Saddles[0]));
+    saddles->SetTypedComponent(c, 1, stable(cell.Saddles[1]));
+    for (int k = 0; k < 4; ++k)
     {
-      const auto& cell = complex.TwoCells[c];
-      double xyz[3];
-      embedding.To3D(cell.Centroid, xyz);
-      points->SetPoint(c, xyz);
-      verts->InsertNextCell(1, &c);
-      id->SetValue(c, static_cast<int>(c));
-      minimum->SetValue(c, stable(cell.Minimum));
-      maximum->SetValue(c, stable(cell.Maximum));
-      saddles->SetTypedComponent(c, 0, stable(cell.Saddles[0]));
-      saddles->SetTypedComponent(c, 1, stable(cell.Saddles[1]));
-      for (int k = 0; k < 4; ++k)
-      {
-        arcs->SetTypedComponent(c, k, cell.BoundaryOneCells[k]);
-      }
-      pouch->SetValue(c, cell.Pouch ? 1 : 0);
-      size->SetValue(c, cell.NumberOfVertices);
+      sides->SetTypedComponent(c, k, cell.BoundaryOneCells[k]);
     }
-    twoCells->SetPoints(points);
-    twoCells->SetVerts(verts);
-    conversion::AddArrays(twoCells->GetPointData(), { id, minimum, maximum, saddles, arcs, pouch, size });
+    pouch->SetValue(c, cell.Pouch ? 1 : 0);
+    size->SetValue(c, cell.NumberOfVertices);
+  }
+  twoCells->SetPoints(points);
+  twoCells->SetVerts(verts);
+  conversion::AddArrays(twoCells->GetPointData(), { id, minimum, maximum, saddles, sides, pouch, size });
   return twoCells;
 }
 
@@ -187,19 +190,19 @@ vtkSmartPointer<vtkDataSet> SegmentationBlock(const topospline::MorseSmaleComple
   const auto& cps = complex.CriticalPoints;
   vtkSmartPointer<vtkDataSet> segmentation = vtkSmartPointer<vtkDataSet>::Take(domain->NewInstance());
   segmentation->ShallowCopy(domain);
-    const vtkIdType n = domain->GetNumberOfPoints();
-    auto ascending = conversion::NewArray<vtkIntArray>(names::AscendingManifoldId, 1, n);
-    auto descending = conversion::NewArray<vtkIntArray>(names::DescendingManifoldId, 1, n);
-    auto cell = conversion::NewArray<vtkIntArray>(names::TwoCellId, 1, n);
-    for (vtkIdType v = 0; v < n; ++v)
-    {
-      ascending->SetValue(v, cps[complex.AscendingManifold[v]].Id);
-      descending->SetValue(v, cps[complex.DescendingManifold[v]].Id);
-      cell->SetValue(v, complex.TwoCellId[v]);
-    }
-    segmentation->GetPointData()->AddArray(ascending);
-    segmentation->GetPointData()->AddArray(descending);
-    segmentation->GetPointData()->AddArray(cell);
+  const vtkIdType n = domain->GetNumberOfPoints();
+  auto ascending = conversion::NewArray<vtkIntArray>(names::AscendingManifoldId, 1, n);
+  auto descending = conversion::NewArray<vtkIntArray>(names::DescendingManifoldId, 1, n);
+  auto cell = conversion::NewArray<vtkIntArray>(names::TwoCellId, 1, n);
+  for (vtkIdType v = 0; v < n; ++v)
+  {
+    ascending->SetValue(v, cps[complex.AscendingManifold[v]].Id);
+    descending->SetValue(v, cps[complex.DescendingManifold[v]].Id);
+    cell->SetValue(v, complex.TwoCellId[v]);
+  }
+  segmentation->GetPointData()->AddArray(ascending);
+  segmentation->GetPointData()->AddArray(descending);
+  segmentation->GetPointData()->AddArray(cell);
   return segmentation;
 }
 
@@ -592,44 +595,44 @@ vtkSmartPointer<vtkUnstructuredGrid> SmoothedOneCellsBlock(
   vtkNew<vtkCellArray> cells;
   for (Index p = 0; p < static_cast<Index>(smoothed.Pieces.size()); ++p)
   {
-    const auto& smoothedPiece = smoothed.Pieces[p];
-    for (int s = 0; s < smoothedPiece.Curve.Segments; ++s)
-    {
-      const double* curve = smoothedPiece.Curve.Segment(s);
-      const double* h = smoothedPiece.Height.Segment(s);
-      vtkIdType ids[4];
-      for (int m = 0; m < 4; ++m)
-      {
-        double xyz[3];
-        plane.To3D(curve + 2 * CurvePointOfVtkPoint[m], xyz);
-        ids[m] = points->InsertNextPoint(xyz);
-        height->InsertNextValue(h[CurvePointOfVtkPoint[m]]);
-      }
-      cells->InsertNextCell(4, ids);
-      piece->InsertNextValue(p);
-      segments->InsertNextValue(smoothedPiece.Segments);
-      type->InsertNextValue(smoothedPiece.Type);
-    }
-  }
-  bezier->SetPoints(points);
-  bezier->SetCells(VTK_BEZIER_CURVE, cells);
-  bezier->GetPointData()->AddArray(height);
-  bezier->GetPointData()->SetActiveScalars(names::Height);
-  conversion::AddArrays(bezier->GetCellData(), { piece, segments, type });
-  // Which pieces make up every 1-cell, in order from its source: stage 4 assembles the sides of
-  // the 2-cells from them. 1-cell a is SeparatrixPieces[offsets[a] .. offsets[a+1]).
-  auto offsets = conversion::NewArray<vtkIntArray>(names::SeparatrixPieceOffsets);
-  auto list = conversion::NewArray<vtkIntArray>(names::SeparatrixPieces);
-  offsets->InsertNextValue(0);
-  for (const auto& pieces : smoothed.PiecesOfOneCell)
+  const auto& smoothedPiece = smoothed.Pieces[p];
+  for (int s = 0; s < smoothedPiece.Curve.Segments; ++s)
   {
-    for (Index p : pieces)
+    const double* curve = smoothedPiece.Curve.Segment(s);
+    const double* h = smoothedPiece.Height.Segment(s);
+    vtkIdType ids[4];
+    for (int m = 0; m < 4; ++m)
     {
-      list->InsertNextValue(p);
+      double xyz[3];
+      plane.To3D(curve + 2 * CurvePointOfVtkPoint[m], xyz);
+      ids[m] = points->InsertNextPoint(xyz);
+      height->InsertNextValue(h[CurvePointOfVtkPoint[m]]);
     }
-    offsets->InsertNextValue(static_cast<int>(list->GetNumberOfTuples()));
+    cells->InsertNextCell(4, ids);
+    piece->InsertNextValue(p);
+    segments->InsertNextValue(smoothedPiece.Segments);
+    type->InsertNextValue(smoothedPiece.Type);
   }
-  conversion::AddArrays(bezier->GetFieldData(), { offsets, list });
+}
+bezier->SetPoints(points);
+bezier->SetCells(VTK_BEZIER_CURVE, cells);
+bezier->GetPointData()->AddArray(height);
+bezier->GetPointData()->SetActiveScalars(names::Height);
+conversion::AddArrays(bezier->GetCellData(), { piece, segments, type });
+// Which pieces make up every 1-cell, in order from its source: stage 4 assembles the sides of
+// the 2-cells from them. 1-cell a is SeparatrixPieces[offsets[a] .. offsets[a+1]).
+auto offsets = conversion::NewArray<vtkIntArray>(names::SeparatrixPieceOffsets);
+auto list = conversion::NewArray<vtkIntArray>(names::SeparatrixPieces);
+offsets->InsertNextValue(0);
+for (const auto& pieces : smoothed.PiecesOfOneCell)
+{
+  for (Index p : pieces)
+  {
+    list->InsertNextValue(p);
+  }
+  offsets->InsertNextValue(static_cast<int>(list->GetNumberOfTuples()));
+}
+conversion::AddArrays(bezier->GetFieldData(), { offsets, list });
   return bezier;
 }
 
@@ -648,41 +651,41 @@ vtkSmartPointer<vtkPolyData> SampledOneCellsBlock(const topospline::MorseSmaleCo
   std::vector<vtkIdType> ids;
   for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
   {
-    ids.clear();
-    for (Index p : smoothed.PiecesOfOneCell[a])
+  ids.clear();
+  for (Index p : smoothed.PiecesOfOneCell[a])
+  {
+    const auto& piece = smoothed.Pieces[p];
+    const int count = piece.Curve.Segments * samplesPerSegment;
+    for (int s = ids.empty() ? 0 : 1; s <= count; ++s)
     {
-      const auto& piece = smoothed.Pieces[p];
-      const int count = piece.Curve.Segments * samplesPerSegment;
-      for (int s = ids.empty() ? 0 : 1; s <= count; ++s)
-      {
-        const double t = static_cast<double>(s) / count;
-        double uv[2], xyz[3];
-        piece.Curve.Evaluate(t, uv);
-        plane.To3D(uv, xyz);
-        ids.push_back(points->InsertNextPoint(xyz));
-        height->InsertNextValue(piece.Height.Value(t));
-      }
-    }
-    const auto& oneCell = complex.OneCells[a];
-    if (ids.empty())
-    {
-      // A 1-cell of one point (a saddle on its minimum's vertex, zero persistence).
-      double xyz[3];
-      plane.To3D(oneCell.Points.data(), xyz);
+      const double t = static_cast<double>(s) / count;
+      double uv[2], xyz[3];
+      piece.Curve.Evaluate(t, uv);
+      plane.To3D(uv, xyz);
       ids.push_back(points->InsertNextPoint(xyz));
-      height->InsertNextValue(oneCell.Values.front());
+      height->InsertNextValue(piece.Height.Value(t));
     }
-    lines->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
-    id->InsertNextValue(a);
-    source->InsertNextValue(complex.CriticalPoints[oneCell.Source].Id);
-    destination->InsertNextValue(complex.CriticalPoints[oneCell.Destination].Id);
-    type->InsertNextValue(oneCell.Type);
   }
-  sampled->SetPoints(points);
-  sampled->SetLines(lines);
-  sampled->GetPointData()->AddArray(height);
-  sampled->GetPointData()->SetActiveScalars(names::Height);
-  conversion::AddArrays(sampled->GetCellData(), { id, source, destination, type });
+  const auto& oneCell = complex.OneCells[a];
+  if (ids.empty())
+  {
+    // A 1-cell of one point (a saddle on its minimum's vertex, zero persistence).
+    double xyz[3];
+    plane.To3D(oneCell.Points.data(), xyz);
+    ids.push_back(points->InsertNextPoint(xyz));
+    height->InsertNextValue(oneCell.Values.front());
+  }
+  lines->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
+  id->InsertNextValue(a);
+  source->InsertNextValue(complex.CriticalPoints[oneCell.Source].Id);
+  destination->InsertNextValue(complex.CriticalPoints[oneCell.Destination].Id);
+  type->InsertNextValue(oneCell.Type);
+}
+sampled->SetPoints(points);
+sampled->SetLines(lines);
+sampled->GetPointData()->AddArray(height);
+sampled->GetPointData()->SetActiveScalars(names::Height);
+conversion::AddArrays(sampled->GetCellData(), { id, source, destination, type });
   return sampled;
 }
 } // namespace

@@ -253,7 +253,8 @@ void FieldReconstruction::SampleTopologicallyAtVertices(const PlanarScalarField&
 {
   report.Sampled = true;
   report.Exact = report.Values;
-  report.Sampling = this->SamplingOf(complex, mesh, field, smoothed).Apply(field, mesh, [](Index v) { return v; }, report.Values);
+  const auto sameVertex = [](Index v) { return v; };
+  report.Sampling = this->SamplingOf(complex, mesh, field, smoothed).Apply(field, mesh, sameVertex, report.Values);
   for (std::size_t v = 0; v < report.Values.size(); ++v)
   {
     report.Difference[v] = report.Values[v] - field.Values[v];

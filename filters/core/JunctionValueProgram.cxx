@@ -119,7 +119,8 @@ std::string DescribeCycle(const std::vector<JunctionValueNode>& nodes, const Rel
   {
     cycle = DescribeNode(nodes, n) + " < " + cycle;
   }
-  return cycle + " < " + DescribeNode(nodes, at);
+  // The cycle closes where it starts: at < (its predecessors' chain) < at.
+  return DescribeNode(nodes, at) + " < " + cycle;
 }
 
 // Topological order (Kahn); false with the cycle named in `error` when there is none.

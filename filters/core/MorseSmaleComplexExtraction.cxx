@@ -3,6 +3,7 @@
 #include "DisjointSets.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -373,15 +374,17 @@ bool TraceOneCells(ExtractionState& state)
   const Index nS = static_cast<Index>(saddles.size());
   std::vector<OneCell> slots(4 * static_cast<size_t>(nS));
   std::vector<unsigned char> traced(4 * static_cast<size_t>(nS), 0);
-  bool cycle = false;
+  std::atomic<bool> cycle(false); // written by every thread that meets one
   state.Parallel(0, nS, [&](Index begin, Index end) {
     for (Index k = begin; k < end; ++k)
     {
       const Index e = state.Complex.CriticalPoints[saddles[k]].Cell;
       for (int side = 0; side < 2; ++side)
       {
-        const bool ends = TraceDescendingOneCell(state, saddles[k], side, slots[4 * k + side]);
-        cycle = cycle || !ends;
+        if (!TraceDescendingOneCell(state, saddles[k], side, slots[4 * k + side]))
+        {
+          cycle = true;
+        }
         traced[4 * k + side] = 1;
       }
       for (int side = 0; side < 2; ++side)
@@ -391,8 +394,10 @@ bool TraceOneCells(ExtractionState& state)
         {
           continue;
         }
-        const bool ends = TraceAscendingOneCell(state, saddles[k], t, slots[4 * k + 2 + side]);
-        cycle = cycle || !ends;
+        if (!TraceAscendingOneCell(state, saddles[k], t, slots[4 * k + 2 + side]))
+        {
+          cycle = true;
+        }
         traced[4 * k + 2 + side] = 1;
       }
     }

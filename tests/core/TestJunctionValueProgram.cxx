@@ -385,6 +385,17 @@ TEST_CASE(OrderConflicts)
   const std::size_t one = error.find("junction node 1 "), two = error.find("junction node 2 "),
                     three = error.find("junction node 3 ");
   CHECK((one < two && two < three) || (two < three && three < one) || (three < one && one < two));
+  // ... and closes where it starts: "a < b < c < a".
+  const std::size_t open = error.find("cycle (") + 7, close = error.find("): ");
+  std::vector<std::string> chain;
+  for (std::size_t at = open; at < close;)
+  {
+    const std::size_t next = std::min(error.find(" < ", at), close);
+    chain.push_back(error.substr(at, next - at));
+    at = next + 3;
+  }
+  CHECK_EQ(chain.size(), std::size_t(4));
+  CHECK(chain.size() == 4 && chain.front() == chain.back() && chain[0] != chain[1] && chain[1] != chain[2]);
 
   // A critical value below a lower one along a chain of junctions.
   error.clear();
