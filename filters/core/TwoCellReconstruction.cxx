@@ -173,120 +173,87 @@ const Eigen::Matrix<double, 10, 10>& LatticeToControl()
 
 } // namespace
 
-bool AssembleTwoCellSides(const TwoCell& cell, const OneCellSmoothingResult& smoothed, TwoCellSides& sides,
-  std::string& error, bool mergeAtMinimum, bool mergeAtMaximum)
+namespace
 {
-  sides = TwoCellSides();
-  const Index arcs = static_cast<Index>(smoothed.PiecesOfOneCell.size());
-  for (Index a : cell.BoundaryOneCells)
+// Two different descending 1-cells that share their first pieces merge before the minimum: the
+// cell's boundary leaves them where they split, and that junction takes the minimum's corner
+// (mergeAtMinimum, the paper's rule), or the shared stem stays on the boundary as a slit.
+void CutMergedStemAtMinimum(std::vector<Index>& bottom, std::vector<Index>& left, bool mergeAtMinimum,
+  TwoCellSides& sides)
+{
+  std::size_t shared = 0;
+  while (shared < bottom.size() && shared < left.size() && bottom[shared] == left[shared])
   {
-    if (a < 0 || a >= arcs)
+    ++shared;
+  }
+  if (shared > 0 && !mergeAtMinimum)
+  {
+    sides.Slit = true;
+  }
+  else if (shared > 0)
+  {
+    bottom.erase(bottom.begin(), bottom.begin() + shared);
+    left.erase(left.begin(), left.begin() + shared);
+    sides.MinimumShifted = true;
+  }
+}
+
+// The same at the maximum, where ascending 1-cells share their last pieces.
+void CutMergedStemAtMaximum(std::vector<Index>& right, std::vector<Index>& top, bool mergeAtMaximum,
+  TwoCellSides& sides)
+{
+  std::size_t shared = 0;
+  while (shared < right.size() && shared < top.size() && right[right.size() - 1 - shared] == top[top.size() - 1 - shared])
+  {
+    ++shared;
+  }
+  if (shared > 0 && !mergeAtMaximum)
+  {
+    sides.Slit = true;
+  }
+  else if (shared > 0)
+  {
+    right.resize(right.size() - shared);
+    top.resize(top.size() - shared);
+    sides.MaximumShifted = true;
+  }
+}
+
+// A side of zero length (a 1-cell of one point: a saddle on its extremum's vertex) is no side:
+// the cell has 3 corners. Likewise a side that ends where it starts: on the domain boundary, a
+// maximum can sit on its saddle's vertex, and the ascending 1-cell between them is a loop
+// through a few triangles around that vertex (well below a grid cell).
+bool IsPointLike(const std::vector<Index>& side, const OneCellSmoothingResult& smoothed)
+{
+  const Index pieces = static_cast<Index>(smoothed.Pieces.size());
+  if (!side.empty() && side.front() >= 0 && side.back() >= 0 && side.front() < pieces && side.back() < pieces)
+  {
+    const auto& first = smoothed.Pieces[side.front()].Curve.ControlPoints;
+    const auto& last = smoothed.Pieces[side.back()].Curve.ControlPoints;
+    if (!first.empty() && !last.empty() && first[0] == last[last.size() - 2] && first[1] == last.back())
     {
-      error = "a boundary 1-cell is not in the smoothed complex";
+      return true;
+    }
+  }
+  bool degenerate = !side.empty();
+  for (Index p : side)
+  {
+    if (p < 0 || p >= pieces)
+    {
       return false;
     }
+    const auto& points = smoothed.Pieces[p].Curve.ControlPoints;
+    for (std::size_t i = 2; i < points.size() && degenerate; ++i)
+    {
+      degenerate = points[i] == points[i % 2];
+    }
   }
-  const Index d0 = cell.BoundaryOneCells[0], a0 = cell.BoundaryOneCells[1], d1 = cell.BoundaryOneCells[2], a1 = cell.BoundaryOneCells[3];
-  auto& bottom = sides.Pieces[TwoCellSides::Bottom];
-  auto& right = sides.Pieces[TwoCellSides::Right];
-  auto& top = sides.Pieces[TwoCellSides::Top];
-  auto& left = sides.Pieces[TwoCellSides::Left];
-  bottom = smoothed.PiecesOfOneCell[d0];
-  right = smoothed.PiecesOfOneCell[a0];
-  left = smoothed.PiecesOfOneCell[d1];
-  top = smoothed.PiecesOfOneCell[a1];
+  return degenerate;
+}
 
-  // Two different 1-cells that share their first pieces merge before the minimum: the cell's
-  // boundary leaves them where they split, and that junction takes the minimum's corner.
-  // The same 1-cell on both sides (a pouch) is a slit and stays whole.
-  if (d0 != d1)
-  {
-    std::size_t shared = 0;
-    while (shared < bottom.size() && shared < left.size() && bottom[shared] == left[shared])
-    {
-      ++shared;
-    }
-    if (shared > 0 && !mergeAtMinimum)
-    {
-      sides.Slit = true;
-    }
-    else if (shared > 0)
-    {
-      bottom.erase(bottom.begin(), bottom.begin() + shared);
-      left.erase(left.begin(), left.begin() + shared);
-      sides.MinimumShifted = true;
-    }
-  }
-  else
-  {
-    sides.Slit = true;
-  }
-  if (a0 != a1)
-  {
-    std::size_t shared = 0;
-    while (shared < right.size() && shared < top.size() &&
-      right[right.size() - 1 - shared] == top[top.size() - 1 - shared])
-    {
-      ++shared;
-    }
-    if (shared > 0 && !mergeAtMaximum)
-    {
-      sides.Slit = true;
-    }
-    else if (shared > 0)
-    {
-      right.resize(right.size() - shared);
-      top.resize(top.size() - shared);
-      sides.MaximumShifted = true;
-    }
-  }
-  else if (sides.Slit)
-  {
-    error = "both pairs of sides are the same 1-cell";
-    return false;
-  }
-  else
-  {
-    sides.Slit = true;
-  }
-  // A side of zero length (a 1-cell of one point: a saddle on its extremum's vertex) is no
-  // side: the cell has 3 corners. Likewise a side that ends where it starts: on the domain
-  // boundary, a maximum can sit on its saddle's vertex, and the ascending 1-cell between them
-  // is a loop through a few triangles around that vertex (well below a grid cell).
-  for (auto& side : sides.Pieces)
-  {
-    if (!side.empty() && side.front() >= 0 && side.back() >= 0 &&
-      side.front() < static_cast<Index>(smoothed.Pieces.size()) &&
-      side.back() < static_cast<Index>(smoothed.Pieces.size()))
-    {
-      const auto& first = smoothed.Pieces[side.front()].Curve.ControlPoints;
-      const auto& last = smoothed.Pieces[side.back()].Curve.ControlPoints;
-      if (!first.empty() && !last.empty() && first[0] == last[last.size() - 2] && first[1] == last.back())
-      {
-        side.clear();
-        continue;
-      }
-    }
-    bool degenerate = !side.empty();
-    for (Index p : side)
-    {
-      if (p < 0 || p >= static_cast<Index>(smoothed.Pieces.size()))
-      {
-        degenerate = false;
-        break;
-      }
-      const auto& points = smoothed.Pieces[p].Curve.ControlPoints;
-      for (std::size_t i = 2; i < points.size() && degenerate; ++i)
-      {
-        degenerate = points[i] == points[i % 2];
-      }
-    }
-    if (degenerate)
-    {
-      side.clear();
-    }
-  }
-  // An empty side takes half of its partner in the pair Bottom + Right or Left + Top.
+// An empty side takes half of its partner in the pair Bottom + Right or Left + Top.
+bool PairEmptySides(TwoCellSides& sides, std::string& error)
+{
   const int partner[4] = { TwoCellSides::Right, TwoCellSides::Bottom, TwoCellSides::Left, TwoCellSides::Top };
   for (int s = 0; s < 4; ++s)
   {
@@ -300,9 +267,14 @@ bool AssembleTwoCellSides(const TwoCell& cell, const OneCellSmoothingResult& smo
       sides.SplitSides[s == TwoCellSides::Bottom || s == TwoCellSides::Right ? 0 : 1] = partner[s];
     }
   }
-  for (int s = 0; s < 4; ++s)
+  return true;
+}
+
+bool PiecesHaveCurves(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed, std::string& error)
+{
+  for (const auto& side : sides.Pieces)
   {
-    for (Index p : sides.Pieces[s])
+    for (Index p : side)
     {
       if (p < 0 || p >= static_cast<Index>(smoothed.Pieces.size()) || smoothed.Pieces[p].Curve.Segments < 1 ||
         smoothed.Pieces[p].Height.Segments != smoothed.Pieces[p].Curve.Segments)
@@ -313,6 +285,62 @@ bool AssembleTwoCellSides(const TwoCell& cell, const OneCellSmoothingResult& smo
     }
   }
   return true;
+}
+} // namespace
+
+bool AssembleTwoCellSides(const TwoCell& cell, const OneCellSmoothingResult& smoothed, TwoCellSides& sides,
+  std::string& error, bool mergeAtMinimum, bool mergeAtMaximum)
+{
+  sides = TwoCellSides();
+  const Index oneCells = static_cast<Index>(smoothed.PiecesOfOneCell.size());
+  for (Index a : cell.BoundaryOneCells)
+  {
+    if (a < 0 || a >= oneCells)
+    {
+      error = "a boundary 1-cell is not in the smoothed complex";
+      return false;
+    }
+  }
+  const Index d0 = cell.BoundaryOneCells[0], a0 = cell.BoundaryOneCells[1];
+  const Index d1 = cell.BoundaryOneCells[2], a1 = cell.BoundaryOneCells[3];
+  auto& bottom = sides.Pieces[TwoCellSides::Bottom];
+  auto& right = sides.Pieces[TwoCellSides::Right];
+  auto& top = sides.Pieces[TwoCellSides::Top];
+  auto& left = sides.Pieces[TwoCellSides::Left];
+  bottom = smoothed.PiecesOfOneCell[d0];
+  right = smoothed.PiecesOfOneCell[a0];
+  left = smoothed.PiecesOfOneCell[d1];
+  top = smoothed.PiecesOfOneCell[a1];
+  // The same 1-cell on both sides of a pair (a pouch) is a slit and stays whole.
+  if (d0 != d1)
+  {
+    CutMergedStemAtMinimum(bottom, left, mergeAtMinimum, sides);
+  }
+  else
+  {
+    sides.Slit = true;
+  }
+  if (a0 != a1)
+  {
+    CutMergedStemAtMaximum(right, top, mergeAtMaximum, sides);
+  }
+  else if (sides.Slit)
+  {
+    error = "both pairs of sides are the same 1-cell";
+    return false;
+  }
+  else
+  {
+    sides.Slit = true;
+  }
+  for (auto& side : sides.Pieces)
+  {
+    if (IsPointLike(side, smoothed))
+    {
+      side.clear();
+    }
+  }
+  return PairEmptySides(sides, error) && PiecesHaveCurves(sides, smoothed, error);
 }
 
 int ChooseGridLayout(const std::array<SideSegments, 4>& sides, int maximum, std::array<std::vector<int>, 4>& multipliers)
