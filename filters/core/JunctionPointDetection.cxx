@@ -48,21 +48,21 @@ Index Following(const MorseSmaleComplex& complex, const PathFromExtremum& path, 
 std::vector<Index> TreeOfCell(const MorseSmaleComplex& complex, OneCell::Kind kind)
 {
   Index bound = 0;
-  for (const OneCell& arc : complex.OneCells)
+  for (const OneCell& oneCell : complex.OneCells)
   {
-    if (arc.Type == kind)
+    if (oneCell.Type == kind)
     {
-      for (Index c : arc.MeshCells)
+      for (Index c : oneCell.MeshCells)
       {
         bound = std::max(bound, c + 1);
       }
     }
   }
   std::vector<Index> tree(bound, InvalidIndex);
-  for (const OneCell& arc : complex.OneCells)
+  for (const OneCell& oneCell : complex.OneCells)
   {
-    const PathFromExtremum path{ arc };
-    if (arc.Type != kind)
+    const PathFromExtremum path{ oneCell };
+    if (oneCell.Type != kind)
     {
       continue;
     }

@@ -72,28 +72,28 @@ double TurningAngle(double rx, double ry, double dx, double dy)
 } // namespace
 
 void MorseSmaleComplexExtraction::SortAroundExtremum(const MorseSmaleComplex& complex,
-  const std::vector<double>& saddleEnds, Index extremum, std::vector<Index>& arcs)
+  const std::vector<double>& saddleEnds, Index extremum, std::vector<Index>& oneCells)
 {
   // The 1-cells of an extremum form a planar tree rooted at it (V-paths merge and never
   // split): descending ones as vertex paths, ascending ones as triangle paths (through the
   // centroids). Order its leaves counter-clockwise: compare two paths where they diverge by
   // the turning angle of their next step from the way back (from +x at the root).
   const bool minimum = complex.CriticalPoints[extremum].MorseIndex == 0;
-  std::sort(arcs.begin(), arcs.end());
-  std::vector<std::vector<std::array<double, 2>>> paths(arcs.size());
-  for (size_t k = 0; k < arcs.size(); ++k)
+  std::sort(oneCells.begin(), oneCells.end());
+  std::vector<std::vector<std::array<double, 2>>> paths(oneCells.size());
+  for (size_t k = 0; k < oneCells.size(); ++k)
   {
-    const OneCell& arc = complex.OneCells[arcs[k]];
+    const OneCell& oneCell = complex.OneCells[oneCells[k]];
     // From the extremum outwards; ascending 1-cells are stored from the saddle.
-    for (size_t p = 0; p < arc.Values.size(); ++p)
+    for (size_t p = 0; p < oneCell.Values.size(); ++p)
     {
-      const size_t i = minimum ? p : arc.Values.size() - 1 - p;
-      paths[k].push_back({ arc.Points[2 * i], arc.Points[2 * i + 1] });
+      const size_t i = minimum ? p : oneCell.Values.size() - 1 - p;
+      paths[k].push_back({ oneCell.Points[2 * i], oneCell.Points[2 * i + 1] });
     }
-    paths[k].push_back({ saddleEnds[2 * arcs[k]], saddleEnds[2 * arcs[k] + 1] });
+    paths[k].push_back({ saddleEnds[2 * oneCells[k]], saddleEnds[2 * oneCells[k] + 1] });
   }
   auto pathOf = [&](Index a) -> const std::vector<std::array<double, 2>>& {
-    return paths[std::lower_bound(arcs.begin(), arcs.end(), a) - arcs.begin()];
+    return paths[std::lower_bound(oneCells.begin(), oneCells.end(), a) - oneCells.begin()];
   };
   auto less = [&](Index ia, Index ib) {
     const auto& pa = pathOf(ia);
@@ -118,10 +118,10 @@ void MorseSmaleComplexExtraction::SortAroundExtremum(const MorseSmaleComplex& co
     const double ab = TurningAngle(rx, ry, pb[k][0] - node[0], pb[k][1] - node[1]);
     return aa != ab ? aa < ab : ia < ib;
   };
-  // Sort a copy: `less` finds paths in `arcs`, which must stay sorted by id meanwhile.
-  std::vector<Index> sorted = arcs;
+  // Sort a copy: `less` finds paths in `oneCells`, which must stay sorted by id meanwhile.
+  std::vector<Index> sorted = oneCells;
   std::sort(sorted.begin(), sorted.end(), less);
-  arcs = sorted;
+  oneCells = sorted;
 }
 
 namespace
@@ -191,13 +191,13 @@ struct ExtractionState
   {
     return this->Complex.AscendingManifold[a] == this->Complex.AscendingManifold[b];
   }
-  // The 1-cell next to `arc` around its extremum: counter-clockwise (+1) or clockwise (-1).
-  Index NeighbourAround(Index arc, int direction) const
+  // The 1-cell next to `oneCell` around its extremum: counter-clockwise (+1) or clockwise (-1).
+  Index NeighbourAround(Index oneCell, int direction) const
   {
-    const OneCell& sep = this->Complex.OneCells[arc];
+    const OneCell& sep = this->Complex.OneCells[oneCell];
     const auto& around = this->OneCellsAround[sep.Type == OneCell::Descending ? sep.Source : sep.Destination];
     const Index n = static_cast<Index>(around.size());
-    return around[(this->PlaceAround[arc] + n + direction) % n];
+    return around[(this->PlaceAround[oneCell] + n + direction) % n];
   }
   // The minimum and maximum of the 2-cell a sector is a corner of.
   std::pair<Index, Index> GroupKey(Index i) const
@@ -292,14 +292,14 @@ void AppendPoint(const PlanarScalarField& field, Index v, std::vector<double>& p
 // The descending 1-cell of saddle `saddle` through the endpoint `side` of its edge: the
 // vertex V-path from there down to a minimum, stored from the minimum. Returns false if the
 // path does not end (a cycle of the gradient).
-bool TraceDescendingOneCell(const ExtractionState& state, Index saddle, int side, OneCell& arc)
+bool TraceDescendingOneCell(const ExtractionState& state, Index saddle, int side, OneCell& oneCell)
 {
   const PlanarScalarField& field = state.Field;
   const Index nV = state.NumberOfVertices;
   const CriticalPoint& cp = state.Complex.CriticalPoints[saddle];
   const Index owner = cp.Vertex;
-  arc.Type = OneCell::Descending;
-  arc.Destination = saddle;
+  oneCell.Type = OneCell::Descending;
+  oneCell.Destination = saddle;
   std::vector<Index> cells{ owner };
   Index u = state.Mesh.EdgeVertices[cp.Cell][side];
   if (u != owner)
@@ -312,12 +312,12 @@ bool TraceDescendingOneCell(const ExtractionState& state, Index saddle, int side
     cells.push_back(u);
   }
   const bool ends = state.NextVertex(u) == InvalidIndex;
-  arc.Source = state.MinimumOfVertex[u];
-  arc.MeshCells.assign(cells.rbegin(), cells.rend());
-  for (Index v : arc.MeshCells)
+  oneCell.Source = state.MinimumOfVertex[u];
+  oneCell.MeshCells.assign(cells.rbegin(), cells.rend());
+  for (Index v : oneCell.MeshCells)
   {
-    AppendPoint(field, v, arc.Points);
-    arc.Values.push_back(state.Values[v]);
+    AppendPoint(field, v, oneCell.Points);
+    oneCell.Values.push_back(state.Values[v]);
   }
   return ends;
 }
@@ -325,25 +325,25 @@ bool TraceDescendingOneCell(const ExtractionState& state, Index saddle, int side
 // The ascending 1-cell of `saddle` that starts at triangle t of its edge: the triangle
 // V-path up to a maximum, through the triangles' centroids, from the saddle's vertex to the
 // maximum's. Returns false if the path does not end (a cycle of the gradient).
-bool TraceAscendingOneCell(const ExtractionState& state, Index saddle, Index t, OneCell& arc)
+bool TraceAscendingOneCell(const ExtractionState& state, Index saddle, Index t, OneCell& oneCell)
 {
   const PlanarScalarField& field = state.Field;
   const TriangleMeshTopology& mesh = state.Mesh;
   const double* f = state.Values;
   const auto& cps = state.Complex.CriticalPoints;
   const Index owner = cps[saddle].Vertex;
-  arc.Type = OneCell::Ascending;
-  arc.Source = saddle;
-  AppendPoint(field, owner, arc.Points);
-  arc.Values.push_back(f[owner]);
-  arc.MeshCells.push_back(t);
-  while (state.NextTriangle(t) != InvalidIndex && static_cast<Index>(arc.MeshCells.size()) <= mesh.NumberOfTriangles())
+  oneCell.Type = OneCell::Ascending;
+  oneCell.Source = saddle;
+  AppendPoint(field, owner, oneCell.Points);
+  oneCell.Values.push_back(f[owner]);
+  oneCell.MeshCells.push_back(t);
+  while (state.NextTriangle(t) != InvalidIndex && static_cast<Index>(oneCell.MeshCells.size()) <= mesh.NumberOfTriangles())
   {
     t = state.NextTriangle(t);
-    arc.MeshCells.push_back(t);
+    oneCell.MeshCells.push_back(t);
   }
   const bool ends = state.NextTriangle(t) == InvalidIndex;
-  for (Index cell : arc.MeshCells)
+  for (Index cell : oneCell.MeshCells)
   {
     const auto& tv = mesh.TriangleVertices[cell];
     double c[2] = { 0, 0 };
@@ -354,14 +354,14 @@ bool TraceAscendingOneCell(const ExtractionState& state, Index saddle, Index t, 
       c[1] += field.Points[2 * v + 1] / 3;
       value += f[v] / 3;
     }
-    arc.Points.push_back(c[0]);
-    arc.Points.push_back(c[1]);
-    arc.Values.push_back(value);
+    oneCell.Points.push_back(c[0]);
+    oneCell.Points.push_back(c[1]);
+    oneCell.Values.push_back(value);
   }
-  arc.Destination = state.MaximumOfTriangle[t];
-  const Index top = cps[arc.Destination].Vertex;
-  AppendPoint(field, top, arc.Points);
-  arc.Values.push_back(f[top]);
+  oneCell.Destination = state.MaximumOfTriangle[t];
+  const Index top = cps[oneCell.Destination].Vertex;
+  AppendPoint(field, top, oneCell.Points);
+  oneCell.Values.push_back(f[top]);
   return ends;
 }
 
@@ -434,21 +434,21 @@ void CutMeshAlongOneCells(ExtractionState& state)
   std::vector<unsigned char>& onOneCell = state.OnOneCell;
   onOneCell.assign(nV, 0);
   std::vector<unsigned char> crossed(mesh.NumberOfEdges(), 0);
-  for (const OneCell& arc : complex.OneCells)
+  for (const OneCell& oneCell : complex.OneCells)
   {
-    if (arc.Type == OneCell::Descending)
+    if (oneCell.Type == OneCell::Descending)
     {
-      for (Index v : arc.MeshCells)
+      for (Index v : oneCell.MeshCells)
       {
         onOneCell[v] = 1;
       }
     }
     else
     {
-      crossed[cps[arc.Source].Cell] = 1;
-      for (size_t i = 0; i + 1 < arc.MeshCells.size(); ++i)
+      crossed[cps[oneCell.Source].Cell] = 1;
+      for (size_t i = 0; i + 1 < oneCell.MeshCells.size(); ++i)
       {
-        crossed[state.Gradient.TriangleEdge[arc.MeshCells[i]]] = 1;
+        crossed[state.Gradient.TriangleEdge[oneCell.MeshCells[i]]] = 1;
       }
     }
   }
@@ -550,10 +550,10 @@ void SortOneCellsAroundExtrema(ExtractionState& state)
   arcsOfExtremum.assign(cps.size(), {});
   for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
   {
-    const OneCell& arc = complex.OneCells[a];
-    const bool descending = arc.Type == OneCell::Descending;
-    arcsOfExtremum[descending ? arc.Source : arc.Destination].push_back(a);
-    const Index edge = cps[descending ? arc.Destination : arc.Source].Cell;
+    const OneCell& oneCell = complex.OneCells[a];
+    const bool descending = oneCell.Type == OneCell::Descending;
+    arcsOfExtremum[descending ? oneCell.Source : oneCell.Destination].push_back(a);
+    const Index edge = cps[descending ? oneCell.Destination : oneCell.Source].Cell;
     for (int c = 0; c < 2; ++c)
     {
       saddleEdgeMidpoints[2 * a + c] = 0.5 *

@@ -29,11 +29,11 @@ public:
   // of the largest structure.
   const TriangleMeshTopology* GivenMesh = nullptr;
 
-  // Sorts `arcs`, 1-cells of `extremum` (descending ones for a minimum, ascending ones for a
+  // Sorts `oneCells`, 1-cells of `extremum` (descending ones for a minimum, ascending ones for a
   // maximum), counter-clockwise around it. `saddleEnds` holds, per 1-cell, the point (x, y)
   // where it ends at its saddle beyond its stored path (the saddle edge's midpoint).
   static void SortAroundExtremum(const MorseSmaleComplex& complex, const std::vector<double>& saddleEnds,
-    Index extremum, std::vector<Index>& arcs);
+    Index extremum, std::vector<Index>& oneCells);
 
   // Intermediate structures, kept for tests and later stages.
   TriangleMeshTopology Mesh;

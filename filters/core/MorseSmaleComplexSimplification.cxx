@@ -150,47 +150,47 @@ bool CheckOneCells(const MorseSmaleComplex& input, std::string& error)
   const auto& cps = input.CriticalPoints;
   const Index nCP = static_cast<Index>(cps.size());
   std::vector<int> descending(nCP, 0), ascending(nCP, 0);
-  const auto& arcs = input.OneCells;
-  for (size_t a = 0; a < arcs.size(); ++a)
+  const auto& oneCells = input.OneCells;
+  for (size_t a = 0; a < oneCells.size(); ++a)
   {
-    const OneCell& arc = arcs[a];
+    const OneCell& oneCell = oneCells[a];
     const std::string name = "1-cell " + std::to_string(a);
-    const size_t n = arc.MeshCells.size();
-    if (std::any_of(arc.MeshCells.begin(), arc.MeshCells.end(), [](Index c) { return c < 0; }))
+    const size_t n = oneCell.MeshCells.size();
+    if (std::any_of(oneCell.MeshCells.begin(), oneCell.MeshCells.end(), [](Index c) { return c < 0; }))
     {
       return Fail(error, name + " has a negative mesh cell id");
     }
-    if (arc.Type == OneCell::Descending)
+    if (oneCell.Type == OneCell::Descending)
     {
-      if (!IsCriticalPointOfIndex(cps, arc.Source, 0) || !IsCriticalPointOfIndex(cps, arc.Destination, 1))
+      if (!IsCriticalPointOfIndex(cps, oneCell.Source, 0) || !IsCriticalPointOfIndex(cps, oneCell.Destination, 1))
       {
         return Fail(error, name + " is descending but does not join a minimum to a saddle");
       }
-      if (n < 1 || arc.Points.size() != 2 * n || arc.Values.size() != n)
+      if (n < 1 || oneCell.Points.size() != 2 * n || oneCell.Values.size() != n)
       {
         return Fail(error, name + ": a descending 1-cell needs 1+ vertices, with one point and value each");
       }
-      if (arc.MeshCells.front() != cps[arc.Source].Vertex || arc.MeshCells.back() != cps[arc.Destination].Vertex)
+      if (oneCell.MeshCells.front() != cps[oneCell.Source].Vertex || oneCell.MeshCells.back() != cps[oneCell.Destination].Vertex)
       {
         return Fail(error, name + " does not run from its minimum's vertex to its saddle's vertex");
       }
-      ++descending[arc.Destination];
+      ++descending[oneCell.Destination];
     }
-    else if (arc.Type == OneCell::Ascending)
+    else if (oneCell.Type == OneCell::Ascending)
     {
-      if (!IsCriticalPointOfIndex(cps, arc.Source, 1) || !IsCriticalPointOfIndex(cps, arc.Destination, 2))
+      if (!IsCriticalPointOfIndex(cps, oneCell.Source, 1) || !IsCriticalPointOfIndex(cps, oneCell.Destination, 2))
       {
         return Fail(error, name + " is ascending but does not join a saddle to a maximum");
       }
-      if (n < 1 || arc.Points.size() != 2 * (n + 2) || arc.Values.size() != n + 2)
+      if (n < 1 || oneCell.Points.size() != 2 * (n + 2) || oneCell.Values.size() != n + 2)
       {
         return Fail(error, name + ": an ascending 1-cell needs 1+ triangles and n+2 points and values");
       }
-      if (arc.MeshCells.back() != cps[arc.Destination].Cell)
+      if (oneCell.MeshCells.back() != cps[oneCell.Destination].Cell)
       {
         return Fail(error, name + " does not end at its maximum's triangle");
       }
-      ++ascending[arc.Source];
+      ++ascending[oneCell.Source];
     }
     else
     {
@@ -213,8 +213,8 @@ bool CheckOneCells(const MorseSmaleComplex& input, std::string& error)
 bool CheckTwoCells(const MorseSmaleComplex& input, std::string& error)
 {
   const auto& cps = input.CriticalPoints;
-  const auto& arcs = input.OneCells;
-  const Index nArcs = static_cast<Index>(arcs.size());
+  const auto& oneCells = input.OneCells;
+  const Index nArcs = static_cast<Index>(oneCells.size());
   for (size_t c = 0; c < input.TwoCells.size(); ++c)
   {
     const TwoCell& cell = input.TwoCells[c];
@@ -232,12 +232,12 @@ bool CheckTwoCells(const MorseSmaleComplex& input, std::string& error)
       }
       const Index d = cell.BoundaryOneCells[2 * k], u = cell.BoundaryOneCells[2 * k + 1];
       if (!IsCriticalPointOfIndex(cps, cell.Saddles[k], 1) || d < 0 || d >= nArcs || u < 0 || u >= nArcs ||
-        arcs[d].Type != OneCell::Descending || arcs[d].Destination != cell.Saddles[k] ||
-        arcs[u].Type != OneCell::Ascending || arcs[u].Source != cell.Saddles[k])
+        oneCells[d].Type != OneCell::Descending || oneCells[d].Destination != cell.Saddles[k] ||
+        oneCells[u].Type != OneCell::Ascending || oneCells[u].Source != cell.Saddles[k])
       {
         return Fail(error, name + " has a corner whose 1-cells do not belong to its saddle");
       }
-      if (arcs[d].Source != cell.Minimum || arcs[u].Destination != cell.Maximum)
+      if (oneCells[d].Source != cell.Minimum || oneCells[u].Destination != cell.Maximum)
       {
         return Fail(error, name + " has a corner whose 1-cells do not reach its minimum and maximum");
       }
@@ -320,17 +320,17 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
 //------------------------------------------------------------------------------
 void MorseSmaleComplexSimplification::IndexOneCellsBySaddle()
 {
-  const auto& arcs = this->Input.OneCells;
+  const auto& oneCells = this->Input.OneCells;
   const Index nCP = static_cast<Index>(this->Input.CriticalPoints.size());
   this->SaddleOneCells.assign(nCP, { InvalidIndex, InvalidIndex, InvalidIndex, InvalidIndex });
-  this->ArcExtremum.resize(arcs.size());
-  for (Index a = 0; a < static_cast<Index>(arcs.size()); ++a)
+  this->ArcExtremum.resize(oneCells.size());
+  for (Index a = 0; a < static_cast<Index>(oneCells.size()); ++a)
   {
-    const OneCell& arc = arcs[a];
-    auto& slots = this->SaddleOneCells[arc.Type == OneCell::Descending ? arc.Destination : arc.Source];
-    const int first = arc.Type == OneCell::Descending ? 0 : 2;
+    const OneCell& oneCell = oneCells[a];
+    auto& slots = this->SaddleOneCells[oneCell.Type == OneCell::Descending ? oneCell.Destination : oneCell.Source];
+    const int first = oneCell.Type == OneCell::Descending ? 0 : 2;
     slots[slots[first] == InvalidIndex ? first : first + 1] = a;
-    this->ArcExtremum[a] = arc.Type == OneCell::Descending ? arc.Source : arc.Destination;
+    this->ArcExtremum[a] = oneCell.Type == OneCell::Descending ? oneCell.Source : oneCell.Destination;
   }
 }
 
@@ -392,8 +392,8 @@ bool MorseSmaleComplexSimplification::FindSaddleCorners(std::string& error)
 }
 
 //------------------------------------------------------------------------------
-// The geometry of a merged 1-cell is the paper's trivial embedding: arc(s'->x) followed by
-// arc(s->x) backwards and arc(s->x'), for the cancelled pair (s, x). All three are paths in
+// The geometry of a merged 1-cell is the paper's trivial embedding: oneCell(s'->x) followed by
+// oneCell(s->x) backwards and oneCell(s->x'), for the cancelled pair (s, x). All three are paths in
 // the gradient forest (V-paths are deterministic, so all 1-cells reaching an extremum form a
 // tree rooted at it), and a cancellation joins the trees of x and x' by the saddle's own
 // cells, so they stay a forest whose trees are the merged regions. Trimming the back-and-forth
@@ -409,16 +409,16 @@ bool MorseSmaleComplexSimplification::FindSaddleCorners(std::string& error)
 // cancelling a saddle against a maximum joins the two triangles of the saddle edge.
 void MorseSmaleComplexSimplification::BuildForests()
 {
-  const auto& arcs = this->Input.OneCells;
+  const auto& oneCells = this->Input.OneCells;
   const Index nCP = static_cast<Index>(this->Input.CriticalPoints.size());
-  const Index nArcs = static_cast<Index>(arcs.size());
+  const Index nArcs = static_cast<Index>(oneCells.size());
 
   Index vertexBound = 0, triangleBound = 0;
-  for (const OneCell& arc : arcs)
+  for (const OneCell& oneCell : oneCells)
   {
-    for (Index c : arc.MeshCells)
+    for (Index c : oneCell.MeshCells)
     {
-      Index& bound = arc.Type == OneCell::Descending ? vertexBound : triangleBound;
+      Index& bound = oneCell.Type == OneCell::Descending ? vertexBound : triangleBound;
       bound = std::max(bound, c + 1);
     }
   }
@@ -431,7 +431,7 @@ void MorseSmaleComplexSimplification::BuildForests()
   this->CriticalPointPosition.assign(2 * static_cast<size_t>(nCP), 0.0);
   for (Index a = 0; a < nArcs; ++a)
   {
-    if (arcs[a].Type == OneCell::Descending)
+    if (oneCells[a].Type == OneCell::Descending)
     {
       this->AddDescendingPath(a, nodeOfVertex);
     }
@@ -479,20 +479,20 @@ void MorseSmaleComplexSimplification::SetCriticalPointPosition(Index cp, const d
 // as edges.
 void MorseSmaleComplexSimplification::AddDescendingPath(Index a, std::vector<Index>& nodeOfVertex)
 {
-  const OneCell& arc = this->Input.OneCells[a];
-  const Index n = static_cast<Index>(arc.MeshCells.size());
+  const OneCell& oneCell = this->Input.OneCells[a];
+  const Index n = static_cast<Index>(oneCell.MeshCells.size());
   Index previous = InvalidIndex;
   for (Index i = 0; i < n; ++i)
   {
     const Index current =
-      this->DescendingNodes.Node(nodeOfVertex, arc.MeshCells[i], &arc.Points[2 * i], arc.Values[i]);
+      this->DescendingNodes.Node(nodeOfVertex, oneCell.MeshCells[i], &oneCell.Points[2 * i], oneCell.Values[i]);
     if (i > 0 && i < n - 1)
     {
       this->DescendingNodes.AddEdge(previous, current);
     }
     if (i == 0)
     {
-      this->RootNode[arc.Source] = current;
+      this->RootNode[oneCell.Source] = current;
     }
     previous = current;
   }
@@ -500,37 +500,37 @@ void MorseSmaleComplexSimplification::AddDescendingPath(Index a, std::vector<Ind
   {
     // A boundary minimum that owns an interior saddle (an epsilon pair of the boundary
     // rule): the 1-cell is that vertex alone, with no saddle step.
-    this->ArcFirstNode[a] = nodeOfVertex[arc.MeshCells[0]];
+    this->ArcFirstNode[a] = nodeOfVertex[oneCell.MeshCells[0]];
   }
   else
   {
-    this->ArcFirstNode[a] = nodeOfVertex[arc.MeshCells[n - 2]];
-    this->ArcLastNode[a] = nodeOfVertex[arc.MeshCells[n - 1]];
+    this->ArcFirstNode[a] = nodeOfVertex[oneCell.MeshCells[n - 2]];
+    this->ArcLastNode[a] = nodeOfVertex[oneCell.MeshCells[n - 1]];
   }
-  this->SetCriticalPointPosition(arc.Source, &arc.Points[0]);
-  this->SetCriticalPointPosition(arc.Destination, &arc.Points[2 * (n - 1)]);
+  this->SetCriticalPointPosition(oneCell.Source, &oneCell.Points[0]);
+  this->SetCriticalPointPosition(oneCell.Destination, &oneCell.Points[2 * (n - 1)]);
 }
 
 // The triangles of ascending 1-cell a as nodes, its steps as edges.
 void MorseSmaleComplexSimplification::AddAscendingPath(Index a, std::vector<Index>& nodeOfTriangle)
 {
-  const OneCell& arc = this->Input.OneCells[a];
-  const Index n = static_cast<Index>(arc.MeshCells.size());
+  const OneCell& oneCell = this->Input.OneCells[a];
+  const Index n = static_cast<Index>(oneCell.MeshCells.size());
   Index previous = InvalidIndex;
   for (Index i = 0; i < n; ++i)
   {
     const Index current =
-      this->AscendingNodes.Node(nodeOfTriangle, arc.MeshCells[i], &arc.Points[2 * (i + 1)], arc.Values[i + 1]);
+      this->AscendingNodes.Node(nodeOfTriangle, oneCell.MeshCells[i], &oneCell.Points[2 * (i + 1)], oneCell.Values[i + 1]);
     if (i > 0)
     {
       this->AscendingNodes.AddEdge(previous, current);
     }
     previous = current;
   }
-  this->ArcFirstNode[a] = nodeOfTriangle[arc.MeshCells[0]];
-  this->RootNode[arc.Destination] = previous;
-  this->SetCriticalPointPosition(arc.Source, &arc.Points[0]);
-  this->SetCriticalPointPosition(arc.Destination, &arc.Points[2 * (n + 1)]);
+  this->ArcFirstNode[a] = nodeOfTriangle[oneCell.MeshCells[0]];
+  this->RootNode[oneCell.Destination] = previous;
+  this->SetCriticalPointPosition(oneCell.Source, &oneCell.Points[0]);
+  this->SetCriticalPointPosition(oneCell.Destination, &oneCell.Points[2 * (n + 1)]);
 }
 
 //------------------------------------------------------------------------------
@@ -1224,14 +1224,14 @@ bool MorseSmaleComplexSimplification::BuildMergedOneCells(
   Replay& replay, const MergedForests& forests, MorseSmaleComplex& out, std::string& error) const
 {
   const auto& cps = this->Input.CriticalPoints;
-  const auto& arcs = this->Input.OneCells;
-  const Index nArcs = static_cast<Index>(arcs.size());
+  const auto& oneCells = this->Input.OneCells;
+  const Index nArcs = static_cast<Index>(oneCells.size());
   replay.OutputOneCell.assign(nArcs, InvalidIndex);
   for (Index a = 0; a < nArcs; ++a)
   {
-    const OneCell& arc = arcs[a];
-    const bool descending = arc.Type == OneCell::Descending;
-    const Index saddle = descending ? arc.Destination : arc.Source;
+    const OneCell& oneCell = oneCells[a];
+    const bool descending = oneCell.Type == OneCell::Descending;
+    const Index saddle = descending ? oneCell.Destination : oneCell.Source;
     if (!replay.Alive[saddle])
     {
       continue;
@@ -1255,7 +1255,7 @@ bool MorseSmaleComplexSimplification::BuildMergedOneCells(
     replay.OutputOneCell[a] = static_cast<Index>(out.OneCells.size());
     out.OneCells.emplace_back();
     OneCell& merged = out.OneCells.back();
-    merged.Type = arc.Type;
+    merged.Type = oneCell.Type;
     merged.Source = descending ? replay.Position[extremum] : replay.Position[saddle];
     merged.Destination = descending ? replay.Position[saddle] : replay.Position[extremum];
     const size_t n = path.size();
@@ -1277,9 +1277,9 @@ bool MorseSmaleComplexSimplification::BuildMergedOneCells(
       // Saddle vertex, triangle centroids from the saddle to the maximum, maximum vertex.
       merged.Points.resize(2 * (n + 2));
       merged.Values.resize(n + 2);
-      merged.Points[0] = arc.Points[0];
-      merged.Points[1] = arc.Points[1];
-      merged.Values[0] = arc.Values[0];
+      merged.Points[0] = oneCell.Points[0];
+      merged.Points[1] = oneCell.Points[1];
+      merged.Values[0] = oneCell.Values[0];
       for (size_t i = 0; i < n; ++i)
       {
         const Index u = path[n - 1 - i];

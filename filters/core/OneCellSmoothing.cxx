@@ -84,15 +84,15 @@ std::vector<Index> AddJunctionNodes(const std::vector<JunctionPoint>& junctions,
 }
 
 // Where along a 1-cell its mesh cell `cell` sits, as an index into its Points; -1 if absent.
-long PointIndexOfCell(const OneCell& arc, Index cell)
+long PointIndexOfCell(const OneCell& oneCell, Index cell)
 {
-  const auto it = std::find(arc.MeshCells.begin(), arc.MeshCells.end(), cell);
-  if (it == arc.MeshCells.end())
+  const auto it = std::find(oneCell.MeshCells.begin(), oneCell.MeshCells.end(), cell);
+  if (it == oneCell.MeshCells.end())
   {
     return -1;
   }
   // Ascending 1-cells carry the saddle's vertex before their first triangle.
-  return static_cast<long>(it - arc.MeshCells.begin()) + (arc.Type == OneCell::Ascending ? 1 : 0);
+  return static_cast<long>(it - oneCell.MeshCells.begin()) + (oneCell.Type == OneCell::Ascending ? 1 : 0);
 }
 
 // Where a 1-cell is cut: (position in its Points, node there).
@@ -166,16 +166,16 @@ public:
   {
   }
 
-  // Cuts `arc` at the corners it passes (not at its ends).
-  void AddCuts(const OneCell& arc, std::vector<SmoothingNode>& nodes, std::vector<Cut>& at)
+  // Cuts `oneCell` at the corners it passes (not at its ends).
+  void AddCuts(const OneCell& oneCell, std::vector<SmoothingNode>& nodes, std::vector<Cut>& at)
   {
     const auto& corners = this->Corners;
-    const long n = static_cast<long>(arc.Values.size());
+    const long n = static_cast<long>(oneCell.Values.size());
     for (long p = 1; p + 1 < n; ++p)
     {
       for (int c = 0; c < 4; ++c)
       {
-        if (arc.Points[2 * p] == corners[c][0] && arc.Points[2 * p + 1] == corners[c][1])
+        if (oneCell.Points[2 * p] == corners[c][0] && oneCell.Points[2 * p + 1] == corners[c][1])
         {
           auto found = this->NodeOfCorner.find({ corners[c][0], corners[c][1] });
           if (found == this->NodeOfCorner.end())
@@ -184,7 +184,7 @@ public:
             node.Type = SmoothingNode::DomainCorner;
             node.Position[0] = corners[c][0];
             node.Position[1] = corners[c][1];
-            node.FieldValue = node.Value = arc.Values[p];
+            node.FieldValue = node.Value = oneCell.Values[p];
             found =
               this->NodeOfCorner.insert({ { corners[c][0], corners[c][1] }, static_cast<Index>(nodes.size()) }).first;
             nodes.push_back(node);
@@ -201,16 +201,16 @@ private:
 };
 
 // Adds the 1-cell's ends to its cuts and orders them along it, one cut per position.
-void AddEndsAndOrderCuts(const OneCell& arc, std::vector<Cut>& at)
+void AddEndsAndOrderCuts(const OneCell& oneCell, std::vector<Cut>& at)
 {
-  const long n = static_cast<long>(arc.Values.size());
+  const long n = static_cast<long>(oneCell.Values.size());
   // A merged 1-cell may pass its own end's vertex before it ends there (the trivial
   // embedding): no cut at its own ends' nodes.
   at.erase(std::remove_if(at.begin(), at.end(),
-             [&](const auto& cut) { return cut.second == arc.Source || cut.second == arc.Destination; }),
+             [&](const auto& cut) { return cut.second == oneCell.Source || cut.second == oneCell.Destination; }),
     at.end());
-  at.push_back({ 0, arc.Source });
-  at.push_back({ n - 1, arc.Destination });
+  at.push_back({ 0, oneCell.Source });
+  at.push_back({ n - 1, oneCell.Destination });
   std::sort(at.begin(), at.end());
   at.erase(std::unique(at.begin(), at.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
     at.end());
@@ -232,25 +232,25 @@ void AddEndsAndOrderCuts(const OneCell& arc, std::vector<Cut>& at)
 
 // The pieces of 1-cell `a` between consecutive cuts; a piece already made by another 1-cell
 // on the same points (merged 1-cells) is shared.
-void AddPiecesOfOneCell(Index a, const OneCell& arc, const std::vector<Cut>& at,
+void AddPiecesOfOneCell(Index a, const OneCell& oneCell, const std::vector<Cut>& at,
   std::map<std::vector<double>, Index>& pieceOfGeometry, OneCellSmoothingResult& result)
 {
-  const long n = static_cast<long>(arc.Values.size());
+  const long n = static_cast<long>(oneCell.Values.size());
   for (size_t k = 0; k + 1 < at.size(); ++k)
   {
     const long from = at[k].first, to = at[k + 1].first;
-    std::vector<double> key(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
-    key.push_back(arc.Type);
+    std::vector<double> key(oneCell.Points.begin() + 2 * from, oneCell.Points.begin() + 2 * (to + 1));
+    key.push_back(oneCell.Type);
     auto found = pieceOfGeometry.find(key);
     if (found == pieceOfGeometry.end())
     {
       SmoothedPiece piece;
-      piece.Type = arc.Type;
+      piece.Type = oneCell.Type;
       piece.StartNode = at[k].second;
       piece.EndNode = at[k + 1].second;
-      piece.Points.assign(arc.Points.begin() + 2 * from, arc.Points.begin() + 2 * (to + 1));
-      piece.Values.assign(arc.Values.begin() + from, arc.Values.begin() + to + 1);
-      if (arc.Type == OneCell::Ascending && to == n - 1 && piece.Values.size() > 2)
+      piece.Points.assign(oneCell.Points.begin() + 2 * from, oneCell.Points.begin() + 2 * (to + 1));
+      piece.Values.assign(oneCell.Values.begin() + from, oneCell.Values.begin() + to + 1);
+      if (oneCell.Type == OneCell::Ascending && to == n - 1 && piece.Values.size() > 2)
       {
         // Every ascending 1-cell into a maximum ends "centroid of the maximum's triangle,
         // maximum's vertex": a segment they would all share. Go straight to the vertex.
@@ -279,14 +279,14 @@ void CutIntoPieces(const MorseSmaleComplex& complex, const std::vector<JunctionP
   result.PiecesOfOneCell.resize(complex.OneCells.size());
   for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
   {
-    const OneCell& arc = complex.OneCells[a];
-    corners.AddCuts(arc, nodes, cuts[a]);
-    AddEndsAndOrderCuts(arc, cuts[a]);
+    const OneCell& oneCell = complex.OneCells[a];
+    corners.AddCuts(oneCell, nodes, cuts[a]);
+    AddEndsAndOrderCuts(oneCell, cuts[a]);
     if (risingCutsOnly)
     {
       KeepRisingCuts(cuts[a], nodes);
     }
-    AddPiecesOfOneCell(a, arc, cuts[a], pieceOfGeometry, result);
+    AddPiecesOfOneCell(a, oneCell, cuts[a], pieceOfGeometry, result);
   }
   // Node positions: the ends of the pieces that meet there.
   for (const SmoothedPiece& piece : result.Pieces)

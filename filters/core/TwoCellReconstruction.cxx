@@ -130,14 +130,14 @@ bool InsidePolygon(const std::vector<double>& polygon, const std::array<double, 
 }
 
 // First and last point of a 1-cell's smoothed curve.
-std::array<double, 2> StartOf(const OneCellSmoothingResult& smoothed, Index arc)
+std::array<double, 2> StartOf(const OneCellSmoothingResult& smoothed, Index oneCell)
 {
-  const SmoothedPiece& piece = smoothed.Pieces[smoothed.PiecesOfOneCell[arc].front()];
+  const SmoothedPiece& piece = smoothed.Pieces[smoothed.PiecesOfOneCell[oneCell].front()];
   return { { piece.Curve.ControlPoints[0], piece.Curve.ControlPoints[1] } };
 }
-std::array<double, 2> EndOf(const OneCellSmoothingResult& smoothed, Index arc)
+std::array<double, 2> EndOf(const OneCellSmoothingResult& smoothed, Index oneCell)
 {
-  const SmoothedPiece& piece = smoothed.Pieces[smoothed.PiecesOfOneCell[arc].back()];
+  const SmoothedPiece& piece = smoothed.Pieces[smoothed.PiecesOfOneCell[oneCell].back()];
   const std::size_t n = piece.Curve.ControlPoints.size();
   return { { piece.Curve.ControlPoints[n - 2], piece.Curve.ControlPoints[n - 1] } };
 }

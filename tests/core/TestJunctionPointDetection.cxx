@@ -32,39 +32,39 @@ CriticalPoint Point(int morseIndex, Index vertex, Index cell)
 // A descending 1-cell along `vertices` (minimum first), vertex v at (v, 0) with value v.
 OneCell Descending(Index minimum, Index saddle, const std::vector<Index>& vertices)
 {
-  OneCell arc;
-  arc.Type = OneCell::Descending;
-  arc.Source = minimum;
-  arc.Destination = saddle;
-  arc.MeshCells = vertices;
+  OneCell oneCell;
+  oneCell.Type = OneCell::Descending;
+  oneCell.Source = minimum;
+  oneCell.Destination = saddle;
+  oneCell.MeshCells = vertices;
   for (Index v : vertices)
   {
-    arc.Points.insert(arc.Points.end(), { static_cast<double>(v), 0.0 });
-    arc.Values.push_back(v);
+    oneCell.Points.insert(oneCell.Points.end(), { static_cast<double>(v), 0.0 });
+    oneCell.Values.push_back(v);
   }
-  return arc;
+  return oneCell;
 }
 
 // An ascending 1-cell along `triangles` (saddle side first), triangle t at (t, 1) with value
 // t; the saddle's and the maximum's vertices at the ends.
 OneCell Ascending(const MorseSmaleComplex& complex, Index saddle, Index maximum, const std::vector<Index>& triangles)
 {
-  OneCell arc;
-  arc.Type = OneCell::Ascending;
-  arc.Source = saddle;
-  arc.Destination = maximum;
-  arc.MeshCells = triangles;
+  OneCell oneCell;
+  oneCell.Type = OneCell::Ascending;
+  oneCell.Source = saddle;
+  oneCell.Destination = maximum;
+  oneCell.MeshCells = triangles;
   const Index first = complex.CriticalPoints[saddle].Vertex, last = complex.CriticalPoints[maximum].Vertex;
-  arc.Points = { static_cast<double>(first), 0.0 };
-  arc.Values = { static_cast<double>(first) };
+  oneCell.Points = { static_cast<double>(first), 0.0 };
+  oneCell.Values = { static_cast<double>(first) };
   for (Index t : triangles)
   {
-    arc.Points.insert(arc.Points.end(), { static_cast<double>(t), 1.0 });
-    arc.Values.push_back(t);
+    oneCell.Points.insert(oneCell.Points.end(), { static_cast<double>(t), 1.0 });
+    oneCell.Values.push_back(t);
   }
-  arc.Points.insert(arc.Points.end(), { static_cast<double>(last), 0.0 });
-  arc.Values.push_back(last);
-  return arc;
+  oneCell.Points.insert(oneCell.Points.end(), { static_cast<double>(last), 0.0 });
+  oneCell.Values.push_back(last);
+  return oneCell;
 }
 
 // (type, extremum, cell, critical point, 1-cells) of each junction, in order.
@@ -101,13 +101,13 @@ std::vector<JunctionKey> ExpectedJunctions(const MorseSmaleComplex& c)
     std::set<std::pair<Index, Index>> inTree;
     for (Index a = 0; a < static_cast<Index>(c.OneCells.size()); ++a)
     {
-      const OneCell& arc = c.OneCells[a];
-      if (arc.Type != type)
+      const OneCell& oneCell = c.OneCells[a];
+      if (oneCell.Type != type)
       {
         continue;
       }
-      std::vector<Index> path = arc.MeshCells;
-      const Index extremum = type == 0 ? arc.Source : arc.Destination;
+      std::vector<Index> path = oneCell.MeshCells;
+      const Index extremum = type == 0 ? oneCell.Source : oneCell.Destination;
       if (type == 1)
       {
         std::reverse(path.begin(), path.end());
@@ -130,7 +130,7 @@ std::vector<JunctionKey> ExpectedJunctions(const MorseSmaleComplex& c)
         }
         else if (type == 1)
         {
-          following = -2 - c.CriticalPoints[arc.Source].Vertex;
+          following = -2 - c.CriticalPoints[oneCell.Source].Vertex;
         }
         auto& list = visits[{ extremum, path[i] }];
         if (list.empty())

@@ -63,19 +63,19 @@ void CheckInvariants(const PlanarScalarField& field, const MorseSmaleComplex& c)
   }
   // OneCells join critical points of consecutive indices; values increase along descending
   // ones (vertex paths) and their end values are the critical values.
-  for (const auto& arc : c.OneCells)
+  for (const auto& oneCell : c.OneCells)
   {
-    const int lower = arc.Type == OneCell::Descending ? 0 : 1;
-    CHECK_EQ(cps[arc.Source].MorseIndex, lower);
-    CHECK_EQ(cps[arc.Destination].MorseIndex, lower + 1);
-    CHECK_EQ(arc.Values.front(), cps[arc.Source].Value);
-    CHECK_EQ(arc.Values.back(), cps[arc.Destination].Value);
-    CHECK_EQ(arc.Points.size(), 2 * arc.Values.size());
-    if (arc.Type == OneCell::Descending)
+    const int lower = oneCell.Type == OneCell::Descending ? 0 : 1;
+    CHECK_EQ(cps[oneCell.Source].MorseIndex, lower);
+    CHECK_EQ(cps[oneCell.Destination].MorseIndex, lower + 1);
+    CHECK_EQ(oneCell.Values.front(), cps[oneCell.Source].Value);
+    CHECK_EQ(oneCell.Values.back(), cps[oneCell.Destination].Value);
+    CHECK_EQ(oneCell.Points.size(), 2 * oneCell.Values.size());
+    if (oneCell.Type == OneCell::Descending)
     {
-      for (size_t k = 1; k < arc.MeshCells.size(); ++k)
+      for (size_t k = 1; k < oneCell.MeshCells.size(); ++k)
       {
-        const Index a = arc.MeshCells[k - 1], b = arc.MeshCells[k];
+        const Index a = oneCell.MeshCells[k - 1], b = oneCell.MeshCells[k];
         CHECK(field.Values[a] < field.Values[b] || (field.Values[a] == field.Values[b] && a < b));
       }
     }
@@ -100,9 +100,9 @@ void CheckInvariants(const PlanarScalarField& field, const MorseSmaleComplex& c)
   }
   // Every saddle corner belongs to exactly one cell: 4 per interior saddle, 2 per boundary one.
   size_t ascending = 0;
-  for (const auto& arc : c.OneCells)
+  for (const auto& oneCell : c.OneCells)
   {
-    ascending += arc.Type == OneCell::Ascending;
+    ascending += oneCell.Type == OneCell::Ascending;
   }
   CHECK_EQ(sectors, 2 * ascending); // one sector on each side of every ascending 1-cell
   // Every vertex lies in exactly one 2-cell, and in the manifolds of that cell's extrema.

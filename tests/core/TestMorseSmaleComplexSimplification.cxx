@@ -262,55 +262,55 @@ void CheckComplex(Failures& failures, const std::string& at, const PlanarScalarF
   std::vector<int> descending(nCP, 0), ascending(nCP, 0);
   for (size_t a = 0; a < c.OneCells.size(); ++a)
   {
-    const OneCell& arc = c.OneCells[a];
+    const OneCell& oneCell = c.OneCells[a];
     const std::string where = at + ", 1-cell " + std::to_string(a);
-    const bool down = arc.Type == OneCell::Descending;
+    const bool down = oneCell.Type == OneCell::Descending;
     const int lowerIndex = down ? 0 : 1;
-    if (!failures.Check(arc.Source >= 0 && arc.Source < nCP && arc.Destination >= 0 && arc.Destination < nCP &&
-          cps[arc.Source].MorseIndex == lowerIndex && cps[arc.Destination].MorseIndex == lowerIndex + 1 &&
-          !arc.MeshCells.empty(),
+    if (!failures.Check(oneCell.Source >= 0 && oneCell.Source < nCP && oneCell.Destination >= 0 && oneCell.Destination < nCP &&
+          cps[oneCell.Source].MorseIndex == lowerIndex && cps[oneCell.Destination].MorseIndex == lowerIndex + 1 &&
+          !oneCell.MeshCells.empty(),
           "1-cells join critical points of consecutive index", where))
     {
       continue;
     }
-    const size_t n = arc.MeshCells.size();
-    nonSimpleArcs += std::set<Index>(arc.MeshCells.begin(), arc.MeshCells.end()).size() != n;
+    const size_t n = oneCell.MeshCells.size();
+    nonSimpleArcs += std::set<Index>(oneCell.MeshCells.begin(), oneCell.MeshCells.end()).size() != n;
     bool ok = true;
     if (down)
     {
-      ++descending[arc.Destination];
-      ok = arc.MeshCells.front() == cps[arc.Source].Vertex && arc.MeshCells.back() == cps[arc.Destination].Vertex &&
-        arc.Points.size() == 2 * n && arc.Values.size() == n;
+      ++descending[oneCell.Destination];
+      ok = oneCell.MeshCells.front() == cps[oneCell.Source].Vertex && oneCell.MeshCells.back() == cps[oneCell.Destination].Vertex &&
+        oneCell.Points.size() == 2 * n && oneCell.Values.size() == n;
       for (size_t i = 0; ok && i < n; ++i)
       {
-        const Index v = arc.MeshCells[i];
-        ok = arc.Points[2 * i] == field.Points[2 * v] && arc.Points[2 * i + 1] == field.Points[2 * v + 1] &&
-          arc.Values[i] == field.Values[v] && (i == 0 || mesh.FindEdge(arc.MeshCells[i - 1], v) != InvalidIndex);
+        const Index v = oneCell.MeshCells[i];
+        ok = oneCell.Points[2 * i] == field.Points[2 * v] && oneCell.Points[2 * i + 1] == field.Points[2 * v + 1] &&
+          oneCell.Values[i] == field.Values[v] && (i == 0 || mesh.FindEdge(oneCell.MeshCells[i - 1], v) != InvalidIndex);
       }
     }
     else
     {
-      ++ascending[arc.Source];
-      const auto& saddleTriangles = mesh.EdgeTriangles[cps[arc.Source].Cell];
-      const Index sv = cps[arc.Source].Vertex, mv = cps[arc.Destination].Vertex;
-      ok = arc.MeshCells.back() == cps[arc.Destination].Cell && arc.Points.size() == 2 * (n + 2) &&
-        arc.Values.size() == n + 2 && (saddleTriangles[0] == arc.MeshCells[0] || saddleTriangles[1] == arc.MeshCells[0]) &&
-        arc.Points[0] == field.Points[2 * sv] && arc.Values[0] == field.Values[sv] &&
-        arc.Points[2 * (n + 1)] == field.Points[2 * mv] && arc.Values[n + 1] == field.Values[mv];
+      ++ascending[oneCell.Source];
+      const auto& saddleTriangles = mesh.EdgeTriangles[cps[oneCell.Source].Cell];
+      const Index sv = cps[oneCell.Source].Vertex, mv = cps[oneCell.Destination].Vertex;
+      ok = oneCell.MeshCells.back() == cps[oneCell.Destination].Cell && oneCell.Points.size() == 2 * (n + 2) &&
+        oneCell.Values.size() == n + 2 && (saddleTriangles[0] == oneCell.MeshCells[0] || saddleTriangles[1] == oneCell.MeshCells[0]) &&
+        oneCell.Points[0] == field.Points[2 * sv] && oneCell.Values[0] == field.Values[sv] &&
+        oneCell.Points[2 * (n + 1)] == field.Points[2 * mv] && oneCell.Values[n + 1] == field.Values[mv];
       for (size_t i = 0; ok && i < n; ++i)
       {
-        const Index t = arc.MeshCells[i];
+        const Index t = oneCell.MeshCells[i];
         double cx = 0, value = 0;
         for (Index v : mesh.TriangleVertices[t])
         {
           cx += field.Points[2 * v] / 3;
           value += field.Values[v] / 3;
         }
-        ok = arc.Points[2 * (i + 1)] == cx && arc.Values[i + 1] == value;
+        ok = oneCell.Points[2 * (i + 1)] == cx && oneCell.Values[i + 1] == value;
         int shared = 0; // consecutive triangles share an edge
         for (Index e : mesh.TriangleEdges[t])
         {
-          shared += i > 0 && mesh.OtherEdgeTriangle(e, t) == arc.MeshCells[i - 1];
+          shared += i > 0 && mesh.OtherEdgeTriangle(e, t) == oneCell.MeshCells[i - 1];
         }
         ok = ok && (i == 0 || shared == 1);
       }
@@ -383,13 +383,13 @@ void CheckComplex(Failures& failures, const std::string& at, const PlanarScalarF
   std::vector<std::vector<Index>> fromExtremum(c.OneCells.size());
   for (size_t a = 0; a < c.OneCells.size(); ++a)
   {
-    const OneCell& arc = c.OneCells[a];
+    const OneCell& oneCell = c.OneCells[a];
     auto& path = fromExtremum[a];
-    path = arc.MeshCells;
-    if (arc.Type == OneCell::Ascending)
+    path = oneCell.MeshCells;
+    if (oneCell.Type == OneCell::Ascending)
     {
       std::reverse(path.begin(), path.end());
-      path.push_back(-2 - cps[arc.Source].Vertex);
+      path.push_back(-2 - cps[oneCell.Source].Vertex);
     }
   }
   std::set<std::tuple<int, Index, Index>> junctionAt;
@@ -401,10 +401,10 @@ void CheckComplex(Failures& failures, const std::string& at, const PlanarScalarF
     std::set<Index> following;
     for (Index a : j.OneCells)
     {
-      const OneCell& arc = c.OneCells[a];
+      const OneCell& oneCell = c.OneCells[a];
       const auto& path = fromExtremum[a];
       const auto it = std::find(path.begin(), path.end(), j.Cell);
-      ok = ok && arc.Type == j.Type && (j.Type == OneCell::Descending ? arc.Source : arc.Destination) == j.Extremum &&
+      ok = ok && oneCell.Type == j.Type && (j.Type == OneCell::Descending ? oneCell.Source : oneCell.Destination) == j.Extremum &&
         it != path.end();
       if (ok)
       {
@@ -417,8 +417,8 @@ void CheckComplex(Failures& failures, const std::string& at, const PlanarScalarF
   std::map<std::pair<int, Index>, std::vector<Index>> arcsOfExtremum;
   for (size_t a = 0; a < c.OneCells.size(); ++a)
   {
-    const OneCell& arc = c.OneCells[a];
-    arcsOfExtremum[{ arc.Type, arc.Type == OneCell::Descending ? arc.Source : arc.Destination }].push_back(a);
+    const OneCell& oneCell = c.OneCells[a];
+    arcsOfExtremum[{ oneCell.Type, oneCell.Type == OneCell::Descending ? oneCell.Source : oneCell.Destination }].push_back(a);
   }
   bool junctionsComplete = true;
   for (const auto& entry : arcsOfExtremum)
