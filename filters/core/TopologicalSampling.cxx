@@ -52,64 +52,119 @@ bool IsExtremum(const Graph& g, const std::vector<double>& values, Index v, bool
   return true;
 }
 
+// Visit marks shared by the searches of a flood pass (fills, ways up): a vertex is visited in a
+// search when its mark equals the search's stamp, so that no search has to clear the marks.
+struct VisitMarks
+{
+  std::vector<unsigned> Mark;
+  unsigned Stamp = 0;
+
+  unsigned NewStamp() { return ++this->Stamp; }
+};
+
+// The order of a priority queue whose top is the earliest key in the sweep (the lowest when
+// ascending, the highest otherwise).
+struct EarliestFirst
+{
+  bool Ascending;
+
+  bool operator()(const Key& a, const Key& b) const { return this->Ascending ? b < a : a < b; }
+};
+using SweepQueue = std::priority_queue<Key, std::vector<Key>, EarliestFirst>;
+
+// One sweep of the floods: its graph (the boundary curve or whole links), its direction (pits
+// are filled when ascending, peaks cut otherwise) and what ends a region: a vertex wanted as
+// `Flag`, or a boundary vertex of `DrainsToBoundary` (if given).
+struct SweepDirection
+{
+  const Graph& Neighbours;
+  bool Ascending;
+  const std::vector<unsigned char>& Wanted;
+  unsigned char Flag;
+  const TriangleMeshTopology* DrainsToBoundary;
+
+  bool Before(const Key& a, const Key& b) const { return this->Ascending ? a < b : b < a; }
+  bool EndsRegion(Index u) const
+  {
+    return (this->Wanted[u] & this->Flag) || (this->DrainsToBoundary && this->DrainsToBoundary->IsBoundaryVertex(u));
+  }
+};
+
 // Removes the unwanted extremum v by a local flood (priority-flood depression filling, the
 // local form of Tierny and Pascucci's sweep): the region grown from v in sweep order up to the
 // first vertex that drains outside it (a neighbour before it, not in the region) or that is a
 // wanted extremum of the same kind, is then re-valued from that outlet inwards, every vertex
 // just past the neighbour it was reached from, so that each has a neighbour before it. Values
-// only move in the sweep direction. A boundary vertex of `drainsToBoundary` (if given) ends the
-// region like a wanted one: the region drains into it and it keeps its value. Returns the
-// number of changed vertices (and appends them to `revalued`, if given).
-Index Fill(const Graph& g, std::vector<double>& values, Index v, bool ascending,
-  const std::vector<unsigned char>& wanted, unsigned char flag, std::vector<unsigned>& mark, unsigned& stamp,
-  const TriangleMeshTopology* drainsToBoundary = nullptr, std::vector<Index>* revalued = nullptr)
+// only move in the sweep direction. A boundary vertex of Sweep.DrainsToBoundary ends the region
+// like a wanted one: the region drains into it and it keeps its value.
+struct LocalFlood
 {
-  auto before = [ascending](const Key& a, const Key& b) { return ascending ? a < b : b < a; };
-  auto later = [&](const Key& a, const Key& b) { return before(b, a); };
-  std::priority_queue<Key, std::vector<Key>, decltype(later)> queue(later);
-  const unsigned seen = ++stamp;
-  mark[v] = seen;
-  queue.push({ values[v], v });
-  std::vector<Index> region;
-  Index outlet = InvalidIndex;
-  while (!queue.empty() && outlet == InvalidIndex)
+  const SweepDirection& Sweep;
+  std::vector<double>& Values;
+  VisitMarks& Visits;
+
+  // Returns the number of changed vertices (and appends them to `revalued`, if given).
+  Index Fill(Index v, std::vector<Index>* revalued)
   {
-    const Index u = queue.top().Vertex;
-    queue.pop();
-    const Key key{ values[u], u };
-    if (u != v && ((wanted[u] & flag) || (drainsToBoundary && drainsToBoundary->IsBoundaryVertex(u))))
+    std::vector<Index> region;
+    const Index outlet = this->GrowRegionToOutlet(v, region);
+    if (outlet == InvalidIndex)
     {
-      outlet = u;
-      break;
+      return 0; // the whole component: nothing to drain into
     }
+    return this->RevalueFromOutlet(outlet, region, revalued);
+  }
+
+private:
+  // Grows the region from v in sweep order; returns its outlet (InvalidIndex: none).
+  Index GrowRegionToOutlet(Index v, std::vector<Index>& region)
+  {
+    const Graph& g = this->Sweep.Neighbours;
+    const std::vector<double>& values = this->Values;
+    std::vector<unsigned>& mark = this->Visits.Mark;
+    SweepQueue queue(EarliestFirst{ this->Sweep.Ascending });
+    const unsigned seen = this->Visits.NewStamp();
+    mark[v] = seen;
+    queue.push({ values[v], v });
+    while (!queue.empty())
+    {
+      const Index u = queue.top().Vertex;
+      queue.pop();
+      if ((u != v && this->Sweep.EndsRegion(u)) || this->DrainsOutside(u, seen))
+      {
+        return u;
+      }
+      region.push_back(u);
+      for (Index i = g.Start[u]; i < g.Start[u + 1]; ++i)
+      {
+        const Index w = g.Adjacent[i];
+        if (mark[w] != seen)
+        {
+          mark[w] = seen;
+          queue.push({ values[w], w });
+        }
+      }
+    }
+    return InvalidIndex;
+  }
+
+  // Whether u has a neighbour before it that the region (the vertices marked `seen`) has not
+  // reached.
+  bool DrainsOutside(Index u, unsigned seen) const
+  {
+    const Graph& g = this->Sweep.Neighbours;
+    const Key key{ this->Values[u], u };
     for (Index i = g.Start[u]; i < g.Start[u + 1]; ++i)
     {
       const Index w = g.Adjacent[i];
-      if (mark[w] != seen && before({ values[w], w }, key))
+      if (this->Visits.Mark[w] != seen && this->Sweep.Before({ this->Values[w], w }, key))
       {
-        outlet = u;
-        break;
+        return true;
       }
     }
-    if (outlet != InvalidIndex)
-    {
-      break;
-    }
-    region.push_back(u);
-    for (Index i = g.Start[u]; i < g.Start[u + 1]; ++i)
-    {
-      const Index w = g.Adjacent[i];
-      if (mark[w] != seen)
-      {
-        mark[w] = seen;
-        queue.push({ values[w], w });
-      }
-    }
+    return false;
   }
-  if (outlet == InvalidIndex)
-  {
-    return 0; // the whole component: nothing to drain into
-  }
+
   // From the outlet inwards, each region vertex gets the first key after the region neighbour
   // it is reached from, in the sweep order: that neighbour's value if the vertex id already
   // orders it after (ties go by id), else one ulp past it. Taking vertices nearest the outlet
@@ -117,53 +172,63 @@ Index Fill(const Graph& g, std::vector<double>& values, Index v, bool ascending,
   // every vertex instead lifted a filled pit above a plateau it lies in (every region vertex
   // past all the plateau vertices around it): a peak, which the cut made a pit again, round
   // after round.
-  const unsigned inRegion = ++stamp;
-  for (Index r : region)
+  Index RevalueFromOutlet(Index outlet, const std::vector<Index>& region, std::vector<Index>* revalued)
   {
-    mark[r] = inRegion;
-  }
-  const double direction = ascending ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
-  auto firstAfter = [&](Index p, Index r) {
-    const double value = values[p];
-    return before({ value, p }, { value, r }) ? Key{ value, r } : Key{ std::nextafter(value, direction), r };
-  };
-  std::priority_queue<Key, std::vector<Key>, decltype(later)> front(later);
-  front.push({ values[outlet], outlet });
-  const unsigned done = ++stamp;
-  Index changed = 0;
-  while (!front.empty())
-  {
-    const Key k = front.top();
-    front.pop();
-    const Index p = k.Vertex;
-    if (p != outlet)
+    const Graph& g = this->Sweep.Neighbours;
+    std::vector<double>& values = this->Values;
+    std::vector<unsigned>& mark = this->Visits.Mark;
+    const unsigned inRegion = this->Visits.NewStamp();
+    for (Index r : region)
     {
-      if (mark[p] != inRegion)
+      mark[r] = inRegion;
+    }
+    SweepQueue front(EarliestFirst{ this->Sweep.Ascending });
+    front.push({ values[outlet], outlet });
+    const unsigned done = this->Visits.NewStamp();
+    Index changed = 0;
+    while (!front.empty())
+    {
+      const Key k = front.top();
+      front.pop();
+      const Index p = k.Vertex;
+      if (p != outlet)
       {
-        continue; // already placed from a nearer neighbour
-      }
-      mark[p] = done;
-      if (values[p] != k.Value)
-      {
-        values[p] = k.Value;
-        ++changed;
-        if (revalued)
+        if (mark[p] != inRegion)
         {
-          revalued->push_back(p);
+          continue; // already placed from a nearer neighbour
+        }
+        mark[p] = done;
+        if (values[p] != k.Value)
+        {
+          values[p] = k.Value;
+          ++changed;
+          if (revalued)
+          {
+            revalued->push_back(p);
+          }
+        }
+      }
+      for (Index i = g.Start[p]; i < g.Start[p + 1]; ++i)
+      {
+        const Index r = g.Adjacent[i];
+        if (mark[r] == inRegion)
+        {
+          front.push(this->FirstAfter(p, r));
         }
       }
     }
-    for (Index i = g.Start[p]; i < g.Start[p + 1]; ++i)
-    {
-      const Index r = g.Adjacent[i];
-      if (mark[r] == inRegion)
-      {
-        front.push(firstAfter(p, r));
-      }
-    }
+    return changed;
   }
-  return changed;
-}
+
+  // The first key of r after its region neighbour p, in the sweep order.
+  Key FirstAfter(Index p, Index r) const
+  {
+    const double direction =
+      this->Sweep.Ascending ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
+    const double value = this->Values[p];
+    return this->Sweep.Before({ value, p }, { value, r }) ? Key{ value, r } : Key{ std::nextafter(value, direction), r };
+  }
+};
 
 // The vertices sharing a triangle with u.
 std::vector<Index> LinkOf(const TriangleMeshTopology& mesh, Index u)
@@ -222,13 +287,14 @@ NearestPoint NearestOnOneCell(const SaddleOneCell& cell, double x, double y)
 // keeping the path off wanted saddles or their lower neighbours; the first two left more
 // saddles off their nodes on the climate field, the last broke convergence.)
 Index RaiseWayUp(const Graph& g, const TriangleMeshTopology& mesh, std::vector<double>& values, Index v,
-  std::vector<unsigned>& mark, unsigned& stamp)
+  VisitMarks& visits)
 {
+  std::vector<unsigned>& mark = visits.Mark;
   const Key top{ values[v], v };
   auto lower = [](const Key& a, const Key& b) { return a < b; };
   std::priority_queue<Key, std::vector<Key>, decltype(lower)> queue(lower); // highest first
   std::unordered_map<Index, Index> parent, depth;
-  const unsigned seen = ++stamp;
+  const unsigned seen = visits.NewStamp();
   mark[v] = seen;
   depth[v] = 0;
   auto visit = [&](Index w, Index from) {
@@ -398,8 +464,8 @@ public:
     : Mesh(mesh)
     , Graphs(mesh)
     , Wanted(mesh.NumberOfVertices(), 0)
-    , Mark(mesh.NumberOfVertices(), 0)
   {
+    this->Visits.Mark.assign(mesh.NumberOfVertices(), 0);
     for (Index v : constraints.Minima)
     {
       this->Wanted[v] |= WantedMinimum;
@@ -455,6 +521,8 @@ private:
         candidates.push_back(v);
       }
     }
+    const SweepDirection direction{ graph, ascending, wanted, flag, wholeLink ? &mesh : nullptr };
+    LocalFlood flood{ direction, values, this->Visits };
     // A fill can leave a vertex next to its region with no lower neighbour (a cut, no higher
     // one) where values differ by a few ulps (a nearly flat patch): such vertices are taken in
     // the same pass, not a round later, so that a pit chain along an ulp-level valley drains in
@@ -472,11 +540,9 @@ private:
         continue;
       }
       ++fills;
-      const Index raised = getsWayUp(v) ? RaiseWayUp(this->Graphs.All, mesh, values, v, this->Mark, this->Stamp) : 0;
+      const Index raised = getsWayUp(v) ? RaiseWayUp(this->Graphs.All, mesh, values, v, this->Visits) : 0;
       revalued.clear();
-      changed += raised > 0 ? raised
-                            : Fill(graph, values, v, ascending, wanted, flag, this->Mark, this->Stamp,
-                                wholeLink ? &mesh : nullptr, &revalued);
+      changed += raised > 0 ? raised : flood.Fill(v, &revalued);
       for (Index r : revalued)
       {
         for (Index i = graph.Start[r]; i < graph.Start[r + 1]; ++i)
@@ -489,10 +555,10 @@ private:
         }
       }
     }
-    if (this->Stamp > std::numeric_limits<unsigned>::max() / 2)
+    if (this->Visits.Stamp > std::numeric_limits<unsigned>::max() / 2)
     {
-      std::fill(this->Mark.begin(), this->Mark.end(), 0u);
-      this->Stamp = 0;
+      std::fill(this->Visits.Mark.begin(), this->Visits.Mark.end(), 0u);
+      this->Visits.Stamp = 0;
     }
     return changed;
   }
@@ -500,9 +566,7 @@ private:
   const TriangleMeshTopology& Mesh;
   VertexGraphs Graphs;
   std::vector<unsigned char> Wanted;
-  // Visit marks of the fills (a vertex is visited when its mark equals Stamp).
-  std::vector<unsigned> Mark;
-  unsigned Stamp = 0;
+  VisitMarks Visits;
 };
 } // namespace
 
@@ -788,32 +852,101 @@ void CountChanges(const std::vector<double>& before, const std::vector<double>& 
 
 namespace
 {
-int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
-  const SamplingConstraints& constraints, double tolerance, double reach, std::vector<double>& values,
-  int maximumRounds, int maximumMissing, const ParallelFor& parallel)
+// The index in `candidates` of the one nearest to `w` within `limit` (the first of equally near
+// ones; candidates.size(): none), skipping those `used` marks (if given).
+std::size_t NearestWithin(const std::vector<double>& p, Index w, const std::vector<Index>& candidates, double limit,
+  const std::vector<char>* used = nullptr)
 {
-  const std::vector<Index>& wantedSaddles = constraints.Saddles;
-  // Values only: the extraction reads neither positions nor triangles (it is given the mesh).
-  PlanarScalarField sampled;
-  const auto& p = field.Points;
   auto distance = [&p](Index a, Index b) { return std::hypot(p[2 * a] - p[2 * b], p[2 * a + 1] - p[2 * b + 1]); };
-  // Unmatched wanted saddles and the found saddles no wanted one claims, for `current`.
-  auto unmatched = [&](const std::vector<double>& current, std::vector<Index>& missing, std::vector<Index>& spare) {
-    sampled.Values = current;
+  std::size_t best = candidates.size();
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+  {
+    if ((!used || !(*used)[i]) && distance(w, candidates[i]) <= limit &&
+      (best == candidates.size() || distance(w, candidates[i]) < distance(w, candidates[best])))
+    {
+      best = i;
+    }
+  }
+  return best;
+}
+
+// The wanted saddles with no found saddle within the tolerance, and the found saddles no wanted
+// one claims.
+struct SaddleMatch
+{
+  std::vector<Index> Missing, Spare;
+
+  // More wanted saddles matched without adding saddles: found saddles beyond the wanted ones
+  // would come with an extremum the enforcement could not remove.
+  bool IsBetterThan(const SaddleMatch& current) const
+  {
+    return this->Missing.size() < current.Missing.size() &&
+      this->Spare.size() + current.Missing.size() <= current.Spare.size() + this->Missing.size();
+  }
+};
+
+// Extracts the saddles of a sampling's values and matches them to the wanted ones, each wanted
+// saddle (in order) to the nearest unclaimed found saddle within the tolerance.
+class SaddleMatcher
+{
+public:
+  SaddleMatcher(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+    const std::vector<Index>& wantedSaddles, double tolerance, const ParallelFor& parallel)
+    : Points(field.Points)
+    , Mesh(mesh)
+    , WantedSaddles(wantedSaddles)
+    , Tolerance(tolerance)
+    , Parallel(parallel)
+  {
+  }
+
+  SaddleMatch Match(const std::vector<double>& values)
+  {
+    SaddleMatch match;
+    std::vector<Index> saddles;
+    if (!this->ExtractSaddles(values, saddles))
+    {
+      match.Missing = this->WantedSaddles;
+      return match;
+    }
+    std::vector<char> used(saddles.size(), 0);
+    for (Index w : this->WantedSaddles)
+    {
+      const std::size_t best = NearestWithin(this->Points, w, saddles, this->Tolerance, &used);
+      if (best < saddles.size())
+      {
+        used[best] = 1;
+      }
+      else
+      {
+        match.Missing.push_back(w);
+      }
+    }
+    for (std::size_t i = 0; i < saddles.size(); ++i)
+    {
+      if (!used[i])
+      {
+        match.Spare.push_back(saddles[i]);
+      }
+    }
+    return match;
+  }
+
+private:
+  // The saddle vertices of the sampling with `values`; false if the extraction fails.
+  bool ExtractSaddles(const std::vector<double>& values, std::vector<Index>& saddles)
+  {
+    this->Sampled.Values = values;
     MorseSmaleComplexExtraction extraction;
     extraction.CriticalPointsOnly = true;
-    extraction.GivenMesh = &mesh;
-    extraction.Parallel = parallel;
+    extraction.GivenMesh = &this->Mesh;
+    extraction.Parallel = this->Parallel;
     MorseSmaleComplex found;
     std::string error;
-    missing.clear();
-    spare.clear();
-    if (!extraction.Extract(sampled, found, error))
+    if (!extraction.Extract(this->Sampled, found, error))
     {
-      missing = wantedSaddles;
-      return;
+      return false;
     }
-    std::vector<Index> saddles;
     for (const CriticalPoint& cp : found.CriticalPoints)
     {
       if (cp.MorseIndex == 1)
@@ -821,65 +954,88 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
         saddles.push_back(cp.Vertex);
       }
     }
-    std::vector<char> used(saddles.size(), 0);
-    for (Index w : wantedSaddles)
-    {
-      std::size_t best = saddles.size();
-      for (std::size_t i = 0; i < saddles.size(); ++i)
-      {
-        if (!used[i] && distance(w, saddles[i]) <= tolerance &&
-          (best == saddles.size() || distance(w, saddles[i]) < distance(w, saddles[best])))
-        {
-          best = i;
-        }
-      }
-      if (best < saddles.size())
-      {
-        used[best] = 1;
-      }
-      else
-      {
-        missing.push_back(w);
-      }
-    }
-    for (std::size_t i = 0; i < saddles.size(); ++i)
-    {
-      if (!used[i])
-      {
-        spare.push_back(saddles[i]);
-      }
-    }
-  };
-  std::vector<Index> missing, spare;
-  unmatched(values, missing, spare);
-  // A trial is kept if it matches more wanted saddles without adding saddles: found saddles
-  // beyond the wanted ones would come with an extremum the enforcement could not remove.
-  auto better = [&](const std::vector<Index>& trialMissing, const std::vector<Index>& trialSpare) {
-    return trialMissing.size() < missing.size() &&
-      trialSpare.size() + missing.size() <= spare.size() + trialMissing.size();
-  };
-  // Floods `trial` again and keeps it if it is better.
-  auto keepIfBetter = [&](std::vector<double>& trial) {
-    EnforceCriticalVertices(mesh, constraints, trial);
-    std::vector<Index> trialMissing, trialSpare;
-    unmatched(trial, trialMissing, trialSpare);
-    if (!better(trialMissing, trialSpare))
+    return true;
+  }
+
+  const std::vector<double>& Points;
+  const TriangleMeshTopology& Mesh;
+  const std::vector<Index>& WantedSaddles;
+  const double Tolerance;
+  const ParallelFor& Parallel;
+  // Values only: the extraction reads neither positions nor triangles (it is given the mesh).
+  PlanarScalarField Sampled;
+};
+
+// The sampling whose saddles RelocateSaddles moves, with its current match; trials are kept
+// only if they match better.
+struct SaddleRelocation
+{
+  const PlanarScalarField& Field;
+  const TriangleMeshTopology& Mesh;
+  const SamplingConstraints& Constraints;
+  double Reach;
+  SaddleMatcher& Matcher;
+  std::vector<double>& Values;
+  SaddleMatch Current;
+
+  // Floods `trial` again and keeps it if it matches better.
+  bool KeepIfBetter(std::vector<double>& trial)
+  {
+    EnforceCriticalVertices(this->Mesh, this->Constraints, trial);
+    SaddleMatch match = this->Matcher.Match(trial);
+    if (!match.IsBetterThan(this->Current))
     {
       return false;
     }
-    values = std::move(trial);
-    missing = std::move(trialMissing);
-    spare = std::move(trialSpare);
+    this->Values = std::move(trial);
+    this->Current = std::move(match);
     return true;
-  };
+  }
+
+  // Carves the 1-cells of every unmatched wanted saddle, in one trial.
+  void TryCarvingMissingOneCells()
+  {
+    std::vector<double> trial = this->Values;
+    for (Index w : this->Current.Missing)
+    {
+      CarveSaddleOneCells(this->Field, this->Mesh, this->Constraints, w, this->Reach, trial);
+    }
+    this->KeepIfBetter(trial);
+  }
+
+  // Moves the nearest spare saddle within reach of each unmatched wanted saddle just past the
+  // wanted saddle's value in `trial`. Returns whether any moved.
+  bool MoveSpareSaddlesPastMissing(std::vector<double>& trial) const
+  {
+    const std::vector<Index>& spare = this->Current.Spare;
+    bool moved = false;
+    for (Index w : this->Current.Missing)
+    {
+      const std::size_t nearest = NearestWithin(this->Field.Points, w, spare, this->Reach);
+      if (nearest == spare.size())
+      {
+        continue;
+      }
+      const Index f = spare[nearest];
+      const bool raise = trial[f] <= trial[w];
+      trial[f] = std::nextafter(
+        trial[w], raise ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity());
+      moved = true;
+    }
+    return moved;
+  }
+};
+
+int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, double tolerance, double reach, std::vector<double>& values,
+  int maximumRounds, int maximumMissing, const ParallelFor& parallel)
+{
+  SaddleMatcher matcher(field, mesh, constraints.Saddles, tolerance, parallel);
+  SaddleRelocation relocation{ field, mesh, constraints, reach, matcher, values, matcher.Match(values) };
+  const std::vector<Index>& missing = relocation.Current.Missing;
   if (!missing.empty() && !constraints.SaddleOneCells.empty())
   {
-    std::vector<double> trial = values;
-    for (Index w : missing)
-    {
-      CarveSaddleOneCells(field, mesh, constraints, w, reach, trial);
-    }
-    keepIfBetter(trial);
+    relocation.TryCarvingMissingOneCells();
   }
   // Each round costs an extraction of the whole sampling: worth it for the few saddles of a
   // flat pass, not when many are missing (a failed 2-cell keeps the input's own saddles).
@@ -890,27 +1046,7 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
   for (int round = 0; round < maximumRounds && !missing.empty(); ++round)
   {
     std::vector<double> trial = values;
-    bool moved = false;
-    for (Index w : missing)
-    {
-      Index nearest = InvalidIndex;
-      for (Index f : spare)
-      {
-        if (distance(w, f) <= reach && (nearest == InvalidIndex || distance(w, f) < distance(w, nearest)))
-        {
-          nearest = f;
-        }
-      }
-      if (nearest == InvalidIndex)
-      {
-        continue;
-      }
-      const bool raise = trial[nearest] <= trial[w];
-      trial[nearest] = std::nextafter(trial[w], raise ? std::numeric_limits<double>::infinity()
-                                                      : -std::numeric_limits<double>::infinity());
-      moved = true;
-    }
-    if (!moved || !keepIfBetter(trial))
+    if (!relocation.MoveSpareSaddlesPastMissing(trial) || !relocation.KeepIfBetter(trial))
     {
       break;
     }
@@ -921,76 +1057,132 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
 
 namespace
 {
-Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
-  const SamplingConstraints& constraints, Index saddle, double radius, std::vector<double>& values)
+// A wanted saddle with its link and its own smoothed 1-cells, as CarveSaddleOneCells sees them.
+struct SaddleStar
 {
-  const auto& p = field.Points;
-  auto neighbours = [&mesh](Index u) { return LinkOf(mesh, u); };
-  std::vector<const SaddleOneCell*> cells;
-  for (const SaddleOneCell& cell : constraints.SaddleOneCells)
+  const std::vector<double>& Points; // x, y per sampling vertex
+  const TriangleMeshTopology& Mesh;
+  std::vector<const SaddleOneCell*> Cells;
+  std::vector<Index> Link;
+  double X = 0, Y = 0;
+  double ShortestEdge = std::numeric_limits<double>::infinity(); // from the saddle to its link
+
+  SaddleStar(const PlanarScalarField& field, const TriangleMeshTopology& mesh, const SamplingConstraints& constraints,
+    Index saddle)
+    : Points(field.Points)
+    , Mesh(mesh)
+    , Link(LinkOf(mesh, saddle))
+    , X(field.Points[2 * saddle])
+    , Y(field.Points[2 * saddle + 1])
   {
-    if (cell.Saddle == saddle)
+    for (const SaddleOneCell& cell : constraints.SaddleOneCells)
     {
-      cells.push_back(&cell);
+      if (cell.Saddle == saddle)
+      {
+        this->Cells.push_back(&cell);
+      }
+    }
+    for (Index w : this->Link)
+    {
+      this->ShortestEdge = std::min(this->ShortestEdge, this->DistanceFromSaddle(w));
     }
   }
-  const std::vector<Index> link = neighbours(saddle);
-  // The assignment below tries every subset of the link: a handful of vertices on grids, but
-  // an unstructured mesh can have vertices of very high valence; those are left as they are.
-  constexpr std::size_t maximumLinkSize = 16;
-  if (cells.empty() || link.size() < cells.size() || link.size() > maximumLinkSize)
+
+  double DistanceFromSaddle(Index w) const
   {
-    return 0;
+    return std::hypot(this->Points[2 * w] - this->X, this->Points[2 * w + 1] - this->Y);
   }
-  const double sx = p[2 * saddle], sy = p[2 * saddle + 1];
-  double shortestEdge = std::numeric_limits<double>::infinity();
-  for (Index w : link)
+  double AngleOf(double x, double y) const { return std::atan2(y - this->Y, x - this->X); }
+  NearestPoint NearestOn(const SaddleOneCell& cell, Index w) const
   {
-    shortestEdge = std::min(shortestEdge, std::hypot(p[2 * w] - sx, p[2 * w + 1] - sy));
+    return NearestOnOneCell(cell, this->Points[2 * w], this->Points[2 * w + 1]);
   }
-  // The direction in which each 1-cell leaves the saddle, seen at the scale of the link.
-  auto angleOf = [&](double x, double y) { return std::atan2(y - sy, x - sx); };
-  std::vector<double> cellAngle;
-  for (const SaddleOneCell* cell : cells)
-  {
-    const std::vector<double>& q = cell->Points;
-    std::size_t i = 3;
-    while (i + 3 < q.size() && std::hypot(q[i] - sx, q[i + 1] - sy) < shortestEdge)
-    {
-      i += 3;
-    }
-    cellAngle.push_back(angleOf(q[i], q[i + 1]));
-  }
-  std::vector<double> linkAngle;
-  for (Index w : link)
-  {
-    linkAngle.push_back(angleOf(p[2 * w], p[2 * w + 1]));
-  }
-  // Each 1-cell takes its own link vertex, in the same turning order as the 1-cells leave (a
-  // saddle's link alternates above and below it as its 1-cells do), with the least total
-  // angle between the 1-cells and their vertices: all order-preserving choices are tried
-  // (a link has a handful of vertices).
-  std::vector<std::size_t> cellOrder(cells.size()), linkOrder(link.size());
-  std::iota(cellOrder.begin(), cellOrder.end(), 0);
-  std::iota(linkOrder.begin(), linkOrder.end(), 0);
-  std::sort(cellOrder.begin(), cellOrder.end(), [&](std::size_t a, std::size_t b) { return cellAngle[a] < cellAngle[b]; });
-  std::sort(linkOrder.begin(), linkOrder.end(), [&](std::size_t a, std::size_t b) { return linkAngle[a] < linkAngle[b]; });
-  auto gap = [](double a, double b) {
-    const double d = std::fmod(std::abs(a - b), 2 * M_PI);
-    return std::min(d, 2 * M_PI - d);
-  };
-  const std::size_t m = cells.size(), l = link.size();
   // A vertex of the domain boundary should serve only a 1-cell that runs along the boundary
   // through it: raising or lowering it for a 1-cell that merely passes nearby changes the
   // boundary curve's own extrema, which the boundary passes then fight. In the link it is
   // only avoided (a boundary saddle's link may have no other vertex for a 1-cell); chains
   // never take one.
-  const double infinity = std::numeric_limits<double>::infinity();
-  auto onTheirWay = [&](const SaddleOneCell& cell, Index w) {
-    return !mesh.IsBoundaryVertex(w) || NearestOnOneCell(cell, p[2 * w], p[2 * w + 1]).Distance <= 0.25 * shortestEdge;
-  };
+  bool OnTheirWay(const SaddleOneCell& cell, Index w) const
+  {
+    return !this->Mesh.IsBoundaryVertex(w) || this->NearestOn(cell, w).Distance <= 0.25 * this->ShortestEdge;
+  }
+};
+
+// The directions in which the 1-cells leave the saddle and in which the link vertices lie, and
+// both sorted by angle (turning order).
+struct TurningOrders
+{
+  std::vector<double> CellAngle, LinkAngle;
+  std::vector<std::size_t> CellOrder, LinkOrder;
+};
+
+std::vector<std::size_t> ByAngle(const std::vector<double>& angle)
+{
+  std::vector<std::size_t> order(angle.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return angle[a] < angle[b]; });
+  return order;
+}
+
+TurningOrders TurningOrdersOf(const SaddleStar& star)
+{
+  TurningOrders turning;
+  // A 1-cell's direction is seen at the scale of the link: at its first point as far from the
+  // saddle as the nearest link vertex.
+  for (const SaddleOneCell* cell : star.Cells)
+  {
+    const std::vector<double>& q = cell->Points;
+    std::size_t i = 3;
+    while (i + 3 < q.size() && std::hypot(q[i] - star.X, q[i + 1] - star.Y) < star.ShortestEdge)
+    {
+      i += 3;
+    }
+    turning.CellAngle.push_back(star.AngleOf(q[i], q[i + 1]));
+  }
+  for (Index w : star.Link)
+  {
+    turning.LinkAngle.push_back(star.AngleOf(star.Points[2 * w], star.Points[2 * w + 1]));
+  }
+  turning.CellOrder = ByAngle(turning.CellAngle);
+  turning.LinkOrder = ByAngle(turning.LinkAngle);
+  return turning;
+}
+
+// The angle between two directions.
+double AngleGap(double a, double b)
+{
+  const double d = std::fmod(std::abs(a - b), 2 * M_PI);
+  return std::min(d, 2 * M_PI - d);
+}
+
+// What giving the 1-cells, in turning order from `shift` on, the link positions `chosen` (in
+// turning order) costs: the total angle between each 1-cell and its vertex, and a quarter turn
+// for each boundary vertex off its 1-cell's way.
+double AssignmentCost(const SaddleStar& star, const TurningOrders& turning, const std::vector<std::size_t>& chosen,
+  std::size_t shift)
+{
+  const std::size_t m = star.Cells.size();
+  double cost = 0;
+  for (std::size_t j = 0; j < m; ++j)
+  {
+    const std::size_t c = turning.CellOrder[(j + shift) % m];
+    const Index w = star.Link[turning.LinkOrder[chosen[j]]];
+    cost += AngleGap(turning.CellAngle[c], turning.LinkAngle[turning.LinkOrder[chosen[j]]]) +
+      (star.OnTheirWay(*star.Cells[c], w) ? 0 : M_PI / 4);
+  }
+  return cost;
+}
+
+// Each 1-cell takes its own link vertex, in the same turning order as the 1-cells leave (a
+// saddle's link alternates above and below it as its 1-cells do), with the least total
+// angle between the 1-cells and their vertices: all order-preserving choices are tried
+// (a link has a handful of vertices). Returns the vertex of each 1-cell.
+std::vector<Index> AssignLinkVertices(const SaddleStar& star)
+{
+  const TurningOrders turning = TurningOrdersOf(star);
+  const std::size_t m = star.Cells.size(), l = star.Link.size();
   std::vector<Index> vertexOfCell(m, InvalidIndex);
-  double bestCost = infinity;
+  double bestCost = std::numeric_limits<double>::infinity();
   std::vector<std::size_t> chosen(m);
   // Subsets of m link positions in increasing order, by a bit mask over the l positions.
   for (unsigned mask = 0; mask < (1u << l); ++mask)
@@ -1009,41 +1201,43 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
     }
     for (std::size_t shift = 0; shift < m; ++shift)
     {
-      double cost = 0;
-      for (std::size_t j = 0; j < m; ++j)
-      {
-        const std::size_t c = cellOrder[(j + shift) % m];
-        const Index w = link[linkOrder[chosen[j]]];
-        cost += gap(cellAngle[c], linkAngle[linkOrder[chosen[j]]]) + (onTheirWay(*cells[c], w) ? 0 : M_PI / 4);
-      }
+      const double cost = AssignmentCost(star, turning, chosen, shift);
       if (cost < bestCost)
       {
         bestCost = cost;
         for (std::size_t j = 0; j < m; ++j)
         {
-          vertexOfCell[cellOrder[(j + shift) % m]] = link[linkOrder[chosen[j]]];
+          vertexOfCell[turning.CellOrder[(j + shift) % m]] = star.Link[turning.LinkOrder[chosen[j]]];
         }
       }
     }
   }
-  // From each of those vertices, a chain of vertices along the 1-cell that rises (falls) from
-  // the saddle: each next vertex the neighbour nearest to the 1-cell further along it, among
-  // those no 1-cell of the other kind passes nearer; the chain ends where the values already
-  // rise (fall) on their own, or at `radius`.
-  const double level = values[saddle];
-  std::vector<Index> taken = { saddle };
-  for (Index v : vertexOfCell)
+  return vertexOfCell;
+}
+
+// The chains of vertices along the saddle's 1-cells, each from its link vertex: each next
+// vertex the neighbour nearest to the 1-cell further along it (within `Radius` of the saddle,
+// not yet taken), among those no 1-cell of the other kind passes nearer.
+struct SaddleChains
+{
+  const SaddleStar& Star;
+  double Radius;
+  double Level; // the saddle's value
+  std::vector<Index> Taken;
+  std::vector<double>& Values;
+
+  // Raises (lowers) the chain along `cell` from `first` on, rising (falling) from the saddle
+  // with the 1-cell's heights; the chain ends where the values already rise (fall) on their
+  // own, or at the radius. Returns the number of changed vertices.
+  Index Carve(const SaddleOneCell& cell, Index first)
   {
-    taken.push_back(v);
-  }
-  Index changed = 0;
-  for (std::size_t c = 0; c < m; ++c)
-  {
-    const SaddleOneCell& cell = *cells[c];
+    const double infinity = std::numeric_limits<double>::infinity();
+    std::vector<double>& values = this->Values;
     const bool up = cell.Ascending;
-    Index current = vertexOfCell[c];
-    NearestPoint at = NearestOnOneCell(cell, p[2 * current], p[2 * current + 1]);
-    double previous = level;
+    Index changed = 0;
+    Index current = first;
+    NearestPoint at = this->Star.NearestOn(cell, current);
+    double previous = this->Level;
     for (int step = 0; current != InvalidIndex; ++step)
     {
       const double wanted = up ? std::max(at.Height, std::nextafter(previous, infinity))
@@ -1058,125 +1252,222 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
         ++changed;
       }
       previous = values[current];
-      Index next = InvalidIndex;
       NearestPoint nextAt;
-      for (Index w : neighbours(current))
-      {
-        if (std::find(taken.begin(), taken.end(), w) != taken.end() ||
-          std::hypot(p[2 * w] - sx, p[2 * w + 1] - sy) > radius || !onTheirWay(cell, w))
-        {
-          continue;
-        }
-        const NearestPoint candidate = NearestOnOneCell(cell, p[2 * w], p[2 * w + 1]);
-        if (candidate.Along <= at.Along || candidate.Distance >= nextAt.Distance)
-        {
-          continue;
-        }
-        bool otherKindNearer = false;
-        for (const SaddleOneCell* other : cells)
-        {
-          otherKindNearer = otherKindNearer ||
-            (other->Ascending != up && NearestOnOneCell(*other, p[2 * w], p[2 * w + 1]).Distance < candidate.Distance);
-        }
-        if (!otherKindNearer)
-        {
-          next = w;
-          nextAt = candidate;
-        }
-      }
+      const Index next = this->Next(cell, current, at, nextAt);
       if (next != InvalidIndex)
       {
-        taken.push_back(next);
+        this->Taken.push_back(next);
       }
       current = next;
       at = nextAt;
     }
+    return changed;
+  }
+
+private:
+  // The chain's vertex after `current` (at `at` along the 1-cell), with where it is along the
+  // 1-cell in `nextAt`; InvalidIndex: none.
+  Index Next(const SaddleOneCell& cell, Index current, const NearestPoint& at, NearestPoint& nextAt) const
+  {
+    Index next = InvalidIndex;
+    for (Index w : LinkOf(this->Star.Mesh, current))
+    {
+      if (std::find(this->Taken.begin(), this->Taken.end(), w) != this->Taken.end() ||
+        this->Star.DistanceFromSaddle(w) > this->Radius || !this->Star.OnTheirWay(cell, w))
+      {
+        continue;
+      }
+      const NearestPoint candidate = this->Star.NearestOn(cell, w);
+      if (candidate.Along <= at.Along || candidate.Distance >= nextAt.Distance)
+      {
+        continue;
+      }
+      if (!this->OtherKindNearer(cell.Ascending, w, candidate.Distance))
+      {
+        next = w;
+        nextAt = candidate;
+      }
+    }
+    return next;
+  }
+
+  // Whether a 1-cell of the saddle of the other kind passes nearer to w than `distance`.
+  bool OtherKindNearer(bool ascending, Index w, double distance) const
+  {
+    for (const SaddleOneCell* other : this->Star.Cells)
+    {
+      if (other->Ascending != ascending && this->Star.NearestOn(*other, w).Distance < distance)
+      {
+        return true;
+      }
+    }
+    return false;
+  }
+};
+
+Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, Index saddle, double radius, std::vector<double>& values)
+{
+  const SaddleStar star(field, mesh, constraints, saddle);
+  // The assignment tries every subset of the link: a handful of vertices on grids, but an
+  // unstructured mesh can have vertices of very high valence; those are left as they are.
+  constexpr std::size_t maximumLinkSize = 16;
+  if (star.Cells.empty() || star.Link.size() < star.Cells.size() || star.Link.size() > maximumLinkSize)
+  {
+    return 0;
+  }
+  const std::vector<Index> vertexOfCell = AssignLinkVertices(star);
+  SaddleChains chains{ star, radius, values[saddle], { saddle }, values };
+  chains.Taken.insert(chains.Taken.end(), vertexOfCell.begin(), vertexOfCell.end());
+  Index changed = 0;
+  for (std::size_t c = 0; c < star.Cells.size(); ++c)
+  {
+    changed += chains.Carve(*star.Cells[c], vertexOfCell[c]);
   }
   return changed;
+}
+} // namespace
+
+namespace
+{
+// The sampling as the 1-cells walk over it in CarveOneCells.
+struct CarvingGround
+{
+  const std::vector<double>& Points; // x, y per sampling vertex
+  const TriangleMeshTopology& Mesh;
+  double Spacing;
+  // The critical points themselves keep their values: a 1-cell passing next to another one's
+  // node must not lift a wanted minimum out of its pit.
+  std::unordered_set<Index> Critical;
+
+  double DistanceTo(Index v, const double* q) const
+  {
+    return std::hypot(this->Points[2 * v] - q[0], this->Points[2 * v + 1] - q[1]);
+  }
+
+  // The neighbour of `current` nearest to the curve point q if nearer than `current` (else
+  // `current`).
+  Index NearerNeighbour(Index current, const double* q, bool ascending) const
+  {
+    Index nearest = current;
+    double nearestDistance = this->DistanceTo(current, q);
+    for (Index w : LinkOf(this->Mesh, current))
+    {
+      // A ridge close along the domain boundary walks on the first row inside (the
+      // boundary curve runs lower: it is a valley there, which the boundary passes keep).
+      const double d = this->DistanceTo(w, q);
+      if (d < nearestDistance && (!ascending || !this->Mesh.IsBoundaryVertex(w) || d <= 0.25 * this->Spacing))
+      {
+        nearest = w;
+        nearestDistance = d;
+      }
+    }
+    return nearest;
+  }
+
+  // Whether v is left to the floods and to CarveSaddleOneCells: near the 1-cell's ends (from
+  // `start` to `end`), on the boundary, or a critical point.
+  bool LeftAlone(Index v, const double* start, const double* end) const
+  {
+    return this->DistanceTo(v, start) <= this->Spacing || this->DistanceTo(v, end) <= this->Spacing ||
+      this->Mesh.IsBoundaryVertex(v) || this->Critical.count(v);
+  }
+};
+
+// What the ridges ask of a vertex (the highest value) and what the valleys ask (the lowest).
+struct CarvingRequests
+{
+  std::unordered_map<Index, double> RaiseTo, LowerTo;
+
+  // Asks for v the height of a 1-cell there, strictly past `previous` (the value before v along
+  // the walk). Returns v's value along the walk once carved.
+  double Ask(Index v, double height, double previous, bool up, const std::vector<double>& values)
+  {
+    const double infinity = std::numeric_limits<double>::infinity();
+    const double wanted =
+      up ? std::max(height, std::nextafter(previous, infinity)) : std::min(height, std::nextafter(previous, -infinity));
+    auto& asked = up ? this->RaiseTo : this->LowerTo;
+    auto found = asked.find(v);
+    if (found == asked.end())
+    {
+      asked.emplace(v, wanted);
+    }
+    else
+    {
+      found->second = up ? std::max(found->second, wanted) : std::min(found->second, wanted);
+    }
+    return up ? std::max(wanted, values[v]) : std::min(wanted, values[v]);
+  }
+
+  // Gives each vertex that only ridges or only valleys claim what they ask, where that moves it
+  // up (down). Returns the number of changed vertices.
+  Index Apply(std::vector<double>& values) const
+  {
+    Index changed = 0;
+    for (const auto& asked : { &this->RaiseTo, &this->LowerTo })
+    {
+      const bool up = asked == &this->RaiseTo;
+      for (const auto& [v, value] : *asked)
+      {
+        if ((up ? this->LowerTo : this->RaiseTo).count(v) == 0 && (up ? values[v] < value : values[v] > value))
+        {
+          values[v] = value;
+          ++changed;
+        }
+      }
+    }
+    return changed;
+  }
+};
+
+std::unordered_set<Index> CriticalVertices(const SamplingConstraints& constraints)
+{
+  std::unordered_set<Index> critical;
+  for (const std::vector<Index>* kind : { &constraints.Minima, &constraints.Maxima, &constraints.Saddles })
+  {
+    critical.insert(kind->begin(), kind->end());
+  }
+  return critical;
+}
+
+// Walks from the 1-cell's saddle along its points, to each point vertex by vertex while a
+// neighbour is nearer to it, and asks each vertex walked onto for the 1-cell's height there.
+void AskAlongOneCell(const CarvingGround& ground, const SaddleOneCell& cell, const std::vector<double>& values,
+  CarvingRequests& requests)
+{
+  const std::vector<double>& q = cell.Points;
+  const double* start = &q[0];
+  const double* end = &q[q.size() - 3];
+  Index current = cell.Saddle;
+  double previous = values[cell.Saddle];
+  for (std::size_t i = 0; i + 2 < q.size(); i += 3)
+  {
+    for (;;)
+    {
+      const Index nearest = ground.NearerNeighbour(current, &q[i], cell.Ascending);
+      if (nearest == current)
+      {
+        break;
+      }
+      current = nearest;
+      if (!ground.LeftAlone(current, start, end))
+      {
+        previous = requests.Ask(current, q[i + 2], previous, cell.Ascending, values);
+      }
+    }
+  }
 }
 } // namespace
 
 Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, double spacing, std::vector<double>& values)
 {
-  const auto& p = field.Points;
-  const double infinity = std::numeric_limits<double>::infinity();
-  auto distanceTo = [&p](Index v, const double* q) { return std::hypot(p[2 * v] - q[0], p[2 * v + 1] - q[1]); };
-  // What the ridges ask of a vertex (the highest value) and what the valleys ask (the lowest).
-  std::unordered_map<Index, double> raiseTo, lowerTo;
-  // The critical points themselves keep their values: a 1-cell passing next to another one's
-  // node must not lift a wanted minimum out of its pit.
-  std::unordered_set<Index> critical;
-  for (const std::vector<Index>* kind : { &constraints.Minima, &constraints.Maxima, &constraints.Saddles })
-  {
-    critical.insert(kind->begin(), kind->end());
-  }
+  const CarvingGround ground{ field.Points, mesh, spacing, CriticalVertices(constraints) };
+  CarvingRequests requests;
   for (const SaddleOneCell& cell : constraints.OneCells)
   {
-    const std::vector<double>& q = cell.Points;
-    const bool up = cell.Ascending;
-    const double* start = &q[0];
-    const double* end = &q[q.size() - 3];
-    Index current = cell.Saddle;
-    double previous = values[cell.Saddle];
-    for (std::size_t i = 0; i + 2 < q.size(); i += 3)
-    {
-      // Walk towards the curve point, vertex by vertex, while a neighbour is nearer to it.
-      for (;;)
-      {
-        Index nearest = current;
-        double nearestDistance = distanceTo(current, &q[i]);
-        for (Index w : LinkOf(mesh, current))
-        {
-          // A ridge close along the domain boundary walks on the first row inside (the
-          // boundary curve runs lower: it is a valley there, which the boundary passes keep).
-          const double d = distanceTo(w, &q[i]);
-          if (d < nearestDistance && (!up || !mesh.IsBoundaryVertex(w) || d <= 0.25 * spacing))
-          {
-            nearest = w;
-            nearestDistance = d;
-          }
-        }
-        if (nearest == current)
-        {
-          break;
-        }
-        current = nearest;
-        if (distanceTo(current, start) <= spacing || distanceTo(current, end) <= spacing ||
-          mesh.IsBoundaryVertex(current) || critical.count(current))
-        {
-          continue;
-        }
-        const double height = q[i + 2];
-        const double wanted = up ? std::max(height, std::nextafter(previous, infinity))
-                                 : std::min(height, std::nextafter(previous, -infinity));
-        auto& asked = up ? raiseTo : lowerTo;
-        auto found = asked.find(current);
-        if (found == asked.end())
-        {
-          asked.emplace(current, wanted);
-        }
-        else
-        {
-          found->second = up ? std::max(found->second, wanted) : std::min(found->second, wanted);
-        }
-        previous = up ? std::max(wanted, values[current]) : std::min(wanted, values[current]);
-      }
-    }
+    AskAlongOneCell(ground, cell, values, requests);
   }
-  Index changed = 0;
-  for (const auto& asked : { &raiseTo, &lowerTo })
-  {
-    const bool up = asked == &raiseTo;
-    for (const auto& [v, value] : *asked)
-    {
-      if ((up ? lowerTo : raiseTo).count(v) == 0 && (up ? values[v] < value : values[v] > value))
-      {
-        values[v] = value;
-        ++changed;
-      }
-    }
-  }
-  return changed;
+  return requests.Apply(values);
 }
 } // namespace topospline
