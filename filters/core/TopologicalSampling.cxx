@@ -647,10 +647,10 @@ std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, cons
        a < static_cast<Index>(smoothed.PiecesOfOneCell.size());
        ++a)
   {
-    const OneCell& arc = complex.OneCells[a];
-    const bool ascending = arc.Type == OneCell::Ascending;
+    const OneCell& oneCell = complex.OneCells[a];
+    const bool ascending = oneCell.Type == OneCell::Ascending;
     SaddleOneCell cell;
-    cell.Saddle = vertexAt(complex.CriticalPoints[ascending ? arc.Source : arc.Destination].Vertex);
+    cell.Saddle = vertexAt(complex.CriticalPoints[ascending ? oneCell.Source : oneCell.Destination].Vertex);
     cell.Ascending = ascending;
     if (cell.Saddle == InvalidIndex)
     {
