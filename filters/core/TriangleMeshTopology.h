@@ -49,7 +49,7 @@ public:
   Index VertexTriangle(Index i) const { return this->VertexTriangles[i]; }
   // Edge joining a and b, or InvalidIndex.
   Index FindEdge(Index a, Index b) const;
-  // Number of connected components of the vertex graph; the Euler characteristic V - E + T.
+  // The Euler characteristic V - E + T: 1 for a disk.
   long long EulerCharacteristic() const
   {
     return static_cast<long long>(this->NumVertices) - this->NumberOfEdges() + this->NumberOfTriangles();
@@ -62,6 +62,25 @@ public:
   FilledByPassVector<unsigned char> BoundaryVertex;
 
 private:
+  // Build's steps, in order.
+  bool ReadTriangles(const std::vector<Index>& triangles, std::string& error);
+  void BuildVertexTriangles();
+  void CountEdges(const ParallelFor& parallelFor);
+  bool NumberEdgesAndConnectTriangles(const ParallelFor& parallelFor, std::string& error);
+  bool NumberEdgesOfVertex(Index v, std::vector<Index>& scratch);
+  void FlagBoundaryVertices();
+
+  // BuildGrid's steps (GridLayout and GridVertex are defined in the .cxx).
+  struct GridLayout;
+  struct GridVertex;
+  void CountGridEdges(const GridLayout& grid);
+  void CountGridVertexTriangles(const GridLayout& grid);
+  Index GridEdge(const GridLayout& grid, Index i, Index j, int which) const;
+  void FillGridVertexTriangles(const GridLayout& grid, const GridVertex& at);
+  void FillGridEdges(const GridLayout& grid, const GridVertex& at);
+  void FillGridQuad(const GridLayout& grid, const GridVertex& at);
+  void MoveSingleTrianglesToFirstSlot(const ParallelFor& parallelFor);
+
   Index NumVertices = 0;
   std::vector<Index> VertexTriangleOffsets;
   FilledByPassVector<Index> VertexTriangles;
