@@ -22,7 +22,6 @@
 #include <vtkUnstructuredGrid.h>
 
 #include <algorithm>
-#include <map>
 
 namespace names = vtkTopoSplineArrayNames;
 namespace conversion = vtkTopoSplineDomainConversion;
@@ -514,70 +513,6 @@ void WriteJunctionPoints(const topospline::MorseSmaleComplex& complex,
   output->SetBlock(names::JunctionPointsIndex, block);
   output->GetMetaData(static_cast<unsigned int>(names::JunctionPointsIndex))
     ->Set(vtkCompositeDataSet::NAME(), names::JunctionPointsBlock);
-}
-
-bool ReadJunctionPoints(vtkMultiBlockDataSet* input, const topospline::MorseSmaleComplex& complex,
-  std::vector<topospline::JunctionPoint>& junctions)
-{
-  auto* block = input->GetNumberOfBlocks() > names::JunctionPointsIndex
-    ? vtkPolyData::SafeDownCast(input->GetBlock(names::JunctionPointsIndex))
-    : nullptr;
-  if (!block)
-  {
-    return false;
-  }
-  auto* pd = block->GetPointData();
-  vtkDataArray* type = pd->GetArray(names::SeparatrixType);
-  vtkDataArray* extremum = pd->GetArray(names::ExtremumId);
-  vtkDataArray* cell = pd->GetArray(names::MeshCellId);
-  vtkDataArray* value = pd->GetArray(names::JunctionValue);
-  vtkDataArray* critical = pd->GetArray(names::CriticalPointId);
-  if (!type || !extremum || !cell || !value || !critical)
-  {
-    return false;
-  }
-  std::map<Index, Index> position; // stable id -> position
-  for (Index i = 0; i < static_cast<Index>(complex.CriticalPoints.size()); ++i)
-  {
-    position[complex.CriticalPoints[i].Id] = i;
-  }
-  std::map<Index, std::vector<Index>> oneCellsOfExtremum;
-  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
-  {
-    const auto& oneCell = complex.OneCells[a];
-    oneCellsOfExtremum[oneCell.Type == topospline::OneCell::Descending ? oneCell.Source : oneCell.Destination]
-      .push_back(a);
-  }
-  const auto plane = conversion::PlaneOf(SegmentationOf(input));
-  for (vtkIdType j = 0; j < block->GetNumberOfPoints(); ++j)
-  {
-    topospline::JunctionPoint junction;
-    junction.Type = type->GetComponent(j, 0) == 0 ? topospline::OneCell::Descending : topospline::OneCell::Ascending;
-    const auto ext = position.find(static_cast<Index>(extremum->GetComponent(j, 0)));
-    const auto cp = position.find(static_cast<Index>(critical->GetComponent(j, 0)));
-    if (ext == position.end())
-    {
-      return false;
-    }
-    junction.Extremum = ext->second;
-    junction.CriticalPoint = cp == position.end() ? topospline::InvalidIndex : cp->second;
-    junction.Cell = static_cast<Index>(cell->GetComponent(j, 0));
-    junction.Value = value->GetComponent(j, 0);
-    double xyz[3];
-    block->GetPoint(j, xyz);
-    plane.ToPlanar(xyz, junction.Position);
-    for (Index a : oneCellsOfExtremum[junction.Extremum])
-    {
-      const auto& oneCell = complex.OneCells[a];
-      if (oneCell.Type == junction.Type &&
-        std::find(oneCell.MeshCells.begin(), oneCell.MeshCells.end(), junction.Cell) != oneCell.MeshCells.end())
-      {
-        junction.OneCells.push_back(a);
-      }
-    }
-    junctions.push_back(std::move(junction));
-  }
-  return true;
 }
 
 namespace

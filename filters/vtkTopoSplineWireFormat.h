@@ -3,7 +3,7 @@
 // add to it. Every block has its writer and its reader here, side by side, so that a block is
 // read exactly as it was written:
 //   0-3  CriticalPoints, OneCells, TwoCells, Segmentation   "Morse-Smale Complex" and later
-//   4    JunctionPoints                                     "Simplify Morse-Smale Complex"
+//   4    JunctionPoints (for display)                       "Simplify Morse-Smale Complex"
 //   5    SmoothedOneCells (cubic Bezier curves, heights)    "Smooth 1-Cells"
 //   6    SampledOneCells (the same, densely sampled)        "Smooth 1-Cells", for display only
 #pragma once
@@ -34,14 +34,10 @@ std::string ScalarFieldNameOf(vtkMultiBlockDataSet* input);
 void PassBlocks(vtkMultiBlockDataSet* input, unsigned int count, vtkMultiBlockDataSet* output);
 
 // Block 4: where 1-cells sharing an extremum merge (positions of `complex`, which the
-// junctions refer to, are written as its stable ids).
+// junctions refer to, are written as its stable ids). For display: stage 3 finds the junction
+// points of any complex itself (JunctionPointDetection), so no filter reads this block back.
 void WriteJunctionPoints(const topospline::MorseSmaleComplex& complex,
   const std::vector<topospline::JunctionPoint>& junctions, vtkMultiBlockDataSet* output);
-// False when the block is absent (an unsimplified complex) or malformed. The 1-cells through
-// each junction are found again in `complex` (those of its kind and extremum whose path holds
-// the junction's cell).
-bool ReadJunctionPoints(vtkMultiBlockDataSet* input, const topospline::MorseSmaleComplex& complex,
-  std::vector<topospline::JunctionPoint>& junctions);
 
 // Blocks 5 and 6: every piece as VTK_BEZIER_CURVE cells of degree 3 with their heights, the
 // pieces of every 1-cell, and (block 6) every 1-cell sampled at `samplesPerSegment` points per
