@@ -11,10 +11,11 @@ export TOPOSPLINE_PLUGIN="$build/lib/paraview-plugins/TopoSpline/TopoSpline.so"
 # Rendering needs an X server: pvbatch runs under a virtual one (the display search starts at a
 # random number: two "xvfb-run -a" starting together can otherwise pick the same display).
 # The virtual X server sometimes fails to come up under load ("bad X server connection"):
-# one more try in that case only.
+# up to two more tries, a few seconds apart, in that case only.
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
-for attempt in 1 2; do
+for attempt in 1 2 3; do
+  [ "$attempt" -gt 1 ] && sleep 5
   set +e
   xvfb-run -a -n $((200 + RANDOM % 30000)) -s "-screen 0 1280x1024x24" \
     pvbatch "$here/scripts/topospline_main.py" "$@" 2>&1 | tee "$log"

@@ -5,6 +5,7 @@ import os
 import random
 import subprocess
 import sys
+import time
 
 import numpy as np
 from paraview import servermanager as sm
@@ -51,9 +52,12 @@ X_STARTUP_FAILURES = ("bad X server connection", "SupportsOpenGL", "Could not op
 
 def run_with_virtual_display(args, cwd, env, timeout=600, screen="1280x1024x24"):
     """Runs args under xvfb-run (display search from a random number, since two "xvfb-run -a"
-    starting together can pick the same display); one more try if the X server failed to
-    start. Returns (returncode, output)."""
-    for attempt in range(2):
+    starting together can pick the same display); up to two more tries, a few seconds apart, if
+    the X server failed to start (seen on a loaded machine: twice in a row once). Returns
+    (returncode, output)."""
+    for attempt in range(3):
+        if attempt:
+            time.sleep(5)
         result = subprocess.run(["xvfb-run", "-a", "-n", str(random.randint(200, 30000)), "-s", "-screen 0 " + screen]
                                 + args, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
         output = result.stdout + result.stderr
