@@ -449,8 +449,8 @@ void vtkTopoSplineReconstructTwoCells::WarnAbout(const topospline::FieldReconstr
     vtkWarningMacro("Reconstruct 2-Cells: " << report.UnreconstructedPoints
                                             << " vertices lie in no reconstructed 2-cell and keep their input value.");
   }
-  for (const auto& [prefix, check] : { std::make_pair("Input", &report.Input),
-         std::make_pair("Resampled", &report.Resampled) })
+  for (const auto& [prefix, check] : { std::make_pair(names::InputSampling, &report.Input),
+         std::make_pair(names::ResampledSampling, &report.Resampled) })
   {
     const bool judged = report.VerificationRan && (check == &report.Input || this->OutputResolution > 1);
     const auto& c = check->Comparison;

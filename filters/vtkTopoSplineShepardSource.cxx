@@ -1,5 +1,6 @@
 #include "vtkTopoSplineShepardSource.h"
 
+#include "vtkTopoSplineArrayNames.h"
 #include "vtkTopoSplineDomainConversion.h"
 #include "vtkTopoSplineSyntheticSourceSupport.h"
 
@@ -24,7 +25,7 @@ void vtkTopoSplineShepardSource::ExecuteDataWithInformation(vtkDataObject* outpu
 {
   const auto grid = topospline::ShepardField(this->NumberOfSites, this->Power, this->Resolution,
     static_cast<std::uint64_t>(this->Seed), vtkTopoSplineDomainConversion::SMPParallelFor());
-  vtkTopoSplineSyntheticSourceSupport::FillImage(output, outInfo, grid, "Shepard");
+  vtkTopoSplineSyntheticSourceSupport::FillImage(output, outInfo, grid, vtkTopoSplineArrayNames::ShepardField);
 }
 
 void vtkTopoSplineShepardSource::PrintSelf(ostream& os, vtkIndent indent)

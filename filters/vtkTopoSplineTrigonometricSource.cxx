@@ -1,5 +1,6 @@
 #include "vtkTopoSplineTrigonometricSource.h"
 
+#include "vtkTopoSplineArrayNames.h"
 #include "vtkTopoSplineSyntheticSourceSupport.h"
 
 #include <vtkInformation.h>
@@ -24,7 +25,7 @@ int vtkTopoSplineTrigonometricSource::RequestInformation(
 void vtkTopoSplineTrigonometricSource::ExecuteDataWithInformation(vtkDataObject* output, vtkInformation* outInfo)
 {
   const auto grid = topospline::TrigonometricField(this->Amplitude, this->Resolution, this->Origin);
-  vtkTopoSplineSyntheticSourceSupport::FillImage(output, outInfo, grid, "Trigonometric");
+  vtkTopoSplineSyntheticSourceSupport::FillImage(output, outInfo, grid, vtkTopoSplineArrayNames::TrigonometricField);
 }
 
 void vtkTopoSplineTrigonometricSource::PrintSelf(ostream& os, vtkIndent indent)
