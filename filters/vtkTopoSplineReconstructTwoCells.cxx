@@ -237,10 +237,10 @@ void WriteResampled(const topospline::FieldReconstructionReport& report, vtkData
   resampled->SetDimensions(dims);
   resampled->SetOrigin(origin);
   resampled->SetSpacing(spacing);
-  const auto m = static_cast<vtkIdType>(report.FinerValues.size());
+  const auto m = static_cast<vtkIdType>(report.Finer.Values.size());
   auto values = conversion::NewArray<vtkDoubleArray>(names::ReconstructedField, 1, m);
   auto valid = conversion::NewArray<vtkCharArray>(names::ValidPointMask, 1, m);
-  std::copy(report.FinerValues.begin(), report.FinerValues.end(), values->GetPointer(0));
+  std::copy(report.Finer.Values.begin(), report.Finer.Values.end(), values->GetPointer(0));
   std::copy(report.FinerValid.begin(), report.FinerValid.end(), valid->GetPointer(0));
   conversion::AddArrays(resampled->GetPointData(), { values, valid });
   resampled->GetPointData()->SetActiveScalars(names::ReconstructedField);

@@ -108,9 +108,9 @@ double FieldReconstruction::MemoryEstimate(double cells, double finerPoints)
   return 230e3 * cells + 260.0 * finerPoints;
 }
 
-SamplingGrid FieldReconstruction::FinerGrid(const PlanarScalarField& field) const
+GridField FieldReconstruction::FinerGrid(const PlanarScalarField& field) const
 {
-  SamplingGrid grid;
+  GridField grid;
   const int f = this->OutputResolution;
   if (field.IsGrid())
   {
@@ -295,27 +295,17 @@ void FieldReconstruction::CollectPatches(FieldReconstructionReport& report) cons
 void FieldReconstruction::Resample(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const
 {
-  const SamplingGrid grid = this->FinerGrid(field);
-  report.Finer = grid;
+  const GridField grid = this->FinerGrid(field);
   const int ni = grid.Dimensions[0], nj = grid.Dimensions[1];
-  PlanarScalarField fine;
-  fine.GridDimensions[0] = ni;
-  fine.GridDimensions[1] = nj;
-  fine.GridSpacing[0] = grid.Spacing[0];
-  fine.GridSpacing[1] = grid.Spacing[1];
-  const Index m = static_cast<Index>(grid.NumberOfPoints());
-  fine.Points.resize(2 * static_cast<std::size_t>(m));
+  PlanarScalarField fine = FieldOnGrid(grid);
+  const Index m = static_cast<Index>(fine.Points.size() / 2);
   fine.Values.resize(m);
   report.FinerValid.resize(m);
   this->Parallel(0, m, [&](Index begin, Index end) {
     for (Index p = begin; p < end; ++p)
     {
-      const int i = p % ni, j = p / ni;
-      const double u = grid.Origin[0] + i * grid.Spacing[0];
-      const double v = grid.Origin[1] + j * grid.Spacing[1];
-      fine.Points[2 * static_cast<std::size_t>(p)] = u;
-      fine.Points[2 * static_cast<std::size_t>(p) + 1] = v;
-      const auto e = this->Cells.Evaluate(u, v);
+      const auto e = this->Cells.Evaluate(fine.Points[2 * static_cast<std::size_t>(p)],
+        fine.Points[2 * static_cast<std::size_t>(p) + 1]);
       fine.Values[p] = e.Cell == InvalidIndex ? 0.0 : e.Value;
       report.FinerValid[p] = e.Cell == InvalidIndex ? 0 : 1;
     }
@@ -337,7 +327,8 @@ void FieldReconstruction::Resample(const PlanarScalarField& field, const Triangl
     report.Sampling.MaximumChange = std::max(report.Sampling.MaximumChange, fineReport.MaximumChange);
     report.Sampling.Converged = report.Sampling.Converged && fineReport.Converged;
   }
-  report.FinerValues = std::move(fine.Values);
+  report.Finer = grid;
+  report.Finer.Values = std::move(fine.Values);
 }
 
 // The verdict covers the whole reconstruction: a failed 2-cell or a vertex outside every
@@ -370,20 +361,7 @@ void FieldReconstruction::Verify(
   judge(report.Input);
   if (this->OutputResolution > 1)
   {
-    PlanarScalarField fine;
-    fine.GridDimensions[0] = report.Finer.Dimensions[0];
-    fine.GridDimensions[1] = report.Finer.Dimensions[1];
-    fine.GridSpacing[0] = report.Finer.Spacing[0];
-    fine.GridSpacing[1] = report.Finer.Spacing[1];
-    fine.Values = report.FinerValues;
-    fine.Points.resize(2 * report.Finer.NumberOfPoints());
-    const int ni = report.Finer.Dimensions[0];
-    for (std::size_t p = 0; p < report.Finer.NumberOfPoints(); ++p)
-    {
-      fine.Points[2 * p] = report.Finer.Origin[0] + static_cast<int>(p % ni) * report.Finer.Spacing[0];
-      fine.Points[2 * p + 1] = report.Finer.Origin[1] + static_cast<int>(p / ni) * report.Finer.Spacing[1];
-    }
-    report.Resampled = CheckSampling(fine, report.Expected, tolerance, this->Parallel);
+    report.Resampled = CheckSampling(FieldOnGrid(report.Finer), report.Expected, tolerance, this->Parallel);
     judge(report.Resampled);
   }
   report.VerificationSeconds = SecondsSince(start);

@@ -9,6 +9,7 @@
 #include "CoreTypes.h"
 #include "MorseSmaleComplex.h"
 #include "OneCellSmoothing.h"
+#include "SyntheticFields.h" // GridField, FieldOnGrid
 #include "TopologicalSampling.h"
 #include "TopologyVerification.h"
 #include "TwoCellReconstruction.h"
@@ -20,19 +21,6 @@
 
 namespace topospline
 {
-// A uniform grid over the domain's bounding box: vertex (i, j) = j * Dimensions[0] + i at
-// Origin + (i, j) * Spacing.
-struct SamplingGrid
-{
-  double Origin[2] = { 0, 0 };
-  double Spacing[2] = { 1, 1 };
-  int Dimensions[2] = { 0, 0 };
-  std::size_t NumberOfPoints() const
-  {
-    return static_cast<std::size_t>(this->Dimensions[0]) * static_cast<std::size_t>(this->Dimensions[1]);
-  }
-};
-
 // Stage 1 run again on one sampling of the reconstruction, compared with the complex.
 struct SamplingTopologyCheck
 {
@@ -58,9 +46,8 @@ struct FieldReconstructionReport
   double ValueRange[2] = { 0, 0 };
   double EvaluationSeconds = 0;
 
-  // The finer grid (OutputResolution > 1): values, and whether a cell covers each point.
-  SamplingGrid Finer;
-  std::vector<double> FinerValues;
+  // The finer grid (OutputResolution > 1) with its values, and whether a cell covers each point.
+  GridField Finer;
   std::vector<char> FinerValid;
 
   // The Bezier triangles of every cell, in the plane.
@@ -75,7 +62,7 @@ struct FieldReconstructionReport
   bool VerificationRan = false;
   SamplingTopologyCheck RawInput;  // F o Phi at the input vertices: reported, not judged
   SamplingTopologyCheck Input;     // Values
-  SamplingTopologyCheck Resampled; // FinerValues
+  SamplingTopologyCheck Resampled; // Finer.Values
   std::vector<CriticalPointLocation> Expected;
   std::vector<CriticalPointLocation> Spurious, Missing; // of the judged samplings
   double VerificationSeconds = 0;
@@ -102,9 +89,10 @@ public:
   bool Run(const PlanarScalarField& field, const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
     FieldReconstructionReport& report, std::string& error);
 
-  // The finer grid of OutputResolution over `field`: a grid's own points refined, or for a
-  // triangle mesh a grid over its bounding box at the mean edge length / OutputResolution.
-  SamplingGrid FinerGrid(const PlanarScalarField& field) const;
+  // The finer grid of OutputResolution over `field` (no values yet): a grid's own points
+  // refined, or for a triangle mesh a grid over its bounding box at the mean edge length /
+  // OutputResolution.
+  GridField FinerGrid(const PlanarScalarField& field) const;
 
 private:
   void EvaluateAtVertices(const PlanarScalarField& field, const MorseSmaleComplex& complex,

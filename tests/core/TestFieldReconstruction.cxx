@@ -128,7 +128,8 @@ void CheckCase(const char* name, const GridField& grid, double percent, int k, i
   {
     CHECK_EQ(report.Finer.Dimensions[0], (nx - 1) * resolution + 1);
     CHECK_EQ(report.Finer.Dimensions[1], (ny - 1) * resolution + 1);
-    CHECK_EQ(report.FinerValues.size(), report.Finer.NumberOfPoints());
+    CHECK_EQ(report.Finer.Values.size(),
+      static_cast<std::size_t>(report.Finer.Dimensions[0]) * static_cast<std::size_t>(report.Finer.Dimensions[1]));
     const double* last = &p.Field.Points[2 * (n - 1)];
     for (int axis = 0; axis < 2; ++axis)
     {
@@ -155,7 +156,7 @@ void CheckCase(const char* name, const GridField& grid, double percent, int k, i
   FieldReconstructionReport threadedReport;
   CHECK(threaded.Run(p.Field, p.Simplified.Complex, p.Smoothed, threadedReport, error));
   CHECK(threadedReport.Values == report.Values);
-  CHECK(threadedReport.FinerValues == report.FinerValues);
+  CHECK(threadedReport.Finer.Values == report.Finer.Values);
   CHECK(threadedReport.Verified == report.Verified);
 
   // The verdict, against an independent count.
