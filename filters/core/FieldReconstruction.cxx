@@ -34,17 +34,12 @@ SamplingTopologyCheck CheckSampling(const PlanarScalarField& sampling,
   return check;
 }
 
-// The field with other values at the same vertices.
+// The field with other values at the same vertices (copied whole, so that no member of the
+// field's geometry is left behind; the input's values are small beside its points).
 PlanarScalarField WithValues(const PlanarScalarField& field, const std::vector<double>& values)
 {
-  PlanarScalarField sampling;
-  sampling.Points = field.Points;
-  sampling.Triangles = field.Triangles;
+  PlanarScalarField sampling = field;
   sampling.Values = values;
-  sampling.GridDimensions[0] = field.GridDimensions[0];
-  sampling.GridDimensions[1] = field.GridDimensions[1];
-  sampling.GridSpacing[0] = field.GridSpacing[0];
-  sampling.GridSpacing[1] = field.GridSpacing[1];
   return sampling;
 }
 } // namespace
