@@ -124,6 +124,8 @@ constexpr const char* LinearizedDiagonals = "LinearizedDiagonals";
 constexpr const char* BezierTriangles = "BezierTriangles";
 constexpr const char* MeshTriangles = "MeshTriangles";
 constexpr const char* MaximumGridSize = "MaximumGridSize";
+constexpr const char* FittedCells = "FittedCells";
+constexpr const char* RefinedCells = "RefinedCells";
 constexpr const char* SnappedPoints = "SnappedPoints";
 constexpr const char* UnreconstructedPoints = "UnreconstructedPoints";
 constexpr const char* MaximumError = "MaximumError";
@@ -134,8 +136,13 @@ constexpr const char* SurfaceSeconds = "SurfaceSeconds";
 constexpr const char* EvaluationSeconds = "EvaluationSeconds";
 constexpr const char* SamplingChangedVertices = "SamplingChangedVertices";
 constexpr const char* SamplingMaximumChange = "SamplingMaximumChange";
+constexpr const char* SamplingChangedFraction = "SamplingChangedFraction";
 constexpr const char* SamplingConverged = "SamplingConverged";
 constexpr const char* SamplingDisplacedSaddles = "SamplingDisplacedSaddles";
+// Spurious critical points of F o Phi at the input vertices, within two grid spacings of a
+// smoothed 1-cell and farther.
+constexpr const char* RawSpuriousNearOneCells = "RawSpuriousNearOneCells";
+constexpr const char* RawSpuriousFarFromOneCells = "RawSpuriousFarFromOneCells";
 // Topology verification: per sampling (the prefixes RawInput, Input, Resampled), the found
 // counts of minima, saddles, maxima and the largest distance of a matched point to its node.
 constexpr const char* RawInputSampling = "RawInput";

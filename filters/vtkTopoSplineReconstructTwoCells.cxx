@@ -273,6 +273,8 @@ void WriteReport(const topospline::FieldReconstructionReport& report, vtkFieldDa
   AddFieldNumbers(fd, names::BezierTriangles, { static_cast<double>(cells.BezierTriangles) });
   AddFieldNumbers(fd, names::MeshTriangles, { static_cast<double>(cells.MeshTriangles) });
   AddFieldNumbers(fd, names::MaximumGridSize, { static_cast<double>(cells.MaximumGridSize) });
+  AddFieldNumbers(fd, names::FittedCells, { static_cast<double>(cells.FittedCells) });
+  AddFieldNumbers(fd, names::RefinedCells, { static_cast<double>(cells.RefinedCells) });
   AddFieldNumbers(fd, names::SnappedPoints, { static_cast<double>(report.SnappedPoints) });
   AddFieldNumbers(fd, names::UnreconstructedPoints, { static_cast<double>(report.UnreconstructedPoints) });
   AddFieldNumbers(fd, names::MaximumError, { report.MaximumError });
@@ -285,12 +287,19 @@ void WriteReport(const topospline::FieldReconstructionReport& report, vtkFieldDa
   {
     AddFieldNumbers(fd, names::SamplingChangedVertices, { static_cast<double>(report.Sampling.ChangedVertices) });
     AddFieldNumbers(fd, names::SamplingMaximumChange, { report.Sampling.MaximumChange });
+    AddFieldNumbers(fd, names::SamplingChangedFraction,
+      { report.Values.empty() ? 0.0 : static_cast<double>(report.Sampling.ChangedVertices) / report.Values.size() });
     AddFieldNumbers(fd, names::SamplingConverged, { report.Sampling.Converged ? 1.0 : 0.0 });
     AddFieldNumbers(fd, names::SamplingDisplacedSaddles, { static_cast<double>(report.Sampling.DisplacedSaddles) });
   }
   if (!report.VerificationRan)
   {
     return;
+  }
+  if (report.RawInput.Ran)
+  {
+    AddFieldNumbers(fd, names::RawSpuriousNearOneCells, { static_cast<double>(report.RawSpuriousNearOneCells) });
+    AddFieldNumbers(fd, names::RawSpuriousFarFromOneCells, { static_cast<double>(report.RawSpuriousFarFromOneCells) });
   }
   for (const auto& [prefix, check] : { std::make_pair(names::RawInputSampling, &report.RawInput),
          std::make_pair(names::InputSampling, &report.Input),
@@ -375,6 +384,9 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
 
   topospline::FieldReconstruction reconstruction;
   reconstruction.BoundarySamples = this->BoundarySamples;
+  reconstruction.Interior = this->Interior == INTERIOR_PAPER ? topospline::TwoCellInterior::Paper
+                                                              : topospline::TwoCellInterior::Fitted;
+  reconstruction.SurfaceTolerance = this->SurfaceTolerance / 100.0;
   reconstruction.OutputResolution = this->OutputResolution;
   reconstruction.TopologicalSampling = this->TopologicalSampling != 0;
   reconstruction.VerifyTopology = this->VerifyTopology != 0;
@@ -473,6 +485,8 @@ void vtkTopoSplineReconstructTwoCells::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "BoundarySamples: " << this->BoundarySamples << "\n"
+     << indent << "Interior: " << (this->Interior == INTERIOR_PAPER ? "Paper" : "Fitted") << "\n"
+     << indent << "SurfaceTolerance: " << this->SurfaceTolerance << "\n"
      << indent << "OutputResolution: " << this->OutputResolution << "\n"
      << indent << "TopologicalSampling: " << this->TopologicalSampling << "\n"
      << indent << "VerifyTopology: " << this->VerifyTopology << "\n";

@@ -49,6 +49,32 @@ public:
   //@}
 
   //@{
+  /**
+   * What decides a 2-cell's interior: INTERIOR_FITTED (default) fits the free Bezier ordinates
+   * of its Sibson surface to the input samples inside the cell (least squares under the
+   * monotonicity conditions, so still no interior critical point); INTERIOR_PAPER is the
+   * paper's construction from the boundary curves alone (its Table 1).
+   */
+  enum InteriorModes
+  {
+    INTERIOR_PAPER = 0,
+    INTERIOR_FITTED = 1
+  };
+  vtkSetClampMacro(Interior, int, INTERIOR_PAPER, INTERIOR_FITTED);
+  vtkGetMacro(Interior, int);
+  //@}
+
+  //@{
+  /**
+   * Fitted interiors: a cell's Sibson grid is refined (doubled, its boundary Beziers split
+   * exactly) while the fit misses the input by more than this percentage of the input's value
+   * range, up to 32 x 32, while each doubling gains at least 10 %. 0: no refinement.
+   */
+  vtkSetClampMacro(SurfaceTolerance, double, 0.0, 100.0);
+  vtkGetMacro(SurfaceTolerance, double);
+  //@}
+
+  //@{
   /** Refinement factor of the resampled image on output port 2; 1 produces no image. */
   vtkSetMacro(OutputResolution, int);
   vtkGetMacro(OutputResolution, int);
@@ -92,6 +118,8 @@ protected:
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   int BoundarySamples = 5;
+  int Interior = INTERIOR_FITTED;
+  double SurfaceTolerance = 1.0;
   int OutputResolution = 1;
   bool VerifyTopology = true;
   bool TopologicalSampling = true;

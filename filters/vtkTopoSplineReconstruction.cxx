@@ -76,6 +76,8 @@ int vtkTopoSplineReconstruction::RequestData(
   this->Complex->SetInputArrayToProcess(0, this->GetInputArrayInformation(0));
   this->Simplify->SetPersistenceThreshold(this->PersistenceThreshold);
   this->Smooth->SetCurveSegments(this->CurveSegments);
+  this->Reconstruct->SetInterior(this->Interior);
+  this->Reconstruct->SetSurfaceTolerance(this->SurfaceTolerance);
   this->Reconstruct->SetVerifyTopology(this->VerifyTopology);
   this->UpdateProgress(0.0);
   this->Reconstruct->Update();
@@ -98,5 +100,7 @@ void vtkTopoSplineReconstruction::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "PersistenceThreshold: " << this->PersistenceThreshold << "\n"
      << indent << "CurveSegments: " << this->CurveSegments << "\n"
+     << indent << "Interior: " << (this->Interior ? "Fitted" : "Paper") << "\n"
+     << indent << "SurfaceTolerance: " << this->SurfaceTolerance << "\n"
      << indent << "VerifyTopology: " << this->VerifyTopology << "\n";
 }

@@ -42,6 +42,18 @@ public:
   //@}
 
   //@{
+  /** Stage 4: fitted (1, default) or paper (0) 2-cell interiors; see vtkTopoSplineReconstructTwoCells. */
+  vtkSetClampMacro(Interior, int, 0, 1);
+  vtkGetMacro(Interior, int);
+  //@}
+
+  //@{
+  /** Stage 4: refinement tolerance of fitted interiors, % of the value range (0: none). */
+  vtkSetClampMacro(SurfaceTolerance, double, 0.0, 100.0);
+  vtkGetMacro(SurfaceTolerance, double);
+  //@}
+
+  //@{
   /** The built-in topology check of stage 4. */
   vtkSetMacro(VerifyTopology, bool);
   vtkGetMacro(VerifyTopology, bool);
@@ -57,6 +69,8 @@ protected:
 
   double PersistenceThreshold = 5.0;
   int CurveSegments = 4;
+  int Interior = 1;
+  double SurfaceTolerance = 1.0;
   bool VerifyTopology = true;
 
 private:

@@ -145,6 +145,13 @@ summary["reconstruction"] = {
     "rms_error": field_numbers("RMSError"),
     "max_error_percent_of_range": 100 * field_numbers("MaximumError") / (value_range[1] - value_range[0]),
     "rms_error_percent_of_range": 100 * field_numbers("RMSError") / (value_range[1] - value_range[0]),
+    "interior": "fitted to the data" if reconstruction.Interior in (1, "Fitted") else "the paper's (boundary only)",
+    "fitted_two_cells": field_numbers("FittedCells"), "refined_two_cells": field_numbers("RefinedCells"),
+    "topological_sampling_changed_percent_of_vertices": 100 * field_numbers("SamplingChangedFraction"),
+    "topological_sampling_largest_change_percent_of_range":
+        100 * field_numbers("SamplingMaximumChange") / (value_range[1] - value_range[0]),
+    "spurious_critical_points_of_F_o_Phi_near_1_cells": field_numbers("RawSpuriousNearOneCells"),
+    "spurious_critical_points_of_F_o_Phi_far_from_1_cells": field_numbers("RawSpuriousFarFromOneCells"),
     "two_cells": field_numbers("TwoCells"), "failed_two_cells": field_numbers("FailedTwoCells"),
     "violating_patches": field_numbers("ViolatingPatches"), "bezier_triangles": field_numbers("BezierTriangles"),
     "time_II_delaunay_parameterization_s": round(field_numbers("ParameterizationSeconds"), 4),
@@ -231,6 +238,73 @@ def save_persistence_curve(name):
     pictures.append(path)
 
 
+def planar_field(data, names):
+    """x, y, triangles (None for a grid: then the arrays are 2D) and the named point arrays."""
+    import numpy as np
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    arrays = [vtk_to_numpy(data.GetPointData().GetArray(n)).astype(float) for n in names]
+    if data.IsA("vtkImageData"):
+        dims = [d for d in data.GetDimensions() if d > 1]
+        origin, spacing, extent = data.GetOrigin(), data.GetSpacing(), data.GetExtent()
+        x = origin[0] + spacing[0] * np.arange(extent[0], extent[1] + 1)
+        y = origin[1] + spacing[1] * np.arange(extent[2], extent[3] + 1)
+        return x, y, None, [a.reshape(dims[1], dims[0]) for a in arrays]
+    points = vtk_to_numpy(data.GetPoints().GetData())
+    triangles = [[data.GetCell(c).GetPointId(i) for i in range(3)] for c in range(data.GetNumberOfCells())
+                 if data.GetCell(c).GetNumberOfPoints() == 3]
+    return points[:, 0], points[:, 1], np.array(triangles), arrays
+
+
+def save_side_by_side(input_name, output_name):
+    """The input and the reconstruction with one colour map and the same isolines, and the error
+    map (Reconstructed - input, symmetric diverging colours), drawn from the output arrays."""
+    import numpy as np
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    data = sm.Fetch(reconstruction)
+    x, y, triangles, (original, rebuilt, difference) = planar_field(data, [array, "Reconstructed", "Difference"])
+    low, high = float(original.min()), float(original.max())
+    levels = np.linspace(low, high, 22)[1:-1]
+    span = high - low if high > low else 1.0
+
+    def draw(axes, values, title, cmap="viridis", vmin=low, vmax=high, lines=True):
+        if triangles is None:
+            image = axes.imshow(values, origin="lower", extent=(x[0], x[-1], y[0], y[-1]), cmap=cmap, vmin=vmin,
+                                vmax=vmax, interpolation="nearest")
+            if lines:
+                axes.contour(x, y, values, levels=levels, colors="k", linewidths=0.6)
+        else:
+            image = axes.tripcolor(x, y, triangles, values, cmap=cmap, vmin=vmin, vmax=vmax, shading="gouraud")
+            if lines:
+                axes.tricontour(x, y, triangles, values, levels=levels, colors="k", linewidths=0.6)
+        axes.set_aspect("equal")
+        axes.set_title(title)
+        axes.set_xticks([])
+        axes.set_yticks([])
+        return image
+
+    figure, axes = plt.subplots(1, 2, figsize=(14, 7), dpi=110)
+    draw(axes[0], original, "input")
+    image = draw(axes[1], rebuilt, "reconstruction (%g %%, k = %d)" % (args.threshold, args.k))
+    figure.colorbar(image, ax=axes, shrink=0.7, label=array)
+    path = os.path.join(args.output, input_name)
+    figure.savefig(path, bbox_inches="tight")
+    plt.close(figure)
+    pictures.append(path)
+
+    bound = max(float(np.abs(difference).max()), 1e-300)
+    figure, axes = plt.subplots(figsize=(8, 7), dpi=110)
+    image = draw(axes, difference, "reconstruction - input: max %.2f %%, RMS %.2f %% of the range" % (
+        100 * bound / span, 100 * float(np.sqrt(np.mean(difference ** 2))) / span), cmap="RdBu_r", vmin=-bound,
+        vmax=bound, lines=False)
+    figure.colorbar(image, ax=axes, shrink=0.8, label="error")
+    path = os.path.join(args.output, output_name)
+    figure.savefig(path, bbox_inches="tight")
+    plt.close(figure)
+    pictures.append(path)
+
+
 pictures = []
 show_field(source)
 save("1_input.png")
@@ -249,6 +323,7 @@ save("5_reconstruction_k%d.png" % args.k)
 style.field_with_isolines(reconstruction, "Reconstructed", view)
 save("6_reconstruction_isolines_k%d.png" % args.k)
 save_persistence_curve("3b_persistence_curve.png")
+save_side_by_side("7_input_and_reconstruction_k%d.png" % args.k, "8_error_map_k%d.png" % args.k)
 summary["pictures"] = pictures
 
 with open(os.path.join(args.output, "summary.json"), "w") as f:

@@ -159,10 +159,16 @@ bool FieldReconstruction::Run(const PlanarScalarField& field, const MorseSmaleCo
   const double edge = MeanEdgeLength(field);
   this->Cells.MinimumMeshEdgeLength = 2 * edge;
   this->Cells.NegligibleArea = edge * edge;
+  this->Cells.Interior = this->Interior;
+  if (!field.Values.empty())
+  {
+    const auto [lowest, highest] = std::minmax_element(field.Values.begin(), field.Values.end());
+    this->Cells.SurfaceTolerance = this->SurfaceTolerance * (*highest - *lowest);
+  }
   this->Cells.Parallel = this->Parallel;
   this->Cells.Hooks.Progress = [this](double f) { this->Hooks.Report(0.6 * f); };
   this->Cells.Hooks.AbortRequested = this->Hooks.AbortRequested;
-  if (!this->Cells.Reconstruct(complex, smoothed, error))
+  if (!this->Cells.Reconstruct(complex, smoothed, error, &field))
   {
     return false;
   }
@@ -194,7 +200,7 @@ bool FieldReconstruction::Run(const PlanarScalarField& field, const MorseSmaleCo
   this->Hooks.Report(0.85);
   if (this->VerifyTopology)
   {
-    this->Verify(field, complex, report);
+    this->Verify(field, complex, smoothed, report);
   }
   this->Hooks.Report(1.0);
   return true;
@@ -329,8 +335,45 @@ void FieldReconstruction::Resample(const PlanarScalarField& field, const Triangl
 // The verdict covers the whole reconstruction: a failed 2-cell or a vertex outside every
 // reconstructed cell keeps input values, which no critical-point count can vouch for. The raw
 // F o Phi before topological sampling is only reported.
-void FieldReconstruction::Verify(
-  const PlanarScalarField& field, const MorseSmaleComplex& complex, FieldReconstructionReport& report) const
+double GridSpacing(const PlanarScalarField& field)
+{
+  return field.IsGrid() ? std::max(field.GridSpacing[0], field.GridSpacing[1]) : MeanEdgeLength(field);
+}
+
+void CountByDistanceToOneCells(const std::vector<CriticalPointLocation>& points, const OneCellSmoothingResult& smoothed,
+  double distance, Index& near, Index& far)
+{
+  near = far = 0;
+  // The smoothed curves, sampled finely enough that the nearest sample is within a few
+  // percent of `distance` of the nearest curve point.
+  std::vector<double> samples;
+  for (const SmoothedPiece& piece : smoothed.Pieces)
+  {
+    const int perSegment = 16;
+    for (int j = 0; j < piece.Curve.Segments; ++j)
+    {
+      for (int m = 0; m <= perSegment; ++m)
+      {
+        double xy[2];
+        CubicBezierSpline::EvaluateSegment(piece.Curve.Segment(j), 2, static_cast<double>(m) / perSegment, xy);
+        samples.push_back(xy[0]);
+        samples.push_back(xy[1]);
+      }
+    }
+  }
+  for (const CriticalPointLocation& point : points)
+  {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < samples.size(); k += 2)
+    {
+      nearest = std::min(nearest, std::hypot(samples[k] - point.Position[0], samples[k + 1] - point.Position[1]));
+    }
+    ++(nearest <= distance ? near : far);
+  }
+}
+
+void FieldReconstruction::Verify(const PlanarScalarField& field, const MorseSmaleComplex& complex,
+  const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const
 {
   const auto start = std::chrono::steady_clock::now();
   report.VerificationRan = true;
@@ -351,6 +394,11 @@ void FieldReconstruction::Verify(
   if (report.Sampled)
   {
     report.RawInput = CheckSampling(WithValues(field, report.Exact), report.Expected, tolerance, this->Parallel);
+    if (report.RawInput.Ran)
+    {
+      CountByDistanceToOneCells(report.RawInput.Comparison.Spurious, smoothed, 2 * GridSpacing(field),
+        report.RawSpuriousNearOneCells, report.RawSpuriousFarFromOneCells);
+    }
   }
   report.Input = CheckSampling(WithValues(field, report.Values), report.Expected, tolerance, this->Parallel);
   judge(report.Input);

@@ -61,6 +61,10 @@ struct FieldReconstructionReport
   bool Verified = false;
   bool VerificationRan = false;
   SamplingTopologyCheck RawInput;  // F o Phi at the input vertices: reported, not judged
+  // Its spurious critical points within two grid spacings of a smoothed 1-cell (creases and
+  // curves crossing the grid) and farther (a surface that is not monotone enough inside).
+  Index RawSpuriousNearOneCells = 0;
+  Index RawSpuriousFarFromOneCells = 0;
   SamplingTopologyCheck Input;     // Values
   SamplingTopologyCheck Resampled; // Finer.Values
   std::vector<CriticalPointLocation> Expected;
@@ -73,6 +77,12 @@ class FieldReconstruction
 public:
   int BoundarySamples = 5;     // c in the paper: samples per boundary Bezier segment
   int OutputResolution = 1;    // finer grid: input spacing / OutputResolution; 1: none
+  // The 2-cell interiors (TwoCellReconstruction::Interior): fitted to the input by default, the
+  // paper's boundary-only construction on request (Table 1 as the paper defines it).
+  TwoCellInterior Interior = TwoCellInterior::Fitted;
+  // Fitted interiors: a cell's grid is refined while its largest residual exceeds this fraction
+  // of the input's value range (<= 0: no refinement).
+  double SurfaceTolerance = 0.01;
   bool TopologicalSampling = true;
   bool VerifyTopology = true;
   ParallelFor Parallel = SequentialFor;
@@ -89,6 +99,9 @@ public:
   bool Run(const PlanarScalarField& field, const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
     FieldReconstructionReport& report, std::string& error);
 
+  // The reconstructed 2-cells of the last Run (their surfaces, fits and parameterizations).
+  const TwoCellReconstruction& Reconstruction() const { return this->Cells; }
+
   // The finer grid of OutputResolution over `field` (no values yet): a grid's own points
   // refined, or for a triangle mesh a grid over its bounding box at the mean edge length /
   // OutputResolution.
@@ -103,7 +116,8 @@ private:
   void CollectPatches(FieldReconstructionReport& report) const;
   void Resample(const PlanarScalarField& field, const TriangleMeshTopology& mesh, const MorseSmaleComplex& complex,
     const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const;
-  void Verify(const PlanarScalarField& field, const MorseSmaleComplex& complex, FieldReconstructionReport& report) const;
+  void Verify(const PlanarScalarField& field, const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
+    FieldReconstructionReport& report) const;
 
   topospline::TopologicalSampling SamplingOf(const MorseSmaleComplex& complex, const TriangleMeshTopology& mesh,
     const PlanarScalarField& field, const OneCellSmoothingResult& smoothed) const;
@@ -116,6 +130,11 @@ private:
 double LargestEdgeLength(const PlanarScalarField& field);
 // Mean edge length of the triangulation (grids: of the two axes and the diagonal).
 double MeanEdgeLength(const PlanarScalarField& field);
+// The grid spacing (the larger axis), or the mean edge length of a triangle mesh.
+double GridSpacing(const PlanarScalarField& field);
+// Counts `points` within `distance` of a smoothed 1-cell curve (near) and beyond it (far).
+void CountByDistanceToOneCells(const std::vector<CriticalPointLocation>& points, const OneCellSmoothingResult& smoothed,
+  double distance, Index& near, Index& far);
 // The mesh of a field (closed form for grids).
 bool BuildMesh(const PlanarScalarField& field, TriangleMeshTopology& mesh, const ParallelFor& parallel,
   std::string& error);

@@ -233,6 +233,7 @@ bool MonotoneSibsonSurface::Build(
 {
   error.clear();
   this->BuildReport = MonotoneSurfaceReport();
+  this->Fit = MonotoneSurfaceFitReport();
   this->Patches.clear();
   const int n = static_cast<int>(boundary.Bottom.size());
   this->N = 0;

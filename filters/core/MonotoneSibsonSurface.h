@@ -6,6 +6,7 @@
 // that every cell meets the patch's sufficient monotonicity conditions (docs/Algorithms.md, 1.4).
 #pragma once
 
+#include "ConstrainedLeastSquares.h"
 #include "MonotoneSibsonPatch.h"
 
 #include <array>
@@ -83,6 +84,46 @@ struct MonotoneSurfaceReport
   double MaximumValueShift = 0; // largest change of an interior value from the Laplace one
 };
 
+// One input sample mapped into the square: (U, V) = Phi(x, y) and the input value at (x, y).
+struct SurfaceSample
+{
+  double U = 0;
+  double V = 0;
+  double Value = 0;
+};
+
+// The data-fitted interior (FitToSamples).
+struct MonotoneSurfaceFitOptions
+{
+  // Weight of the thin-plate energy of F on the square, per sample: it decides the free
+  // ordinates that no sample pins down (a grid cell without samples) and keeps the fit from
+  // chasing noise between samples.
+  double Smoothness = 1e-7;
+  // Every monotonicity row (p + q at the nodes with a free derivative, (C0), (C2), (C3)) is
+  // asked to be at least this fraction of the square's rise per grid step, R / N: a strictly
+  // increasing F whose samples have no flat spots where the kinks of Phi could make critical
+  // points. The paper's surface, which the fit starts from, bounds what is asked where it has
+  // less.
+  double MarginFraction = 0.02;
+  // Also aim at p >= 0 and q >= 0 (F increasing along u and v, as its sides are), not enforced
+  // exactly (see FitToSamples).
+  bool IncreasingAlongAxes = true;
+  ConstrainedLeastSquaresOptions Solver;
+};
+
+struct MonotoneSurfaceFitReport
+{
+  bool Fitted = false;        // false: the paper's interior was kept (no sample, or no gain)
+  int Samples = 0;
+  int Unknowns = 0;           // free ordinates: (N-1)^2 (z, p, q) + 4 (N-1) cross derivatives
+  int Rows = 0;               // monotonicity rows
+  double MaximumResidual = 0; // |F(u, v) - value| over the samples, after the fit
+  double RMSResidual = 0;
+  double PaperMaximumResidual = 0; // the same for the paper's boundary-only interior
+  double PaperRMSResidual = 0;
+  ConstrainedLeastSquaresReport Solver;
+};
+
 // A cubic Bezier triangle of the output, control points (x, y, z) with (x, y) in the unit
 // square, in the ordinate order of BezierOrdinateIndex.
 struct SurfaceBezierTriangle
@@ -98,6 +139,20 @@ public:
   // and Report().ViolatingCells says how many cells fail).
   bool Build(const MonotoneSurfaceBoundary& boundary, std::string& error,
     const MonotoneSurfaceOptions& options = MonotoneSurfaceOptions());
+
+  // Replaces the interior of the built surface (the paper's, from Build) by the one closest to
+  // the samples in the least-squares sense, under the same sufficient monotonicity conditions
+  // as linear rows: the free ordinates (z, p, q at the interior nodes, the cross derivative at
+  // the boundary nodes) are the unknowns, the boundary curves stay exactly as built, C1 holds
+  // inside by construction of the element. The paper's surface is the solver's feasible start,
+  // so the result satisfies every condition exactly; it is kept only if it fits better.
+  // Returns false with a message when the surface was not built or the fit's input is malformed
+  // (the paper's interior is then kept).
+  bool FitToSamples(const std::vector<SurfaceSample>& samples, std::string& error,
+    const MonotoneSurfaceFitOptions& options = MonotoneSurfaceFitOptions());
+  const MonotoneSurfaceFitReport& FitReport() const { return this->Fit; }
+  // Largest and root-mean-square |F(u, v) - value| over samples.
+  void MeasureResiduals(const std::vector<SurfaceSample>& samples, double& maximum, double& rms) const;
 
   int GetGridSize() const { return this->N; }
   const MonotoneSurfaceReport& Report() const { return this->BuildReport; }
@@ -158,8 +213,21 @@ private:
   // The nodes of the cells of a diagonal, sorted, each once.
   void DiagonalCellNodes(const GridDiagonal& diagonal, std::vector<int>& nodes) const;
 
+  // The steps of FitToSamples: the free ordinates' positions in the unknown vector (-1: fixed
+  // by the boundary), the quadratic program (objective, condition rows per cell, then per
+  // node), and its solution.
+  struct FreeOrdinates;
+  struct FitProblem;
+  FreeOrdinates NumberFreeOrdinates() const;
+  void AssembleFit(const FreeOrdinates& free, const std::vector<SurfaceSample>& samples,
+    const MonotoneSurfaceFitOptions& options, FitProblem& problem) const;
+  void AddNodeRows(const FreeOrdinates& free, double margin, bool increasingAlongAxes, FitProblem& problem) const;
+  bool SolveFit(const FitProblem& problem, const MonotoneSurfaceFitOptions& options, Eigen::VectorXd& solution,
+    std::string& error);
+
   int N = 0;
   std::vector<double> Z, P, Q, LaplaceZ;
+  MonotoneSurfaceFitReport Fit;
   std::vector<MonotoneSibsonPatch> Patches;
   MonotoneSurfaceReport BuildReport;
 };

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 namespace topospline
 {
@@ -522,8 +523,35 @@ std::vector<std::array<bool, 2>> StemChoices(const TwoCell& twoCell, const TwoCe
 }
 } // namespace
 
-bool TwoCellReconstruction::Reconstruct(
-  const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed, std::string& error)
+namespace
+{
+// Counting sort of the items 0..ids.size()-1 by their id in [0, groups): the items of group g
+// are items[first[g] .. first[g + 1]). Items with an id outside the range are left out.
+void GroupByIndex(const std::vector<Index>& ids, Index groups, std::vector<Index>& first, std::vector<Index>& items)
+{
+  first.assign(static_cast<std::size_t>(groups) + 1, 0);
+  for (Index id : ids)
+  {
+    if (id >= 0 && id < groups)
+    {
+      ++first[id + 1];
+    }
+  }
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  items.assign(first.back(), 0);
+  std::vector<Index> next(first.begin(), first.end() - 1);
+  for (Index item = 0; item < static_cast<Index>(ids.size()); ++item)
+  {
+    if (ids[item] >= 0 && ids[item] < groups)
+    {
+      items[next[ids[item]]++] = item;
+    }
+  }
+}
+} // namespace
+
+bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
+  std::string& error, const PlanarScalarField* data)
 {
   this->Cells.clear();
   this->Summary = TwoCellReconstructionReport();
@@ -561,14 +589,44 @@ bool TwoCellReconstruction::Reconstruct(
   this->Summary.ParameterizationSeconds = Seconds(start);
   this->Hooks.Report(0.7);
 
-  // Pass 2 (the paper's "time III"): subdivision to a common count and the Sibson surface.
+  // Pass 2 (the paper's "time III"): subdivision to a common count and the Sibson surface,
+  // fitted to the cell's input samples when asked.
   start = Clock::now();
+  const bool fit = this->Interior == TwoCellInterior::Fitted && data != nullptr &&
+    complex.TwoCellId.size() == data->Values.size() && data->Points.size() == 2 * data->Values.size();
+  std::vector<Index> firstVertex, vertices; // vertices of cell c: [firstVertex[c], firstVertex[c + 1])
+  std::vector<double> parameters;           // (u, v) per vertex in its cell
+  if (fit)
+  {
+    // Every vertex is data for the smoothed cell that contains it (near the 1-cells that is
+    // often not the region stage 1 put it in).
+    this->BuildCellLocator();
+    this->LocateSamples(*data, complex.TwoCellId, firstVertex, vertices, parameters);
+  }
+  std::vector<char> refined(n, 0);
   this->Parallel(0, n, [&](Index begin, Index end) {
-    for (Index c = begin; c < end; ++c)
+    for (Index c = begin; c < end && !this->Hooks.Aborted(); ++c)
     {
-      BuildSurface(*this->Cells[c], boundaries[c]);
+      ReconstructedTwoCell& cell = *this->Cells[c];
+      BuildSurface(cell, boundaries[c]);
+      if (fit && cell.Valid)
+      {
+        std::vector<SurfaceSample> samples;
+        samples.reserve(firstVertex[c + 1] - firstVertex[c]);
+        for (Index k = firstVertex[c]; k < firstVertex[c + 1]; ++k)
+        {
+          samples.push_back({ parameters[2 * vertices[k]], parameters[2 * vertices[k] + 1], data->Values[vertices[k]] });
+        }
+        refined[c] = this->FitSurface(cell, boundaries[c], samples);
+      }
     }
   });
+  if (this->Hooks.Aborted())
+  {
+    error = "aborted";
+    return false;
+  }
+  this->Summary.RefinedCells = std::count(refined.begin(), refined.end(), 1);
   this->Summary.SurfaceSeconds = Seconds(start);
   this->Summarize();
   this->BuildCellLocator();
@@ -649,6 +707,75 @@ void TwoCellReconstruction::ParameterizeCell(const TwoCell& twoCell, const OneCe
 }
 
 // The monotone Sibson surface on the square from the cell's subdivided sides.
+void TwoCellReconstruction::LocateSamples(const PlanarScalarField& data, const std::vector<Index>& hints,
+  std::vector<Index>& firstVertex, std::vector<Index>& vertices, std::vector<double>& parameters) const
+{
+  const Index count = static_cast<Index>(data.Values.size());
+  std::vector<Index> cellOf(count, InvalidIndex);
+  parameters.assign(2 * static_cast<std::size_t>(count), 0.0);
+  this->Parallel(0, count, [&](Index begin, Index end) {
+    for (Index v = begin; v < end; ++v)
+    {
+      const Location location = this->Locate(data.Points[2 * v], data.Points[2 * v + 1], hints[v]);
+      // Snapped vertices (outside every cell) would only repeat the fixed boundary curve.
+      if (location.Inside)
+      {
+        cellOf[v] = location.Cell;
+        parameters[2 * v] = location.UV[0];
+        parameters[2 * v + 1] = location.UV[1];
+      }
+    }
+  });
+  GroupByIndex(cellOf, this->NumberOfCells(), firstVertex, vertices);
+}
+
+bool TwoCellReconstruction::FitSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided,
+  const std::vector<SurfaceSample>& samples) const
+{
+  std::string message;
+  // A handful of samples (tiny cells of noisy data), or far fewer samples than grid cells (a
+  // long boundary around a small region), pins down little the boundary does not, at the cost
+  // of thousands of unknowns: such cells keep the paper's interior.
+  const std::size_t minimumSamples = std::max<std::size_t>(8, cell.GridSize * cell.GridSize / 16);
+  if (cell.GridSize > this->MaximumFittedGridSize || samples.size() < minimumSamples ||
+    !cell.Surface.FitToSamples(samples, message, this->Fit))
+  {
+    return false;
+  }
+  // Refinement: double the grid while the fit misses the tolerance, every grid cell keeps a
+  // few samples, and each doubling gains (the spaces are not nested: keep the best).
+  const double minimumSamplesPerGridCell = 4;
+  bool refined = false;
+  MonotoneSurfaceBoundary boundary = subdivided;
+  for (int n = cell.GridSize * 2; this->SurfaceTolerance > 0 && n <= this->MaximumRefinedGridSize &&
+       cell.Surface.FitReport().MaximumResidual > this->SurfaceTolerance &&
+       static_cast<double>(samples.size()) >= minimumSamplesPerGridCell * n * n;
+       n *= 2)
+  {
+    MonotoneSurfaceBoundary finer;
+    if (!SubdivideSide(boundary.Bottom, n, finer.Bottom) || !SubdivideSide(boundary.Right, n, finer.Right) ||
+      !SubdivideSide(boundary.Top, n, finer.Top) || !SubdivideSide(boundary.Left, n, finer.Left))
+    {
+      break;
+    }
+    boundary = finer;
+    ReconstructedTwoCell trial;
+    trial.Valid = true;
+    BuildSurface(trial, boundary);
+    const MonotoneSurfaceFitReport& coarse = cell.Surface.FitReport();
+    if (!trial.Valid || !trial.Surface.FitToSamples(samples, message, this->Fit) ||
+      (trial.Surface.FitReport().MaximumResidual > 0.9 * coarse.MaximumResidual &&
+        trial.Surface.FitReport().RMSResidual > 0.9 * coarse.RMSResidual))
+    {
+      break;
+    }
+    cell.Surface = std::move(trial.Surface);
+    cell.GridSize = trial.GridSize;
+    refined = true;
+  }
+  return refined;
+}
+
 void TwoCellReconstruction::BuildSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided)
 {
   if (!cell.Valid)
@@ -692,6 +819,7 @@ void TwoCellReconstruction::Summarize()
     const MonotoneSurfaceReport& r = cell->Surface.Report();
     s.ViolatingPatches += r.ViolatingCells;
     s.LinearizedDiagonals += r.LinearizedDiagonals;
+    s.FittedCells += cell->Surface.FitReport().Fitted ? 1 : 0;
     s.AdjustedDiagonals += r.AdjustedDiagonals;
     s.MeshTriangles += cell->Parameterization.GetMesh().NumberOfTriangles();
     s.BezierTriangles += 4 * cell->GridSize * cell->GridSize;
@@ -761,7 +889,7 @@ void TwoCellReconstruction::BuildCellLocator()
   }
 }
 
-bool TwoCellReconstruction::EvaluateInCell(Index c, double x, double y, double& value) const
+bool TwoCellReconstruction::LocateInCell(Index c, double x, double y, double uv[2]) const
 {
   const ReconstructedTwoCell& cell = *this->Cells[c];
   const double tolerance = 1e-9 * std::max(cell.Bounds[1] - cell.Bounds[0], cell.Bounds[3] - cell.Bounds[2]);
@@ -770,19 +898,13 @@ bool TwoCellReconstruction::EvaluateInCell(Index c, double x, double y, double& 
   {
     return false;
   }
-  double uv[2];
-  if (!cell.Parameterization.Evaluate(x, y, uv))
-  {
-    return false;
-  }
-  value = cell.Surface.Evaluate(uv[0], uv[1]);
-  return true;
+  return cell.Parameterization.Evaluate(x, y, uv);
 }
 
-TwoCellReconstruction::Evaluation TwoCellReconstruction::Evaluate(double x, double y, Index hint) const
+TwoCellReconstruction::Location TwoCellReconstruction::Locate(double x, double y, Index hint) const
 {
-  Evaluation result;
-  if (hint >= 0 && hint < this->NumberOfCells() && this->EvaluateInCell(hint, x, y, result.Value))
+  Location result;
+  if (hint >= 0 && hint < this->NumberOfCells() && this->LocateInCell(hint, x, y, result.UV))
   {
     result.Cell = hint;
     result.Inside = true;
@@ -803,7 +925,7 @@ TwoCellReconstruction::Evaluation TwoCellReconstruction::Evaluate(double x, doub
   const Index* end = this->BucketCells.data() + this->BucketStart[bucket + 1];
   for (const Index* c = begin; c != end; ++c)
   {
-    if (*c != hint && this->EvaluateInCell(*c, x, y, result.Value))
+    if (*c != hint && this->LocateInCell(*c, x, y, result.UV))
     {
       result.Cell = *c;
       result.Inside = true;
@@ -811,7 +933,7 @@ TwoCellReconstruction::Evaluation TwoCellReconstruction::Evaluate(double x, doub
     }
   }
   // Outside every cell: the smoothed boundary of the domain or a rounding gap. The nearest
-  // boundary point within the snap distance gives the value.
+  // boundary point within the snap distance stands in.
   double best = this->Snap * this->Snap;
   for (const Index* c = begin; c != end; ++c)
   {
@@ -826,13 +948,25 @@ TwoCellReconstruction::Evaluation TwoCellReconstruction::Evaluate(double x, doub
       if (d2 <= best)
       {
         best = d2;
-        const double u = (1 - fraction) * mesh.Parameters[2 * k] + fraction * mesh.Parameters[2 * l];
-        const double v = (1 - fraction) * mesh.Parameters[2 * k + 1] + fraction * mesh.Parameters[2 * l + 1];
-        result.Value = cell.Surface.Evaluate(u, v);
+        result.UV[0] = (1 - fraction) * mesh.Parameters[2 * k] + fraction * mesh.Parameters[2 * l];
+        result.UV[1] = (1 - fraction) * mesh.Parameters[2 * k + 1] + fraction * mesh.Parameters[2 * l + 1];
         result.Cell = *c;
         result.Inside = false;
       }
     }
+  }
+  return result;
+}
+
+TwoCellReconstruction::Evaluation TwoCellReconstruction::Evaluate(double x, double y, Index hint) const
+{
+  const Location location = this->Locate(x, y, hint);
+  Evaluation result;
+  result.Cell = location.Cell;
+  result.Inside = location.Inside;
+  if (location.Cell != InvalidIndex)
+  {
+    result.Value = this->Cells[location.Cell]->Surface.Evaluate(location.UV[0], location.UV[1]);
   }
   return result;
 }

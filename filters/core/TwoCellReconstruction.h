@@ -107,11 +107,22 @@ struct TwoCellReconstructionReport
   Index ViolatingPatches = 0;  // Sibson grid cells failing the monotonicity conditions (0 is the goal)
   Index LinearizedDiagonals = 0; // the paper's fallback for non-increasing Laplace values
   Index AdjustedDiagonals = 0;   // diagonals whose values were moved to meet the conditions
+  Index FittedCells = 0;       // interiors fitted to the input samples (Interior == Fitted)
+  Index RefinedCells = 0;      // of them, cells whose grid was refined beyond the sides' need
   Index MeshTriangles = 0;     // triangles of all cell meshes
   Index BezierTriangles = 0;   // 4 N^2 per cell
   int MaximumGridSize = 0;
   double ParameterizationSeconds = 0; // wall time: triangulation + mean value coordinates
-  double SurfaceSeconds = 0;          // wall time: Sibson surfaces
+  double SurfaceSeconds = 0;          // wall time: Sibson surfaces (with their fits)
+};
+
+// What decides a 2-cell's interior: the paper's construction from the boundary curves alone,
+// or a least-squares fit to the input samples inside the cell under the same monotonicity
+// conditions (MonotoneSibsonSurface::FitToSamples), with the grid refined where the data ask.
+enum class TwoCellInterior : int
+{
+  Paper = 0,
+  Fitted = 1
 };
 
 // A cubic Bezier triangle of the reconstruction in the plane: control points (x, y, height),
@@ -140,13 +151,28 @@ public:
   // of the mean grid edge: such a cell holds at most a vertex or two, which take the value of
   // the nearest cell boundary).
   double NegligibleArea = 0;
+  TwoCellInterior Interior = TwoCellInterior::Paper;
+  // Fitted interiors: a cell's grid is doubled (its boundary Beziers split exactly) while its
+  // largest residual exceeds this (in the field's units; <= 0: never), up to
+  // MaximumRefinedGridSize, while every grid cell keeps a few samples and each doubling gains
+  // at least 10 %; the best grid is kept (the spaces are not nested).
+  double SurfaceTolerance = 0;
+  int MaximumRefinedGridSize = 32;
+  // Cells whose sides alone need a finer grid than this keep the paper's interior: their fit
+  // has tens of thousands of unknowns (seconds per cell), and such grids come from long sides
+  // around few samples, where the boundary curves already carry the data. So do cells with
+  // fewer than 8 samples or than one per 16 grid cells.
+  int MaximumFittedGridSize = 48;
+  MonotoneSurfaceFitOptions Fit;
   ParallelFor Parallel = SequentialFor;
   ProgressHooks Hooks;
 
   // Reconstructs every 2-cell of `complex` (the simplified complex that `smoothed` was made
-  // from). Cells that fail are reported (Report().FailedCells); the call fails only on
-  // malformed input or abort.
-  bool Reconstruct(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed, std::string& error);
+  // from). `data`, the input field, is needed for fitted interiors (its vertices are assigned to
+  // cells by complex.TwoCellId); without it the interiors are the paper's. Cells that fail are
+  // reported (Report().FailedCells); the call fails only on malformed input or abort.
+  bool Reconstruct(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed, std::string& error,
+    const PlanarScalarField* data = nullptr);
 
   Index NumberOfCells() const { return static_cast<Index>(this->Cells.size()); }
   const ReconstructedTwoCell& Cell(Index c) const { return *this->Cells[c]; }
@@ -172,9 +198,25 @@ private:
   void ParameterizeCell(const TwoCell& twoCell, const OneCellSmoothingResult& smoothed, ReconstructedTwoCell& cell,
     MonotoneSurfaceBoundary& boundary) const;
   static void BuildSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided);
+  // Where each input vertex lies: the cell containing it (hints: a likely cell per vertex) and
+  // its (u, v) there; the vertices of cell c are vertices[firstVertex[c] .. firstVertex[c + 1]).
+  void LocateSamples(const PlanarScalarField& data, const std::vector<Index>& hints, std::vector<Index>& firstVertex,
+    std::vector<Index>& vertices, std::vector<double>& parameters) const;
+  // Fits the cell's interior, refining its grid (see SurfaceTolerance); returns whether refined.
+  bool FitSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided,
+    const std::vector<SurfaceSample>& samples) const;
   void Summarize();
   void BuildCellLocator();
-  bool EvaluateInCell(Index c, double x, double y, double& value) const;
+  // The cell containing (x, y) and the point's (u, v) in its square (Inside false: snapped to
+  // the nearest boundary point within the snap distance; Cell InvalidIndex: none).
+  struct Location
+  {
+    Index Cell = InvalidIndex;
+    bool Inside = false;
+    double UV[2] = { 0, 0 };
+  };
+  Location Locate(double x, double y, Index hint) const;
+  bool LocateInCell(Index c, double x, double y, double uv[2]) const;
 
   std::vector<std::unique_ptr<ReconstructedTwoCell>> Cells;
   TwoCellReconstructionReport Summary;

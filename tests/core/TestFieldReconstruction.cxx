@@ -188,6 +188,70 @@ TEST_CASE(TrigonometricAtTwoThresholds)
   CheckCase("trigonometric", TrigonometricField(10, 100, -49), 25, 4, 1);
 }
 
+namespace
+{
+struct Fidelity
+{
+  double Maximum = 0; // of Reconstructed, fraction of the range
+  double RMS = 0;
+  double ExactMaximum = 0; // of F o Phi
+  Index FarSpurious = 0;
+};
+
+// Errors against the input, recomputed here from the values the report gives.
+Fidelity Measure(const GridField& grid, double percent, int k, TwoCellInterior interior)
+{
+  Pipeline p;
+  std::string error;
+  Fidelity result;
+  CHECK(RunStages1To3(grid, percent, k, p, error));
+  FieldReconstruction reconstruction;
+  reconstruction.Interior = interior;
+  reconstruction.Parallel = ThreadedFor;
+  FieldReconstructionReport report;
+  CHECK(reconstruction.Run(p.Field, p.Simplified.Complex, p.Smoothed, report, error));
+  CHECK(report.Verified);
+  double squares = 0;
+  for (std::size_t v = 0; v < p.Field.Values.size(); ++v)
+  {
+    const double d = std::abs(report.Values[v] - p.Field.Values[v]);
+    result.Maximum = std::max(result.Maximum, d / p.Range);
+    result.ExactMaximum = std::max(result.ExactMaximum, std::abs(report.Exact[v] - p.Field.Values[v]) / p.Range);
+    squares += d * d;
+  }
+  result.RMS = std::sqrt(squares / p.Field.Values.size()) / p.Range;
+  result.FarSpurious = report.RawSpuriousFarFromOneCells;
+  return result;
+}
+} // namespace
+
+TEST_CASE(FittedInteriorsFollowTheData)
+{
+  // The Trigonometric Field with nothing removed: the fitted surface itself (F o Phi) within 2 %
+  // of the range everywhere, where the paper's boundary-only interior is off by a third.
+  const GridField trig = TrigonometricField(10, 100, -49);
+  const Fidelity fitted = Measure(trig, 0, 4, TwoCellInterior::Fitted);
+  const Fidelity paper = Measure(trig, 0, 4, TwoCellInterior::Paper);
+  std::printf("  trigonometric 0%%: F o Phi max error %.2f %% (paper %.2f %%), RMS %.2f %% (paper %.2f %%), "
+              "%d spurious critical points far from the 1-cells\n",
+    100 * fitted.ExactMaximum, 100 * paper.ExactMaximum, 100 * fitted.RMS, 100 * paper.RMS, fitted.FarSpurious);
+  CHECK(fitted.ExactMaximum <= 0.02);
+  CHECK(fitted.RMS <= 0.005);
+  CHECK(paper.ExactMaximum > 0.1);
+  CHECK(fitted.FarSpurious == 0);
+  // Shepard fields at 5 %: RMS within 2 % of the range, at most half the paper's.
+  for (std::uint64_t seed : { 0, 1, 2, 3 })
+  {
+    const GridField shepard = ShepardField(40, 2.0, 250, seed);
+    const Fidelity f = Measure(shepard, 5, 4, TwoCellInterior::Fitted);
+    const Fidelity q = Measure(shepard, 5, 4, TwoCellInterior::Paper);
+    std::printf("  shepard seed %d 5%%: RMS %.2f %% (paper %.2f %%), max %.2f %% (paper %.2f %%)\n",
+      static_cast<int>(seed), 100 * f.RMS, 100 * q.RMS, 100 * f.Maximum, 100 * q.Maximum);
+    CHECK(f.RMS <= 0.02);
+    CHECK(f.RMS <= 0.5 * q.RMS);
+  }
+}
+
 int main()
 {
   return testing_harness::RunAll();

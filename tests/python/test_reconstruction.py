@@ -43,7 +43,6 @@ def field_range_of(fd):
 KNOWN_MISSES = {
     "sainthelens_usgs_dem_crop.vti 25% k=4": "a minimum two spacings from a boundary junction: "
     "F o Phi misses its value by 2.1 (0.1 % of the range) and the sampling loses it",
-    "ttk_happi_tas_anomaly.vti 5% k=4": "one saddle found about 11 spacings from its node in a nearly flat pass",
     # TOPOSPLINE_LARGE_TESTS=1 only:
     "rainier_ned1_1970_full.vti 25% k=4": "topology verdict off (a critical point off its node)",
     "rainier_ned1_1970_full.vti 25% k=7": "topology verdict off (a critical point off its node)",

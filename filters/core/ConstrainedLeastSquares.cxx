@@ -1,0 +1,193 @@
+#include "ConstrainedLeastSquares.h"
+
+#include <Eigen/SparseCholesky>
+
+#include <algorithm>
+#include <cmath>
+
+namespace topospline
+{
+namespace
+{
+double Objective(const Eigen::SparseMatrix<double>& h, const Eigen::VectorXd& g, const Eigen::VectorXd& x)
+{
+  return 0.5 * x.dot(h * x) - g.dot(x);
+}
+
+// The largest t in [0, 1] with C (x0 + t (x1 - x0)) >= d, given C x0 >= d.
+double LargestFeasibleStep(const Eigen::VectorXd& atStart, const Eigen::VectorXd& atEnd, const Eigen::VectorXd& d)
+{
+  double t = 1;
+  for (Eigen::Index r = 0; r < d.size(); ++r)
+  {
+    const double slack = atStart[r] - d[r];
+    const double change = atEnd[r] - atStart[r];
+    if (change < 0)
+    {
+      t = std::min(t, std::max(0.0, slack) / -change);
+    }
+  }
+  return t;
+}
+
+bool AllFinite(const Eigen::SparseMatrix<double>& m)
+{
+  for (Eigen::Index k = 0; k < m.nonZeros(); ++k)
+  {
+    if (!std::isfinite(m.valuePtr()[k]))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+} // namespace
+
+bool SolveConstrainedLeastSquares(const Eigen::SparseMatrix<double>& hessian, const Eigen::VectorXd& gradient,
+  const Eigen::SparseMatrix<double>& constraints, const Eigen::VectorXd& bounds, const Eigen::VectorXd& targets,
+  const Eigen::VectorXd& feasible, Eigen::VectorXd& solution, ConstrainedLeastSquaresReport& report,
+  std::string& error, const ConstrainedLeastSquaresOptions& options)
+{
+  report = ConstrainedLeastSquaresReport();
+  const Eigen::Index n = hessian.rows();
+  const Eigen::Index m = constraints.rows();
+  if (hessian.cols() != n || gradient.size() != n || feasible.size() != n || constraints.cols() != n ||
+    bounds.size() != m || targets.size() != m)
+  {
+    error = "constrained least squares: the sizes do not match";
+    return false;
+  }
+  if (!AllFinite(hessian) || !AllFinite(constraints) || !gradient.allFinite() || !bounds.allFinite() ||
+    !targets.allFinite() || !feasible.allFinite())
+  {
+    error = "constrained least squares: a non-finite entry";
+    return false;
+  }
+  const Eigen::VectorXd atFeasible = constraints * feasible;
+  if (m > 0 && (atFeasible - bounds).minCoeff() < 0)
+  {
+    error = "constrained least squares: the starting point violates a row";
+    return false;
+  }
+  report.FeasibleObjective = Objective(hessian, gradient, feasible);
+
+  // Rows scaled to unit norm, so that one rho and one tolerance fit them all.
+  Eigen::VectorXd rowNorm = Eigen::VectorXd::Zero(m);
+  for (Eigen::Index k = 0; k < constraints.outerSize(); ++k)
+  {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(constraints, k); it; ++it)
+    {
+      rowNorm[it.row()] += it.value() * it.value();
+    }
+  }
+  Eigen::VectorXd rowScale(m);
+  for (Eigen::Index r = 0; r < m; ++r)
+  {
+    rowScale[r] = rowNorm[r] > 0 ? 1 / std::sqrt(rowNorm[r]) : 0;
+  }
+  const Eigen::SparseMatrix<double> c = rowScale.asDiagonal() * constraints;
+  const Eigen::VectorXd lower = rowScale.cwiseProduct(targets.cwiseMax(bounds));
+
+  // Start from the unconstrained minimizer: when it meets every row, it is the answer.
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> unconstrained(hessian);
+  if (unconstrained.info() != Eigen::Success)
+  {
+    error = "constrained least squares: the objective is not positive definite";
+    return false;
+  }
+  Eigen::VectorXd x = unconstrained.solve(gradient);
+  Eigen::VectorXd cx = c * x;
+  if (m == 0 || (cx - lower).minCoeff() >= 0)
+  {
+    report.UnconstrainedFeasible = report.Converged = true;
+  }
+  else
+  {
+    // ADMM (OSQP's splitting): x-update through K = H + sigma I + rho C^T C, z = projection of
+    // C x onto {z >= lower}, y the multipliers; over-relaxation alpha.
+    const double scale = std::max(1e-300, hessian.diagonal().cwiseAbs().mean());
+    const double sigma = 1e-6 * scale;
+    const double alpha = 1.6;
+    double rho = 0.1 * scale;
+    Eigen::SparseMatrix<double> identity(n, n);
+    identity.setIdentity();
+    const Eigen::SparseMatrix<double> ctc = Eigen::SparseMatrix<double>(c.transpose()) * c;
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> k;
+    auto factor = [&]() {
+      k.compute(hessian + sigma * identity + rho * ctc);
+      return k.info() == Eigen::Success;
+    };
+    if (!factor())
+    {
+      error = "constrained least squares: the ADMM system is singular";
+      return false;
+    }
+    Eigen::VectorXd z = cx.cwiseMax(lower);
+    Eigen::VectorXd y = Eigen::VectorXd::Zero(m);
+    const double tolerance = options.PrimalTolerance * std::max(1.0, lower.cwiseAbs().maxCoeff());
+    for (int iteration = 1; iteration <= options.MaximumIterations; ++iteration)
+    {
+      report.Iterations = iteration;
+      const Eigen::VectorXd xTilde = k.solve(sigma * x + gradient + c.transpose() * (rho * z - y));
+      const Eigen::VectorXd zTilde = c * xTilde;
+      x = alpha * xTilde + (1 - alpha) * x;
+      const Eigen::VectorXd zRelaxed = alpha * zTilde + (1 - alpha) * z;
+      const Eigen::VectorXd zNext = (zRelaxed + y / rho).cwiseMax(lower);
+      y += rho * (zRelaxed - zNext);
+      z = zNext;
+      if (iteration % 10 != 0 && iteration != options.MaximumIterations)
+      {
+        continue;
+      }
+      cx = c * x;
+      const double primal = (lower - cx).cwiseMax(0.0).maxCoeff();
+      const Eigen::VectorXd dualVector = hessian * x - gradient + c.transpose() * y;
+      const double dual = dualVector.cwiseAbs().maxCoeff();
+      const double dualScale = std::max({ 1.0, gradient.cwiseAbs().maxCoeff(), (hessian * x).cwiseAbs().maxCoeff() });
+      if (primal <= tolerance && dual <= options.DualTolerance * dualScale)
+      {
+        report.Converged = true;
+        break;
+      }
+      // Residual balancing: rho up when the rows lag, down when optimality does.
+      const double primalRelative = primal / std::max({ 1e-300, cx.cwiseAbs().maxCoeff(), z.cwiseAbs().maxCoeff() });
+      const double dualRelative = dual / dualScale;
+      const double ratio = std::sqrt(primalRelative / std::max(1e-300, dualRelative));
+      if ((ratio > 5 || ratio < 0.2) && iteration % 100 == 0)
+      {
+        rho = std::clamp(rho * ratio, 1e-6 * scale, 1e6 * scale);
+        if (!factor())
+        {
+          error = "constrained least squares: the ADMM system is singular";
+          return false;
+        }
+      }
+    }
+  }
+
+  // Exactly feasible: pull towards the feasible start as little as every row allows.
+  const Eigen::VectorXd atSolution = constraints * x;
+  double t = m > 0 ? LargestFeasibleStep(atFeasible, atSolution, bounds) : 1.0;
+  solution = feasible + t * (x - feasible);
+  // Rounding in the step can leave a row a few ulps short: step back until none is.
+  for (int attempt = 0; attempt < 8 && m > 0 && (constraints * solution - bounds).minCoeff() < 0; ++attempt)
+  {
+    t *= 0.5;
+    solution = feasible + t * (x - feasible);
+  }
+  if (m > 0 && (constraints * solution - bounds).minCoeff() < 0)
+  {
+    t = 0;
+    solution = feasible;
+  }
+  report.PulledBack = 1 - t;
+  report.Objective = Objective(hessian, gradient, solution);
+  if (report.Objective > report.FeasibleObjective)
+  {
+    solution = feasible;
+    report.Objective = report.FeasibleObjective;
+    report.PulledBack = 1;
+  }
+  return true;
+}
+} // namespace topospline

@@ -1,0 +1,53 @@
+// The quadratic program behind the data-fitted 2-cell interiors (stage 4, MonotoneSibsonSurface::
+// FitToSamples): minimize 1/2 x^T H x - g^T x subject to linear inequalities C x >= d, with H
+// symmetric positive definite (a least-squares fit A^T A plus a smoothness energy plus a small
+// ridge) and a point x_f known to satisfy every row (the paper's boundary-only surface).
+//
+// Solver: the alternating direction method of multipliers in the splitting of OSQP (Stellato et
+// al., Math. Prog. Comp. 12, 2020): one sparse LDLT factorization of H + sigma I + rho C^T C
+// (Eigen's SimplicialLDLT), then cheap iterations, rho rebalanced (and refactored) a few times.
+// ADMM satisfies the rows only up to a tolerance, so the answer is then pulled towards x_f:
+// x = x_f + t (x_admm - x_f) with the largest t in [0, 1] that keeps every row at or above its
+// bound. The rows are linear, so t is a minimum over rows in closed form, and the result is
+// feasible whatever the solver did (docs/Reconstruction.md, "Fitted interiors"). GLPK,
+// the project's LP solver, has no quadratic objective, and an L1 fit as an LP with one slack per
+// sample took 0.6 - 11 s per cell on this machine kind, against milliseconds here.
+#pragma once
+
+#include <Eigen/Sparse>
+
+#include <string>
+#include <vector>
+
+namespace topospline
+{
+struct ConstrainedLeastSquaresOptions
+{
+  int MaximumIterations = 300;
+
+  // Stop when every row is violated by at most this (in the row's own units, after rows are
+  // scaled to unit norm) and the dual residual is small.
+  double PrimalTolerance = 1e-5;
+  double DualTolerance = 1e-5;
+};
+
+struct ConstrainedLeastSquaresReport
+{
+  int Iterations = 0;
+  bool Converged = false;       // the ADMM tolerances were met
+  bool UnconstrainedFeasible = false; // the unconstrained minimizer already met every row
+  double PulledBack = 0;        // 1 - t: how far the answer was pulled towards x_f
+  double Objective = 0;         // at the returned x
+  double FeasibleObjective = 0; // at x_f
+};
+
+// Minimizes as above. `feasible` must satisfy every row (C feasible >= bounds); the returned x
+// does too. ADMM aims at `targets` (>= bounds, row by row): the gap between the two absorbs its
+// tolerance, so that the pull towards x_f is small. Returns false with a message on malformed
+// input (sizes, a non-finite entry, an infeasible start, H not positive definite).
+bool SolveConstrainedLeastSquares(const Eigen::SparseMatrix<double>& hessian, const Eigen::VectorXd& gradient,
+  const Eigen::SparseMatrix<double>& constraints, const Eigen::VectorXd& bounds, const Eigen::VectorXd& targets,
+  const Eigen::VectorXd& feasible,
+  Eigen::VectorXd& solution, ConstrainedLeastSquaresReport& report, std::string& error,
+  const ConstrainedLeastSquaresOptions& options = ConstrainedLeastSquaresOptions());
+} // namespace topospline
