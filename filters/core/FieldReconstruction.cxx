@@ -3,9 +3,12 @@
 #include "MorseSmaleComplexExtraction.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <unordered_map>
 
 namespace topospline
 {
@@ -344,9 +347,19 @@ void CountByDistanceToOneCells(const std::vector<CriticalPointLocation>& points,
   double distance, Index& near, Index& far)
 {
   near = far = 0;
-  // The smoothed curves, sampled finely enough that the nearest sample is within a few
-  // percent of `distance` of the nearest curve point.
-  std::vector<double> samples;
+  if (points.empty())
+  {
+    return;
+  }
+  // The smoothed curves, sampled finely enough that the nearest sample is within a few percent
+  // of `distance` of the nearest curve point, in buckets of side `distance`: a point is near
+  // when a sample within `distance` lies in its bucket or the 8 around it.
+  const double side = distance > 0 ? distance : 1.0;
+  std::unordered_map<long long, std::vector<std::array<double, 2>>> buckets;
+  const auto key = [side](double x, double y) {
+    return (static_cast<long long>(std::floor(x / side)) << 32) ^
+      (static_cast<long long>(std::floor(y / side)) & 0xffffffffLL);
+  };
   for (const SmoothedPiece& piece : smoothed.Pieces)
   {
     const int perSegment = 16;
@@ -354,21 +367,35 @@ void CountByDistanceToOneCells(const std::vector<CriticalPointLocation>& points,
     {
       for (int m = 0; m <= perSegment; ++m)
       {
-        double xy[2];
-        CubicBezierSpline::EvaluateSegment(piece.Curve.Segment(j), 2, static_cast<double>(m) / perSegment, xy);
-        samples.push_back(xy[0]);
-        samples.push_back(xy[1]);
+        std::array<double, 2> xy;
+        CubicBezierSpline::EvaluateSegment(piece.Curve.Segment(j), 2, static_cast<double>(m) / perSegment, xy.data());
+        buckets[key(xy[0], xy[1])].push_back(xy);
       }
     }
   }
   for (const CriticalPointLocation& point : points)
   {
-    double nearest = std::numeric_limits<double>::infinity();
-    for (std::size_t k = 0; k < samples.size(); k += 2)
+    bool isNear = false;
+    for (int dx = -1; dx <= 1 && !isNear; ++dx)
     {
-      nearest = std::min(nearest, std::hypot(samples[k] - point.Position[0], samples[k + 1] - point.Position[1]));
+      for (int dy = -1; dy <= 1 && !isNear; ++dy)
+      {
+        const auto found = buckets.find(key(point.Position[0] + dx * side, point.Position[1] + dy * side));
+        if (found == buckets.end())
+        {
+          continue;
+        }
+        for (const auto& xy : found->second)
+        {
+          if (std::hypot(xy[0] - point.Position[0], xy[1] - point.Position[1]) <= distance)
+          {
+            isNear = true;
+            break;
+          }
+        }
+      }
     }
-    ++(nearest <= distance ? near : far);
+    ++(isNear ? near : far);
   }
 }
 

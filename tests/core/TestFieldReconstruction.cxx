@@ -252,6 +252,34 @@ TEST_CASE(FittedInteriorsFollowTheData)
   }
 }
 
+TEST_CASE(SpuriousPointsAreCountedNearAndFarFromTheOneCells)
+{
+  // One straight smoothed 1-cell from (0, 0) to (30, 0); points at known distances from it.
+  OneCellSmoothingResult smoothed;
+  SmoothedPiece piece;
+  piece.Curve.Segments = 1;
+  piece.Curve.Dimension = 2;
+  piece.Curve.ControlPoints = { 0, 0, 10, 0, 20, 0, 30, 0 };
+  smoothed.Pieces.push_back(piece);
+  std::vector<CriticalPointLocation> points;
+  // (The curve is sampled 16 times per Bezier segment: the test distances stay clear of 2 by more
+  // than the sampling error.)
+  for (const auto& xy : { std::array<double, 2>{ 5, 0.5 }, { 12, -1.5 }, { 29, 2.5 }, { 15, 5 }, { -1.5, 0 },
+         { 33, 0 }, { -40, 7 } })
+  {
+    CriticalPointLocation point;
+    point.Position[0] = xy[0];
+    point.Position[1] = xy[1];
+    points.push_back(point);
+  }
+  Index near = -1, far = -1;
+  CountByDistanceToOneCells(points, smoothed, 2.0, near, far);
+  CHECK_EQ(near, 3); // 0.5, 1.5 and 1.5 (beyond the start) away
+  CHECK_EQ(far, 4);  // 2.5, 5, 3 (beyond the end) and far outside
+  CountByDistanceToOneCells({}, smoothed, 2.0, near, far);
+  CHECK(near == 0 && far == 0);
+}
+
 int main()
 {
   return testing_harness::RunAll();
