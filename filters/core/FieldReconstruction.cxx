@@ -335,9 +335,6 @@ void FieldReconstruction::Resample(const PlanarScalarField& field, const Triangl
   report.Finer.Values = std::move(fine.Values);
 }
 
-// The verdict covers the whole reconstruction: a failed 2-cell or a vertex outside every
-// reconstructed cell keeps input values, which no critical-point count can vouch for. The raw
-// F o Phi before topological sampling is only reported.
 double GridSpacing(const PlanarScalarField& field)
 {
   return field.IsGrid() ? std::max(field.GridSpacing[0], field.GridSpacing[1]) : MeanEdgeLength(field);
@@ -399,6 +396,9 @@ void CountByDistanceToOneCells(const std::vector<CriticalPointLocation>& points,
   }
 }
 
+// The verdict covers the whole reconstruction: a failed 2-cell or a vertex outside every
+// reconstructed cell keeps input values, which no critical-point count can vouch for. The raw
+// F o Phi before topological sampling is only reported.
 void FieldReconstruction::Verify(const PlanarScalarField& field, const MorseSmaleComplex& complex,
   const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const
 {

@@ -706,7 +706,6 @@ void TwoCellReconstruction::ParameterizeCell(const TwoCell& twoCell, const OneCe
   }
 }
 
-// The monotone Sibson surface on the square from the cell's subdivided sides.
 void TwoCellReconstruction::LocateSamples(const PlanarScalarField& data, const std::vector<Index>& hints,
   std::vector<Index>& firstVertex, std::vector<Index>& vertices, std::vector<double>& parameters) const
 {
@@ -776,6 +775,7 @@ bool TwoCellReconstruction::FitSurface(ReconstructedTwoCell& cell, const Monoton
   return refined;
 }
 
+// The monotone Sibson surface on the square from the cell's subdivided sides.
 void TwoCellReconstruction::BuildSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided)
 {
   if (!cell.Valid)

@@ -168,8 +168,9 @@ public:
   ProgressHooks Hooks;
 
   // Reconstructs every 2-cell of `complex` (the simplified complex that `smoothed` was made
-  // from). `data`, the input field, is needed for fitted interiors (its vertices are assigned to
-  // cells by complex.TwoCellId); without it the interiors are the paper's. Cells that fail are
+  // from). `data`, the input field, is needed for fitted interiors (each vertex is data for the
+  // smoothed cell that contains it; complex.TwoCellId only says where to look first); without
+  // it the interiors are the paper's. Cells that fail are
   // reported (Report().FailedCells); the call fails only on malformed input or abort.
   bool Reconstruct(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed, std::string& error,
     const PlanarScalarField* data = nullptr);
