@@ -35,6 +35,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <sstream>
 
 namespace names = vtkTopoSplineArrayNames;
 namespace conversion = vtkTopoSplineDomainConversion;
@@ -472,11 +473,25 @@ void vtkTopoSplineReconstructTwoCells::WarnAbout(const topospline::FieldReconstr
     }
     else if (judged && !c.Identical())
     {
+      // The first few of each, with their place, so that a user can look there.
+      std::ostringstream where;
+      constexpr std::size_t shown = 4;
+      static const char* const kinds[] = { "minimum", "saddle", "maximum" };
+      for (const auto& [label, points] :
+        { std::make_pair("spurious", &c.Spurious), std::make_pair("missing", &c.Missing) })
+      {
+        for (std::size_t i = 0; i < points->size() && i < shown; ++i)
+        {
+          const auto& p = (*points)[i];
+          where << (where.tellp() > 0 ? "; " : "") << label << " " << kinds[std::clamp(p.MorseIndex, 0, 2)] << " at ("
+                << p.Position[0] << ", " << p.Position[1] << ")";
+        }
+      }
       vtkWarningMacro("Reconstruct 2-Cells: the " << prefix << " sampling of the reconstruction has "
                       << c.Spurious.size() << " spurious and " << c.Missing.size()
                       << " missing critical point(s) (found "
                       << c.Found[0] << "/" << c.Found[1] << "/" << c.Found[2] << ", expected " << c.Expected[0] << "/"
-                      << c.Expected[1] << "/" << c.Expected[2] << ").");
+                      << c.Expected[1] << "/" << c.Expected[2] << "): " << where.str() << ".");
     }
   }
 }

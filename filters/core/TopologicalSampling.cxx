@@ -598,6 +598,62 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
   return report;
 }
 
+Index RestoreWantedExtrema(const TriangleMeshTopology& mesh, const SamplingConstraints& constraints,
+  std::vector<double>& values)
+{
+  const VertexGraphs graphs(mesh);
+  Index changed = 0;
+  // Moves v just past its extreme neighbour in `graph` unless it is an extremum there already.
+  auto restore = [&](const Graph& graph, Index v, bool minimum) {
+    if (graph.Start[v] == graph.Start[v + 1] || IsExtremum(graph, values, v, minimum))
+    {
+      return;
+    }
+    Key extreme{ values[graph.Adjacent[graph.Start[v]]], graph.Adjacent[graph.Start[v]] };
+    for (Index i = graph.Start[v] + 1; i < graph.Start[v + 1]; ++i)
+    {
+      const Key other{ values[graph.Adjacent[i]], graph.Adjacent[i] };
+      extreme = (minimum ? other < extreme : extreme < other) ? other : extreme;
+    }
+    const double infinity = std::numeric_limits<double>::infinity();
+    values[v] = std::nextafter(extreme.Value, minimum ? -infinity : infinity);
+    ++changed;
+  };
+  std::unordered_set<Index> boundaryMinima(constraints.BoundaryMinima.begin(), constraints.BoundaryMinima.end());
+  std::unordered_set<Index> boundaryMaxima(constraints.BoundaryMaxima.begin(), constraints.BoundaryMaxima.end());
+  for (Index v : constraints.Minima)
+  {
+    // A minimum on the boundary is one of the boundary curve (stage 1's boundary rule): its
+    // BoundaryMinima entry is restored below.
+    if (!mesh.IsBoundaryVertex(v))
+    {
+      restore(graphs.All, v, true);
+    }
+  }
+  for (Index v : constraints.BoundaryMinima)
+  {
+    if (!boundaryMaxima.count(v))
+    {
+      restore(graphs.Boundary, v, true);
+    }
+  }
+  for (Index v : constraints.Maxima)
+  {
+    if (!boundaryMinima.count(v))
+    {
+      restore(graphs.All, v, false);
+    }
+  }
+  for (Index v : constraints.BoundaryMaxima)
+  {
+    if (!boundaryMinima.count(v))
+    {
+      restore(graphs.Boundary, v, false);
+    }
+  }
+  return changed;
+}
+
 SamplingConstraints ComplexConstraints(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
   const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt)
 {
@@ -620,6 +676,12 @@ SamplingConstraints ComplexConstraints(const MorseSmaleComplex& complex, const T
     else if (cp.MorseIndex == 2)
     {
       constraints.Maxima.push_back(v);
+      // Above its whole link, a boundary vertex is above both its boundary neighbours: a peak
+      // of the boundary curve, which the boundary pass must keep.
+      if (mesh.IsBoundaryVertex(v))
+      {
+        constraints.BoundaryMaxima.push_back(v);
+      }
     }
     else
     {
@@ -631,6 +693,9 @@ SamplingConstraints ComplexConstraints(const MorseSmaleComplex& complex, const T
       }
     }
   }
+  std::sort(constraints.BoundaryMaxima.begin(), constraints.BoundaryMaxima.end());
+  constraints.BoundaryMaxima.erase(
+    std::unique(constraints.BoundaryMaxima.begin(), constraints.BoundaryMaxima.end()), constraints.BoundaryMaxima.end());
   return constraints;
 }
 
@@ -790,13 +855,13 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   AddSaddleOneCells(this->Complex, this->Smoothed, vertexAt, reach, constraints);
   AddOneCells(this->Complex, this->Smoothed, vertexAt, 0.25 * this->Spacing, constraints);
   const std::vector<double> before = values;
+  // Every node's vertex takes the node's critical value: F o Phi has it at the node, but a
+  // vertex on a node that a 2-cell's smoothed boundary passes beside (a slit, a node between
+  // two short 1-cells) can be evaluated in a neighbouring cell.
   for (const CriticalPoint& cp : this->Complex.CriticalPoints)
   {
     const Index v = vertexAt(cp.Vertex);
-    const std::size_t node = 2 * static_cast<std::size_t>(cp.Vertex);
-    if (v >= 0 && v < mesh.NumberOfVertices() && node + 1 < this->ComplexPoints.size() &&
-      std::hypot(sampling.Points[2 * v] - this->ComplexPoints[node],
-        sampling.Points[2 * v + 1] - this->ComplexPoints[node + 1]) > 1e-6 * this->Spacing)
+    if (v >= 0 && v < mesh.NumberOfVertices())
     {
       values[v] = cp.Value;
     }
@@ -805,10 +870,11 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   // boundary neighbours makes the corner triangle a maximum of stage 1 as well. The peak of
   // the boundary curve is wanted on the higher of the two neighbours instead, one step along
   // the curve (within the verdict's one spacing).
+  const std::unordered_set<Index> wantedMaxima(constraints.Maxima.begin(), constraints.Maxima.end());
   for (Index& v : constraints.BoundaryMaxima)
   {
     const std::vector<Index> link = LinkOf(mesh, v);
-    if (std::all_of(link.begin(), link.end(), [&mesh](Index w) { return mesh.IsBoundaryVertex(w); }))
+    if (!wantedMaxima.count(v) && std::all_of(link.begin(), link.end(), [&mesh](Index w) { return mesh.IsBoundaryVertex(w); }))
     {
       const auto higher = std::max_element(link.begin(), link.end(),
         [&values](Index a, Index b) { return Key{ values[a], a } < Key{ values[b], b }; });
@@ -826,8 +892,22 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
     constraints.Saddles.push_back(v);
   }
   TopologicalSamplingReport report = EnforceCriticalVertices(mesh, constraints, values);
-  report.DisplacedSaddles =
-    RelocateSaddles(sampling, mesh, constraints, this->Spacing * (1 + 1e-9), reach, values, 3, 10, this->Parallel);
+  // With every wanted extremum an extremum and no other one, the saddles (with multiplicity)
+  // are as many as the complex's: min - saddle + max is the same on every disk. A flood of
+  // one kind can take a wanted extremum of the other kind away (a cut peak sinking below a
+  // wanted pit beside it), and so can moving a saddle: such extrema are restored, the floods
+  // run again, and the saddles are moved back again.
+  constexpr int restoreRounds = 4;
+  for (int round = 0; round <= restoreRounds; ++round)
+  {
+    report.DisplacedSaddles =
+      RelocateSaddles(sampling, mesh, constraints, this->Spacing * (1 + 1e-9), reach, values, 3, 10, this->Parallel);
+    if (round == restoreRounds || RestoreWantedExtrema(mesh, constraints, values) == 0)
+    {
+      break;
+    }
+    EnforceCriticalVertices(mesh, constraints, values);
+  }
   report.ChangedVertices = 0;
   report.MaximumChange = 0;
   CountChanges(before, values, report);
@@ -853,15 +933,14 @@ void CountChanges(const std::vector<double>& before, const std::vector<double>& 
 namespace
 {
 // The index in `candidates` of the one nearest to `w` within `limit` (the first of equally near
-// ones; candidates.size(): none), skipping those `used` marks (if given).
-std::size_t NearestWithin(const std::vector<double>& p, Index w, const std::vector<Index>& candidates, double limit,
-  const std::vector<char>* used = nullptr)
+// ones; candidates.size(): none).
+std::size_t NearestWithin(const std::vector<double>& p, Index w, const std::vector<Index>& candidates, double limit)
 {
   auto distance = [&p](Index a, Index b) { return std::hypot(p[2 * a] - p[2 * b], p[2 * a + 1] - p[2 * b + 1]); };
   std::size_t best = candidates.size();
   for (std::size_t i = 0; i < candidates.size(); ++i)
   {
-    if ((!used || !(*used)[i]) && distance(w, candidates[i]) <= limit &&
+    if (distance(w, candidates[i]) <= limit &&
       (best == candidates.size() || distance(w, candidates[i]) < distance(w, candidates[best])))
     {
       best = i;
@@ -885,8 +964,8 @@ struct SaddleMatch
   }
 };
 
-// Extracts the saddles of a sampling's values and matches them to the wanted ones, each wanted
-// saddle (in order) to the nearest unclaimed found saddle within the tolerance.
+// Extracts the saddles of a sampling's values and matches them to the wanted ones within the
+// tolerance, as the verdict does.
 class SaddleMatcher
 {
 public:
@@ -909,17 +988,29 @@ public:
       match.Missing = this->WantedSaddles;
       return match;
     }
-    std::vector<char> used(saddles.size(), 0);
-    for (Index w : this->WantedSaddles)
-    {
-      const std::size_t best = NearestWithin(this->Points, w, saddles, this->Tolerance, &used);
-      if (best < saddles.size())
+    // Matched as the verdict matches them (MatchCriticalPoints: one to one, as many as can be).
+    auto locations = [this](const std::vector<Index>& vertices) {
+      std::vector<CriticalPointLocation> result(vertices.size());
+      for (std::size_t i = 0; i < vertices.size(); ++i)
       {
-        used[best] = 1;
+        result[i].MorseIndex = 1;
+        result[i].Position[0] = this->Points[2 * vertices[i]];
+        result[i].Position[1] = this->Points[2 * vertices[i] + 1];
+      }
+      return result;
+    };
+    const std::vector<std::size_t> partner =
+      MatchCriticalPoints(locations(this->WantedSaddles), locations(saddles), this->Tolerance);
+    std::vector<char> used(saddles.size(), 0);
+    for (std::size_t i = 0; i < this->WantedSaddles.size(); ++i)
+    {
+      if (partner[i] == UnmatchedCriticalPoint)
+      {
+        match.Missing.push_back(this->WantedSaddles[i]);
       }
       else
       {
-        match.Missing.push_back(w);
+        used[partner[i]] = 1;
       }
     }
     for (std::size_t i = 0; i < saddles.size(); ++i)
@@ -1467,6 +1558,25 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
   for (const SaddleOneCell& cell : constraints.OneCells)
   {
     AskAlongOneCell(ground, cell, values, requests);
+  }
+  // A ridge passing beside a wanted maximum lower than the ridge's own extremum (another
+  // 1-cell's) must not rise above it, nor a valley sink below a wanted minimum beside it.
+  const double infinity = std::numeric_limits<double>::infinity();
+  for (const auto& [extrema, up] : { std::make_pair(&constraints.Maxima, true), std::make_pair(&constraints.Minima, false) })
+  {
+    auto& asked = up ? requests.RaiseTo : requests.LowerTo;
+    for (Index m : *extrema)
+    {
+      const double limit = std::nextafter(values[m], up ? -infinity : infinity);
+      for (Index w : LinkOf(mesh, m))
+      {
+        auto found = asked.find(w);
+        if (found != asked.end())
+        {
+          found->second = up ? std::min(found->second, limit) : std::max(found->second, limit);
+        }
+      }
+    }
   }
   return requests.Apply(values);
 }

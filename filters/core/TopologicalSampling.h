@@ -80,6 +80,8 @@ SamplingConstraints ComplexConstraints(const MorseSmaleComplex& complex, const T
 // and strictly monotone from the saddle on. Vertices within `spacing` of the 1-cell's saddle
 // or extremum are left to the floods and to CarveSaddleOneCells; so are vertices that a
 // ridge and a valley both claim, and boundary vertices the 1-cell does not run through.
+// Critical vertices keep their values (the nodes' critical values, as Apply sets them), and
+// no vertex next to a wanted maximum (minimum) is raised (lowered) past it.
 // Returns the number of changed vertices.
 Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, double spacing, std::vector<double>& values);
@@ -136,5 +138,13 @@ private:
 // pairs may remain).
 TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds = 6);
+
+// Makes every wanted extremum an extremum again where a step before (a flood of the other
+// kind, a carved 1-cell, a saddle moved back) took that away: the vertex is moved just past its
+// extreme neighbour (the whole link for minima and maxima, the boundary curve for boundary
+// minima and maxima). The floods then remove what this creates around it. Returns the number of
+// changed vertices.
+Index RestoreWantedExtrema(const TriangleMeshTopology& mesh, const SamplingConstraints& constraints,
+  std::vector<double>& values);
 
 } // namespace topospline

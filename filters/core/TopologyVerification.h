@@ -41,8 +41,15 @@ struct TopologyComparison
   bool Identical() const { return this->Spurious.empty() && this->Missing.empty(); }
 };
 
-// Matches found to expected critical points of the same index within `tolerance` (closest
-// pairs first, each point used once).
+// Matches found to expected critical points of the same index within `tolerance` (times the
+// expected point's Reach), one to one, as many as any such assignment can (closest pairs
+// first, then augmenting paths: a row of saddles found each one vertex along from its node is
+// matched whole). Returns the found point of each expected one (UnmatchedCriticalPoint: none).
+constexpr std::size_t UnmatchedCriticalPoint = static_cast<std::size_t>(-1);
+std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLocation>& expected,
+  const std::vector<CriticalPointLocation>& found, double tolerance);
+
+// The comparison of MatchCriticalPoints: counts, the points left over on either side.
 TopologyComparison CompareCriticalPoints(const std::vector<CriticalPointLocation>& expected,
   const std::vector<CriticalPointLocation>& found, double tolerance);
 } // namespace topospline

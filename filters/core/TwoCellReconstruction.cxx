@@ -396,7 +396,8 @@ int ChooseGridLayout(const std::array<SideSegments, 4>& sides, int maximum, std:
   return 0;
 }
 
-std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed)
+std::array<SideSegments, 4> TwoCellSideSegments(
+  const TwoCellSides& sides, const OneCellSmoothingResult& smoothed, bool exactHalves)
 {
   std::array<SideSegments, 4> result;
   for (int s = 0; s < 4; ++s)
@@ -428,17 +429,25 @@ std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const
       continue;
     }
     SideSegments whole = std::move(result[split]);
-    if (whole.Curve.size() == 1)
+    if (whole.Curve.size() == 1 || (exactHalves && whole.Curve.size() % 2 == 1))
     {
+      // Every segment cut at its middle: the side's parameter speed stays uniform and the
+      // halves have equal counts.
       SideSegments halved;
-      std::array<double, 8> left, right;
-      CubicBezierSpline::Subdivide(whole.Curve[0].data(), 2, 0.5, left.data(), right.data());
-      halved.Curve = { left, right };
-      CubicHeightSegment lower, upper;
-      CubicBezierSpline::Subdivide(
-        whole.Height[0].data(), 1, 0.5, lower.data(), upper.data(), DeCasteljauStep::Weighted);
-      halved.Height = { lower, upper };
-      halved.Pieces = { 2 };
+      for (std::size_t j = 0; j < whole.Curve.size(); ++j)
+      {
+        std::array<double, 8> left, right;
+        CubicBezierSpline::Subdivide(whole.Curve[j].data(), 2, 0.5, left.data(), right.data());
+        halved.Curve.insert(halved.Curve.end(), { left, right });
+        CubicHeightSegment lower, upper;
+        CubicBezierSpline::Subdivide(
+          whole.Height[j].data(), 1, 0.5, lower.data(), upper.data(), DeCasteljauStep::Weighted);
+        halved.Height.insert(halved.Height.end(), { lower, upper });
+      }
+      for (int k : whole.Pieces)
+      {
+        halved.Pieces.push_back(2 * k);
+      }
       whole = std::move(halved);
     }
     const std::size_t half = whole.Curve.size() / 2;
@@ -646,10 +655,25 @@ void TwoCellReconstruction::ParameterizeCell(const TwoCell& twoCell, const OneCe
     {
       return false;
     }
-    if (!BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed), this->BoundarySamples, this->MaximumGridSize,
-          walk, parameters, boundary))
+    // Halves cut at a segment boundary keep the samples of the neighbouring cell that shares
+    // the split 1-cell; when their counts (k and k + 1) make the grid too fine, they are cut at
+    // the exact middle instead, and the two cells' boundaries differ by slivers between samples.
+    if (!BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed, false), this->BoundarySamples,
+          this->MaximumGridSize, walk, parameters, boundary) &&
+      !BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed, true), this->BoundarySamples,
+        this->MaximumGridSize, walk, parameters, boundary))
     {
-      message = "its sides need more than " + std::to_string(this->MaximumGridSize) + " segments each";
+      message = "its sides need more than " + std::to_string(this->MaximumGridSize) + " segments each (pieces";
+      for (const SideSegments& side : TwoCellSideSegments(cell.Sides, smoothed))
+      {
+        std::string counts;
+        for (int k : side.Pieces)
+        {
+          counts += (counts.empty() ? " " : "+") + std::to_string(k);
+        }
+        message += (counts.empty() ? " none" : counts) + ",";
+      }
+      message += ")";
       return false;
     }
     return true;

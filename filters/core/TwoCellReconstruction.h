@@ -81,8 +81,11 @@ struct SideSegments
 int ChooseGridLayout(const std::array<SideSegments, 4>& sides, int maximum, std::array<std::vector<int>, 4>& multipliers);
 
 // The segments of the four sides (Bottom, Right, Top, Left), with an empty side made up from
-// half of its partner (TwoCellSides::SplitSides), cut at the segment boundary nearest the middle.
-std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed);
+// half of its partner (TwoCellSides::SplitSides), cut at the segment boundary nearest the middle,
+// or with `exactHalves` at the exact middle of a partner of an odd count (every segment then
+// cut in two).
+std::array<SideSegments, 4> TwoCellSideSegments(
+  const TwoCellSides& sides, const OneCellSmoothingResult& smoothed, bool exactHalves = false);
 
 // One reconstructed 2-cell.
 struct ReconstructedTwoCell

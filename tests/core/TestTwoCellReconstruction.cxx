@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <cstdio>
 #include <map>
 #include <random>
@@ -289,6 +290,32 @@ TEST_CASE(SideAssembly)
   CHECK(segments[TwoCellSides::Bottom].Height[0][3] == 2 && segments[TwoCellSides::Right].Height[0][0] == 2);
   CHECK(segments[TwoCellSides::Bottom].Curve[0][6] == 3 && segments[TwoCellSides::Right].Curve[0][0] == 3);
 
+  // An odd count (3) splits at a segment boundary into 1 + 2, whose grid layout needs N = 2
+  // with the other sides at 3: none. Exact halves cut every segment in two: 3 + 3, meeting at
+  // the curve's middle, with its height there.
+  smoothed.Pieces[2].Curve.Segments = smoothed.Pieces[2].Height.Segments = 3;
+  smoothed.Pieces[2].Curve.ControlPoints = { 0, 0, 1, 0, 2, 0, 3, 0, 3, 0, 4, 0, 5, 0, 6, 0, 6, 0, 7, 0, 8, 0, 9, 0 };
+  smoothed.Pieces[2].Height.ControlPoints = { 0, 1, 2, 3, 3, 4, 5, 6, 6, 7, 8, 9 };
+  CHECK(AssembleTwoCellSides(cell, smoothed, sides, error));
+  const auto atBoundary = TwoCellSideSegments(sides, smoothed);
+  CHECK_EQ(atBoundary[TwoCellSides::Bottom].Curve.size() + atBoundary[TwoCellSides::Right].Curve.size(), std::size_t(3));
+  const auto halves = TwoCellSideSegments(sides, smoothed, true);
+  const SideSegments& lower = halves[TwoCellSides::Bottom];
+  const SideSegments& upper = halves[TwoCellSides::Right];
+  CHECK_EQ(lower.Curve.size(), std::size_t(3));
+  CHECK_EQ(upper.Curve.size(), std::size_t(3));
+  CHECK(lower.Pieces == std::vector<int>({ 3 }) && upper.Pieces == std::vector<int>({ 3 }));
+  CHECK(std::abs(lower.Curve.back()[6] - 4.5) < 1e-12 && upper.Curve.front()[0] == lower.Curve.back()[6]);
+  CHECK(std::abs(lower.Height.back()[3] - 4.5) < 1e-12 && upper.Height.front()[0] == lower.Height.back()[3]);
+  // Uniform speed kept: every half-segment spans 1.5 in x.
+  for (const auto* half : { &lower, &upper })
+  {
+    for (const auto& c : half->Curve)
+    {
+      CHECK(std::abs(c[6] - c[0] - 1.5) < 1e-12);
+    }
+  }
+
   // Both sides of a pair empty: 2 corners, refused.
   smoothed.PiecesOfOneCell[1] = { 3 };
   smoothed.PiecesOfOneCell[3] = { 3 };
@@ -302,6 +329,26 @@ TEST_CASE(SideAssembly)
   smoothed.PiecesOfOneCell[3] = { 99 };
   cell.BoundaryOneCells = { 0, 1, 2, 3 };
   CHECK(!AssembleTwoCellSides(cell, smoothed, sides, error));
+}
+
+TEST_CASE(GridLayoutOfOddSplitSides)
+{
+  // A cell of three 1-cells of 19 segments each: the empty side takes half of its partner.
+  // Cut at a segment boundary (10 + 9) the four sides need N a multiple of 19, 10 and 9 (1710):
+  // none up to 512. Cut at the exact middle every count is 19.
+  auto side = [](std::vector<int> pieces) {
+    SideSegments s;
+    s.Pieces = pieces;
+    const int total = std::accumulate(pieces.begin(), pieces.end(), 0);
+    s.Curve.assign(static_cast<std::size_t>(total), std::array<double, 8>{});
+    s.Height.assign(static_cast<std::size_t>(total), CubicHeightSegment{});
+    return s;
+  };
+  std::array<std::vector<int>, 4> multipliers;
+  CHECK_EQ(ChooseGridLayout({ side({ 19 }), side({ 19 }), side({ 10 }), side({ 9 }) }, 512, multipliers), 0);
+  CHECK_EQ(ChooseGridLayout({ side({ 19 }), side({ 19 }), side({ 19 }), side({ 19 }) }, 512, multipliers), 19);
+  // Pieces of different counts on one side combine: 19 + 19 against 38.
+  CHECK_EQ(ChooseGridLayout({ side({ 19, 19 }), side({ 19 }), side({ 38 }), side({ 38 }) }, 512, multipliers), 38);
 }
 
 TEST_CASE(DegenerateInputsNeverCrash)

@@ -40,9 +40,13 @@ def field_range_of(fd):
 
 # Runs that miss (docs/Reconstruction.md, "Known misses"); each must still miss, so that the
 # list stays true. Every other check still applies to them.
+# Runs whose F o Phi (before topological sampling) misses a node's critical value; the
+# sampling gives every node's vertex its value, and the verdict holds on them.
+INTERPOLATION_MISSES = {
+    "sainthelens_usgs_dem_crop.vti 25% k=4": "a minimum two spacings from a boundary junction, missed by 2.1 "
+    "(0.1 % of the range)",
+}
 KNOWN_MISSES = {
-    "sainthelens_usgs_dem_crop.vti 25% k=4": "a minimum two spacings from a boundary junction: "
-    "F o Phi misses its value by 2.1 (0.1 % of the range) and the sampling loses it",
     # TOPOSPLINE_LARGE_TESTS=1 only:
     "rainier_ned1_1970_full.vti 25% k=4": "topology verdict off (a critical point off its node)",
     "rainier_ned1_1970_full.vti 25% k=7": "topology verdict off (a critical point off its node)",
@@ -107,8 +111,13 @@ def check_reconstruction(label, reconstruct, c, resolution):
     at_nodes = exact[vertices][located]
     moved = float(np.max(np.abs(values[vertices] - exact[vertices]))) if len(vertices) else 0.0
     worst = float(np.max(np.abs(at_nodes - c["cp_CriticalValue"][located]))) if len(at_nodes) else 0.0
-    checks.check(worst <= 1e-9 * field_range or known_miss,
-                 "%s: critical values interpolated (worst %.3g)" % (label, worst))
+    if label in INTERPOLATION_MISSES:
+        checks.check(worst > 1e-9 * field_range,
+                     "%s: F o Phi still misses a critical value (%s); if it now holds, take it off the list"
+                     % (label, INTERPOLATION_MISSES[label]))
+    else:
+        checks.check(worst <= 1e-9 * field_range or known_miss,
+                     "%s: critical values interpolated (worst %.3g)" % (label, worst))
     print("%s: topological sampling moved node values by up to %.3g (%.2f%% of the range)"
           % (label, moved, 100 * moved / field_range))
     return tt.field_value(fd, "MaximumError"), tt.field_value(fd, "RMSError"), field_range, tt.field_value(fd, "BezierTriangles")
