@@ -801,6 +801,17 @@ std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, cons
 {
   std::vector<Index> placed;
   const auto& p = sampling.Points;
+  // Each junction needs its own pit (the check expects one pair per junction), on no node: a
+  // descent stops before the vertex of another junction, a pit already taken or a node.
+  std::unordered_set<Index> taken;
+  for (Index junction : complex.BoundaryJunctions)
+  {
+    taken.insert(vertexAt(junction));
+  }
+  for (const CriticalPoint& cp : complex.CriticalPoints)
+  {
+    taken.insert(vertexAt(cp.Vertex));
+  }
   for (Index junction : complex.BoundaryJunctions)
   {
     const Index v = vertexAt(junction);
@@ -816,7 +827,7 @@ std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, cons
       Index next = chosen;
       for (Index w : LinkOf(mesh, chosen))
       {
-        if (mesh.IsBoundaryVertex(w) && Key{ values[w], w } < Key{ values[next], next } &&
+        if (mesh.IsBoundaryVertex(w) && !taken.count(w) && Key{ values[w], w } < Key{ values[next], next } &&
           std::hypot(p[2 * w] - p[2 * v], p[2 * w + 1] - p[2 * v + 1]) <= reach)
         {
           next = w;
@@ -840,6 +851,7 @@ std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, cons
     {
       values[lowest] = values[chosen] - 1e-9 * std::max(1.0, std::abs(values[chosen]));
     }
+    taken.insert(chosen);
     placed.push_back(chosen);
   }
   return placed;
