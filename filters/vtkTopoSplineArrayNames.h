@@ -84,6 +84,8 @@ constexpr const char* ScalarFieldName = "TopoSplineScalarField";
 // Field data of a simplified complex: vertices where boundary 1-cells turn inwards
 // (MorseSmaleComplex::BoundaryJunctions).
 constexpr const char* BoundaryJunctionVertexId = "BoundaryJunctionVertexId";
+// The per-axis scales of the coordinates stages 3 and 4 work in (topospline::PlanarFrame).
+constexpr const char* WorkingFrameScale = "WorkingFrameScale";
 
 // Field data of "Simplify Morse-Smale Complex".
 constexpr const char* CancelledLowerId = "CancelledLowerId";
@@ -104,6 +106,7 @@ constexpr const char* PersistenceCurveCriticalPoints = "PersistenceCurveCritical
 constexpr const char* CurveSegments = "CurveSegments";
 constexpr const char* NumberOfPieces = "NumberOfPieces";
 constexpr const char* AdaptedPieces = "AdaptedPieces";
+constexpr const char* PolylinePieces = "PolylinePieces";
 constexpr const char* RemainingCrossings = "RemainingCrossings";
 constexpr const char* PiecesOutsideDomain = "PiecesOutsideDomain";
 constexpr const char* ClampedPieces = "ClampedPieces";
@@ -123,10 +126,12 @@ constexpr const char* ViolatingPatches = "ViolatingPatches";
 constexpr const char* LinearizedDiagonals = "LinearizedDiagonals";
 constexpr const char* BezierTriangles = "BezierTriangles";
 constexpr const char* MeshTriangles = "MeshTriangles";
+constexpr const char* CrowdedTriangles = "CrowdedTriangles";
 constexpr const char* MaximumGridSize = "MaximumGridSize";
 constexpr const char* FittedCells = "FittedCells";
 constexpr const char* RefinedCells = "RefinedCells";
 constexpr const char* SnappedPoints = "SnappedPoints";
+constexpr const char* PointsOnOneCells = "PointsOnOneCells";
 constexpr const char* UnreconstructedPoints = "UnreconstructedPoints";
 constexpr const char* MaximumError = "MaximumError";
 constexpr const char* RMSError = "RMSError";

@@ -273,10 +273,12 @@ void WriteReport(const topospline::FieldReconstructionReport& report, vtkFieldDa
   AddFieldNumbers(fd, names::LinearizedDiagonals, { static_cast<double>(cells.LinearizedDiagonals) });
   AddFieldNumbers(fd, names::BezierTriangles, { static_cast<double>(cells.BezierTriangles) });
   AddFieldNumbers(fd, names::MeshTriangles, { static_cast<double>(cells.MeshTriangles) });
+  AddFieldNumbers(fd, names::CrowdedTriangles, { static_cast<double>(cells.CrowdedTriangles) });
   AddFieldNumbers(fd, names::MaximumGridSize, { static_cast<double>(cells.MaximumGridSize) });
   AddFieldNumbers(fd, names::FittedCells, { static_cast<double>(cells.FittedCells) });
   AddFieldNumbers(fd, names::RefinedCells, { static_cast<double>(cells.RefinedCells) });
   AddFieldNumbers(fd, names::SnappedPoints, { static_cast<double>(report.SnappedPoints) });
+  AddFieldNumbers(fd, names::PointsOnOneCells, { static_cast<double>(report.PointsOnOneCells) });
   AddFieldNumbers(fd, names::UnreconstructedPoints, { static_cast<double>(report.UnreconstructedPoints) });
   AddFieldNumbers(fd, names::MaximumError, { report.MaximumError });
   AddFieldNumbers(fd, names::RMSError, { report.RMSError });

@@ -238,6 +238,10 @@ void WriteComplex(const topospline::MorseSmaleComplex& complex, vtkDataSet* doma
     }
     output->GetFieldData()->AddArray(junctions);
   }
+  auto frame = conversion::NewArray<vtkDoubleArray>(names::WorkingFrameScale);
+  frame->InsertNextValue(complex.Frame.Scale[0]);
+  frame->InsertNextValue(complex.Frame.Scale[1]);
+  output->GetFieldData()->AddArray(frame);
 }
 
 vtkDataSet* SegmentationOf(vtkMultiBlockDataSet* input)
@@ -427,6 +431,20 @@ bool ReadSegmentation(const ComplexArrays& in, vtkFieldData* fieldData, const Po
         return false;
       }
       complex.BoundaryJunctions.push_back(v);
+    }
+  }
+  if (vtkDataArray* frame = fieldData->GetArray(names::WorkingFrameScale))
+  {
+    // Powers of two; anything else is not a frame stage 1 wrote.
+    for (int axis = 0; axis < 2 && frame->GetNumberOfTuples() == 2; ++axis)
+    {
+      const double scale = frame->GetComponent(axis, 0);
+      if (topospline::PlanarFrame::PowerOfTwoNear(scale) != scale)
+      {
+        error = "the input is not a Morse-Smale complex: its working frame's scales are not powers of two";
+        return false;
+      }
+      complex.Frame.Scale[axis] = scale;
     }
   }
   return true;

@@ -149,7 +149,129 @@ topospline::TopologicalSampling FieldReconstruction::SamplingOf(const MorseSmale
   return sampling;
 }
 
+// The smoothed curves, sampled finely enough that the nearest sample is within a few percent of
+// `side` of the nearest curve point, with their heights, in square buckets of side `side`: the
+// samples within `side` of a point lie in its bucket or the 8 around it.
+OneCellSamples::OneCellSamples(const OneCellSmoothingResult& smoothed, double side)
+  : Side(side > 0 ? side : 1.0)
+{
+  constexpr int perSegment = 16;
+  for (const SmoothedPiece& piece : smoothed.Pieces)
+  {
+    const int segments = piece.Curve.Segments;
+    for (int j = 0; j < segments; ++j)
+    {
+      for (int m = 0; m <= perSegment; ++m)
+      {
+        Sample sample;
+        const double s = static_cast<double>(m) / perSegment;
+        CubicBezierSpline::EvaluateSegment(piece.Curve.Segment(j), 2, s, sample.XY);
+        sample.Height = piece.Height.Segments > 0 ? piece.Height.Value((j + s) / segments) : 0;
+        this->Buckets[this->Key(sample.XY[0], sample.XY[1])].push_back(sample);
+      }
+    }
+  }
+}
+
+long long OneCellSamples::Key(double x, double y) const
+{
+  return (static_cast<long long>(std::floor(x / this->Side)) << 32) ^
+    (static_cast<long long>(std::floor(y / this->Side)) & 0xffffffffLL);
+}
+
+bool OneCellSamples::Nearest(double x, double y, double distance, double& height) const
+{
+  double best = std::min(distance, this->Side);
+  bool found = false;
+  for (int dx = -1; dx <= 1; ++dx)
+  {
+    for (int dy = -1; dy <= 1; ++dy)
+    {
+      const auto bucket = this->Buckets.find(this->Key(x + dx * this->Side, y + dy * this->Side));
+      if (bucket == this->Buckets.end())
+      {
+        continue;
+      }
+      for (const Sample& sample : bucket->second)
+      {
+        const double d = std::hypot(sample.XY[0] - x, sample.XY[1] - y);
+        if (d <= best)
+        {
+          best = d;
+          height = sample.Height;
+          found = true;
+        }
+      }
+    }
+  }
+  return found;
+}
+
 bool FieldReconstruction::Run(const PlanarScalarField& field, const MorseSmaleComplex& complex,
+  const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report, std::string& error)
+{
+  const PlanarFrame& frame = complex.Frame;
+  if (frame.IsIdentity())
+  {
+    return this->RunInFrame(field, complex, smoothed, report, error);
+  }
+  // Triangulations, mean value maps, fits and "one spacing" in the complex's frame (see
+  // PlanarFrame); values are the same in both, positions are mapped back.
+  PlanarScalarField framedField = field;
+  frame.ToFrame(framedField.Points);
+  framedField.GridSpacing[0] /= frame.Scale[0];
+  framedField.GridSpacing[1] /= frame.Scale[1];
+  MorseSmaleComplex framedComplex = complex;
+  GeometryToFrame(frame, framedComplex);
+  OneCellSmoothingResult framedSmoothed = smoothed;
+  for (SmoothingNode& node : framedSmoothed.Nodes)
+  {
+    frame.ToFrame(node.Position);
+  }
+  for (SmoothedPiece& piece : framedSmoothed.Pieces)
+  {
+    frame.ToFrame(piece.Points);
+    frame.ToFrame(piece.Curve.ControlPoints);
+  }
+  if (!this->RunInFrame(framedField, framedComplex, framedSmoothed, report, error))
+  {
+    return false;
+  }
+  for (int axis = 0; axis < 2; ++axis)
+  {
+    report.Finer.Origin[axis] *= frame.Scale[axis];
+    report.Finer.Spacing[axis] *= frame.Scale[axis];
+  }
+  for (auto& patches : report.Patches)
+  {
+    for (PlanarBezierTriangle& triangle : patches)
+    {
+      for (auto& point : triangle.Points)
+      {
+        frame.ToWorld(point.data());
+      }
+    }
+  }
+  const auto toWorld = [&frame](std::vector<CriticalPointLocation>& points) {
+    for (CriticalPointLocation& point : points)
+    {
+      frame.ToWorld(point.Position);
+    }
+  };
+  toWorld(report.Expected);
+  toWorld(report.Spurious);
+  toWorld(report.Missing);
+  for (SamplingTopologyCheck* check : { &report.RawInput, &report.Input, &report.Resampled })
+  {
+    toWorld(check->Comparison.Spurious);
+    toWorld(check->Comparison.Missing);
+    // Distances do not map through a scaling per axis: this bounds the world distance.
+    check->Comparison.MaximumDistance *= std::max(frame.Scale[0], frame.Scale[1]);
+  }
+  return true;
+}
+
+bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const MorseSmaleComplex& complex,
   const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report, std::string& error)
 {
   report = FieldReconstructionReport();
@@ -184,7 +306,7 @@ bool FieldReconstruction::Run(const PlanarScalarField& field, const MorseSmaleCo
     }
   }
 
-  this->EvaluateAtVertices(field, complex, report);
+  this->EvaluateAtVertices(field, complex, smoothed, report);
   TriangleMeshTopology mesh;
   std::string ignored; // the input's mesh was checked by stage 1
   BuildMesh(field, mesh, this->Parallel, ignored);
@@ -210,8 +332,8 @@ bool FieldReconstruction::Run(const PlanarScalarField& field, const MorseSmaleCo
 }
 
 // F o Phi at every input vertex; the vertex's 2-cell of the jagged complex is the first guess.
-void FieldReconstruction::EvaluateAtVertices(
-  const PlanarScalarField& field, const MorseSmaleComplex& complex, FieldReconstructionReport& report) const
+void FieldReconstruction::EvaluateAtVertices(const PlanarScalarField& field, const MorseSmaleComplex& complex,
+  const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const
 {
   const auto start = std::chrono::steady_clock::now();
   const Index n = static_cast<Index>(field.Values.size());
@@ -246,6 +368,25 @@ void FieldReconstruction::EvaluateAtVertices(
   });
   report.SnappedPoints = snapped.load();
   report.UnreconstructedPoints = missed.load();
+  if (report.UnreconstructedPoints > 0)
+  {
+    // A cell too small to reconstruct (NegligibleArea) holds a vertex or two, all within a
+    // spacing of its boundary: they take the height of the nearest smoothed 1-cell. So does
+    // any vertex within a spacing of one; the rest keep their input value and are reported.
+    const OneCellSamples samples(smoothed, this->Spacing);
+    for (Index v = 0; v < n; ++v)
+    {
+      double height;
+      const double* xy = &field.Points[2 * static_cast<std::size_t>(v)];
+      if (report.CellOfVertex[v] == InvalidIndex && samples.Nearest(xy[0], xy[1], this->Spacing, height))
+      {
+        report.Values[v] = height;
+        report.Difference[v] = height - field.Values[v];
+        ++report.PointsOnOneCells;
+        --report.UnreconstructedPoints;
+      }
+    }
+  }
   report.EvaluationSeconds = SecondsSince(start);
 }
 
@@ -348,51 +489,11 @@ void CountByDistanceToOneCells(const std::vector<CriticalPointLocation>& points,
   {
     return;
   }
-  // The smoothed curves, sampled finely enough that the nearest sample is within a few percent
-  // of `distance` of the nearest curve point, in buckets of side `distance`: a point is near
-  // when a sample within `distance` lies in its bucket or the 8 around it.
-  const double side = distance > 0 ? distance : 1.0;
-  std::unordered_map<long long, std::vector<std::array<double, 2>>> buckets;
-  const auto key = [side](double x, double y) {
-    return (static_cast<long long>(std::floor(x / side)) << 32) ^
-      (static_cast<long long>(std::floor(y / side)) & 0xffffffffLL);
-  };
-  for (const SmoothedPiece& piece : smoothed.Pieces)
-  {
-    const int perSegment = 16;
-    for (int j = 0; j < piece.Curve.Segments; ++j)
-    {
-      for (int m = 0; m <= perSegment; ++m)
-      {
-        std::array<double, 2> xy;
-        CubicBezierSpline::EvaluateSegment(piece.Curve.Segment(j), 2, static_cast<double>(m) / perSegment, xy.data());
-        buckets[key(xy[0], xy[1])].push_back(xy);
-      }
-    }
-  }
+  const OneCellSamples samples(smoothed, distance > 0 ? distance : 1.0);
+  double height;
   for (const CriticalPointLocation& point : points)
   {
-    bool isNear = false;
-    for (int dx = -1; dx <= 1 && !isNear; ++dx)
-    {
-      for (int dy = -1; dy <= 1 && !isNear; ++dy)
-      {
-        const auto found = buckets.find(key(point.Position[0] + dx * side, point.Position[1] + dy * side));
-        if (found == buckets.end())
-        {
-          continue;
-        }
-        for (const auto& xy : found->second)
-        {
-          if (std::hypot(xy[0] - point.Position[0], xy[1] - point.Position[1]) <= distance)
-          {
-            isNear = true;
-            break;
-          }
-        }
-      }
-    }
-    ++(isNear ? near : far);
+    ++(samples.Nearest(point.Position[0], point.Position[1], distance, height) ? near : far);
   }
 }
 

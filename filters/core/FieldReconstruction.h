@@ -16,6 +16,7 @@
 
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -40,7 +41,10 @@ struct FieldReconstructionReport
   std::vector<double> Difference; // Values - input
   std::vector<Index> CellOfVertex; // the 2-cell whose surface gave the value, or InvalidIndex
   Index SnappedPoints = 0;         // outside every cell by at most a grid spacing
-  Index UnreconstructedPoints = 0; // in no reconstructed cell: they keep the input value
+  Index PointsOnOneCells = 0;      // in no reconstructed cell (a negligible one), within a spacing
+                                   // of a smoothed 1-cell: the 1-cell's height there
+  Index UnreconstructedPoints = 0; // in no reconstructed cell, far from the 1-cells: they keep the
+                                   // input value
   double MaximumError = 0;
   double RMSError = 0;
   double ValueRange[2] = { 0, 0 };
@@ -94,12 +98,14 @@ public:
   // 260 bytes per finer point for its values, mask and critical point check).
   static double MemoryEstimate(double cells, double finerPoints);
 
-  // Reconstructs `complex` (smoothed into `smoothed`) over `field` (the input). Fails only on
+  // Reconstructs `complex` (smoothed into `smoothed`) over `field` (the input). Works in
+  // complex.Frame; the report's positions are in the field's coordinates. Fails only on
   // malformed input or abort ("aborted"); failed cells are reported.
   bool Run(const PlanarScalarField& field, const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
     FieldReconstructionReport& report, std::string& error);
 
-  // The reconstructed 2-cells of the last Run (their surfaces, fits and parameterizations).
+  // The reconstructed 2-cells of the last Run (their surfaces, fits and parameterizations), in
+  // the complex's frame.
   const TwoCellReconstruction& Reconstruction() const { return this->Cells; }
 
   // The finer grid of OutputResolution over `field` (no values yet): a grid's own points
@@ -108,8 +114,11 @@ public:
   GridField FinerGrid(const PlanarScalarField& field) const;
 
 private:
+  // Run in the coordinates given (Run maps everything into complex.Frame and back).
+  bool RunInFrame(const PlanarScalarField& field, const MorseSmaleComplex& complex,
+    const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report, std::string& error);
   void EvaluateAtVertices(const PlanarScalarField& field, const MorseSmaleComplex& complex,
-    FieldReconstructionReport& report) const;
+    const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const;
   void SampleTopologicallyAtVertices(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
     const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const;
   void MeasureErrors(const PlanarScalarField& field, FieldReconstructionReport& report) const;
@@ -132,6 +141,26 @@ double LargestEdgeLength(const PlanarScalarField& field);
 double MeanEdgeLength(const PlanarScalarField& field);
 // The grid spacing (the larger axis), or the mean edge length of a triangle mesh.
 double GridSpacing(const PlanarScalarField& field);
+// The smoothed 1-cell curves sampled with their heights, bucketed for nearest-sample queries
+// within `side`.
+class OneCellSamples
+{
+public:
+  OneCellSamples(const OneCellSmoothingResult& smoothed, double side);
+  // The height of the sample nearest to (x, y) within `distance` (at most `side`); false if none.
+  bool Nearest(double x, double y, double distance, double& height) const;
+
+private:
+  struct Sample
+  {
+    double XY[2] = { 0, 0 };
+    double Height = 0;
+  };
+  long long Key(double x, double y) const;
+  double Side;
+  std::unordered_map<long long, std::vector<Sample>> Buckets;
+};
+
 // Counts `points` within `distance` of a smoothed 1-cell curve (near) and beyond it (far).
 void CountByDistanceToOneCells(const std::vector<CriticalPointLocation>& points, const OneCellSmoothingResult& smoothed,
   double distance, Index& near, Index& far);

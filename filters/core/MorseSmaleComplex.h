@@ -5,6 +5,7 @@
 #pragma once
 
 #include "CoreTypes.h"
+#include "PlanarGeometry.h"
 
 #include <array>
 #include <vector>
@@ -79,6 +80,9 @@ struct MorseSmaleComplex
   // 1-cells turn inwards there. Stage 1 extracts that pair again from any field that falls
   // into the domain at such a vertex, so a topology check expects it (TopologyVerification).
   std::vector<Index> BoundaryJunctions;
+  // The coordinates stages 3 and 4 work in (PlanarFrame): set by stage 1 from the domain's
+  // edges, kept by simplification.
+  PlanarFrame Frame;
 
   std::array<Index, 3> CountByIndex() const
   {
@@ -106,5 +110,19 @@ struct JunctionPoint
   Index CriticalPoint = InvalidIndex;
   std::vector<Index> OneCells;    // output 1-cells through it, ascending order
 };
+
+// Maps the complex's geometry (1-cell points, 2-cell centroids) into `frame` or back to the
+// domain's coordinates.
+inline void GeometryToFrame(const PlanarFrame& frame, MorseSmaleComplex& complex)
+{
+  for (OneCell& oneCell : complex.OneCells)
+  {
+    frame.ToFrame(oneCell.Points);
+  }
+  for (TwoCell& twoCell : complex.TwoCells)
+  {
+    frame.ToFrame(twoCell.Centroid);
+  }
+}
 
 } // namespace topospline

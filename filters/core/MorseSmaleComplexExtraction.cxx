@@ -323,8 +323,15 @@ bool TraceDescendingOneCell(const ExtractionState& state, Index saddle, int side
 }
 
 // The ascending 1-cell of `saddle` that starts at triangle t of its edge: the triangle
-// V-path up to a maximum, through the triangles' centroids, from the saddle's vertex to the
-// maximum's. Returns false if the path does not end (a cycle of the gradient).
+// V-path up to a maximum, from the saddle's vertex to the maximum's, one point per triangle:
+// its centroid, unless the segment to the next triangle's centroid does not cross the edge
+// between them (the two form a non-convex quad, on a triangle mesh), then the midpoint of that
+// edge. Such a segment leaves the two triangles and can cross a descending 1-cell; a polyline
+// whose every segment stays in one triangle meets none (descending 1-cells run along edges no
+// triangle of the gradient is paired with), and stage 3 falls back to these polylines where
+// smoothed curves cross. Either point of a triangle lies in the next one's quad, so the rule
+// holds whichever its neighbours chose. A grid's quads are convex: all centroids. Returns false
+// if the path does not end (a cycle of the gradient).
 bool TraceAscendingOneCell(const ExtractionState& state, Index saddle, Index t, OneCell& oneCell)
 {
   const PlanarScalarField& field = state.Field;
@@ -343,16 +350,51 @@ bool TraceAscendingOneCell(const ExtractionState& state, Index saddle, Index t, 
     oneCell.MeshCells.push_back(t);
   }
   const bool ends = state.NextTriangle(t) == InvalidIndex;
-  for (Index cell : oneCell.MeshCells)
-  {
-    const auto& tv = mesh.TriangleVertices[cell];
-    double c[2] = { 0, 0 };
-    double value = 0;
-    for (Index v : tv)
+  const std::size_t n = oneCell.MeshCells.size();
+  const auto centroid = [&](Index triangle, double c[2]) {
+    c[0] = c[1] = 0;
+    for (Index v : mesh.TriangleVertices[triangle])
     {
       c[0] += field.Points[2 * v] / 3;
       c[1] += field.Points[2 * v + 1] / 3;
-      value += f[v] / 3;
+    }
+  };
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const auto& tv = mesh.TriangleVertices[oneCell.MeshCells[i]];
+    double c[2];
+    centroid(oneCell.MeshCells[i], c);
+    double value = (f[tv[0]] / 3 + f[tv[1]] / 3) + f[tv[2]] / 3;
+    Index shared[2] = { InvalidIndex, InvalidIndex };
+    int count = 0;
+    if (i + 1 < n && !field.IsGrid())
+    {
+      const auto& next = mesh.TriangleVertices[oneCell.MeshCells[i + 1]];
+      for (Index v : tv)
+      {
+        if (std::find(next.begin(), next.end(), v) != next.end() && count < 2)
+        {
+          shared[count++] = v;
+        }
+      }
+    }
+    if (count == 2)
+    {
+      double d[2];
+      centroid(oneCell.MeshCells[i + 1], d);
+      const double* a = &field.Points[2 * shared[0]];
+      const double* b = &field.Points[2 * shared[1]];
+      const auto side = [](const double* p, const double* q, const double* r) {
+        const double cross = (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
+        return (cross > 0) - (cross < 0);
+      };
+      const bool crosses = side(c, d, a) * side(c, d, b) < 0 && side(a, b, c) * side(a, b, d) < 0;
+      if (!crosses)
+      {
+        c[0] = a[0] / 2 + b[0] / 2;
+        c[1] = a[1] / 2 + b[1] / 2;
+        value = f[shared[0]] / 2 + f[shared[1]] / 2;
+      }
     }
     oneCell.Points.push_back(c[0]);
     oneCell.Points.push_back(c[1]);
@@ -953,6 +995,7 @@ bool MorseSmaleComplexExtraction::Extract(
   {
     return false;
   }
+  complex.Frame = DomainFrame(field);
   this->Hooks.Report(0.2);
   if (this->Hooks.Aborted())
   {
@@ -1000,6 +1043,33 @@ bool MorseSmaleComplexExtraction::Extract(
   DescendingManifoldsAndCentroids(state);
   this->Hooks.Report(1.0);
   return true;
+}
+
+//------------------------------------------------------------------------------
+PlanarFrame MorseSmaleComplexExtraction::DomainFrame(const PlanarScalarField& field)
+{
+  if (field.IsGrid())
+  {
+    return PlanarFrame::FromExtents(field.GridSpacing[0], field.GridSpacing[1]);
+  }
+  const auto& p = field.Points;
+  double sumX = 0, sumY = 0;
+  std::size_t count = 0;
+  for (std::size_t t = 0; t + 2 < field.Triangles.size(); t += 3)
+  {
+    for (int e = 0; e < 3; ++e)
+    {
+      const std::size_t a = field.Triangles[t + e], b = field.Triangles[t + (e + 1) % 3];
+      if (2 * std::max(a, b) + 1 < p.size())
+      {
+        const double dx = p[2 * a] - p[2 * b], dy = p[2 * a + 1] - p[2 * b + 1];
+        sumX += dx * dx;
+        sumY += dy * dy;
+        ++count;
+      }
+    }
+  }
+  return count ? PlanarFrame::FromExtents(std::sqrt(sumX / count), std::sqrt(sumY / count)) : PlanarFrame();
 }
 
 //------------------------------------------------------------------------------

@@ -35,6 +35,10 @@ public:
   static void SortAroundExtremum(const MorseSmaleComplex& complex, const std::vector<double>& saddleEnds,
     Index extremum, std::vector<Index>& oneCells);
 
+  // The frame stages 3 and 4 work in (MorseSmaleComplex::Frame): from a grid's spacings or from
+  // the root mean square dx and dy of a mesh's edges.
+  static PlanarFrame DomainFrame(const PlanarScalarField& field);
+
   // Intermediate structures, kept for tests and later stages.
   TriangleMeshTopology Mesh;
   DiscreteGradient Gradient;

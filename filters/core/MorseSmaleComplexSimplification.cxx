@@ -1124,6 +1124,7 @@ MorseSmaleComplexSimplification::Replay MorseSmaleComplexSimplification::ReplayC
   replay.Forward.resize(nCP);
   std::iota(replay.Forward.begin(), replay.Forward.end(), 0);
   out.BoundaryJunctions = in.BoundaryJunctions;
+  out.Frame = in.Frame;
   for (Index j = 0; j < performed; ++j)
   {
     const Step& step = this->Steps[j];

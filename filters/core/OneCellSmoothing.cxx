@@ -250,10 +250,17 @@ void AddPiecesOfOneCell(Index a, const OneCell& oneCell, const std::vector<Cut>&
       piece.EndNode = at[k + 1].second;
       piece.Points.assign(oneCell.Points.begin() + 2 * from, oneCell.Points.begin() + 2 * (to + 1));
       piece.Values.assign(oneCell.Values.begin() + from, oneCell.Values.begin() + to + 1);
-      if (oneCell.Type == OneCell::Ascending && to == n - 1 && piece.Values.size() > 2)
+      // Every ascending 1-cell into a maximum ends "centroid of the maximum's triangle,
+      // maximum's vertex": a segment they would all share. Go straight to the vertex, except
+      // from the saddle's own vertex when it is another vertex of that triangle: that straight
+      // line would run along an edge of the triangle, which another 1-cell may cross into it
+      // (at its midpoint, on a triangle mesh). (A saddle on the maximum's own vertex makes a
+      // piece of no length, which touches nothing.)
+      const std::vector<double>& q = piece.Points;
+      const bool fromSaddleVertex = from == 0 && piece.Values.size() == 3 &&
+        !(q[0] == q[q.size() - 2] && q[1] == q[q.size() - 1]);
+      if (oneCell.Type == OneCell::Ascending && to == n - 1 && piece.Values.size() > 2 && !fromSaddleVertex)
       {
-        // Every ascending 1-cell into a maximum ends "centroid of the maximum's triangle,
-        // maximum's vertex": a segment they would all share. Go straight to the vertex.
         piece.Points.erase(piece.Points.end() - 4, piece.Points.end() - 2);
         piece.Values.erase(piece.Values.end() - 2);
       }
@@ -454,13 +461,25 @@ public:
   }
 
 private:
-  // Every curve as a polyline of SamplesPerSegment segments per Bezier segment.
+  // Every curve as a polyline of SamplesPerSegment segments per Bezier segment. A piece of no
+  // length (a boundary saddle and a maximum on one vertex, joined by one ascending 1-cell) is
+  // a point at its node: it crosses nothing, and the pieces that end there only touch it.
   std::vector<Segment2> SampleCurves() const
   {
     std::vector<Segment2> segments;
     for (Index p = 0; p < static_cast<Index>(this->Result.Pieces.size()); ++p)
     {
       const SmoothedPiece& piece = this->Result.Pieces[p];
+      const std::vector<double>& control = piece.Curve.ControlPoints;
+      bool point = true;
+      for (std::size_t i = 2; point && i + 1 < control.size(); i += 2)
+      {
+        point = control[i] == control[0] && control[i + 1] == control[1];
+      }
+      if (point)
+      {
+        continue;
+      }
       const int count = piece.Segments * this->SamplesPerSegment;
       double previous[2];
       piece.Curve.Evaluate(0.0, previous);
@@ -585,6 +604,64 @@ int CountPiecesOutsideDomain(
 //------------------------------------------------------------------------------
 // Paper, section 4, steps 2 and 3 for one piece: a strictly increasing height (and the
 // unconstrained one, for comparison) and a planar curve, both as k cubic Beziers.
+bool OneCellSmoothing::FollowPolyline(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes)
+{
+  std::vector<double> p = piece.Points;
+  const int edges = static_cast<int>(p.size() / 2) - 1;
+  const int segments = piece.Curve.Segments;
+  if (edges < 1 || segments < edges || piece.Curve.Dimension != 2)
+  {
+    return false;
+  }
+  p[0] = nodes[piece.StartNode].Position[0];
+  p[1] = nodes[piece.StartNode].Position[1];
+  p[2 * edges] = nodes[piece.EndNode].Position[0];
+  p[2 * edges + 1] = nodes[piece.EndNode].Position[1];
+  std::vector<double> length(edges);
+  double total = 0;
+  for (int e = 0; e < edges; ++e)
+  {
+    length[e] = std::hypot(p[2 * e + 2] - p[2 * e], p[2 * e + 3] - p[2 * e + 1]);
+    total += length[e];
+  }
+  // Largest remainders of the length shares of the segments beyond one per edge.
+  std::vector<int> count(edges, 1);
+  const int extra = segments - edges;
+  std::vector<std::pair<double, int>> remainders;
+  int given = 0;
+  for (int e = 0; e < edges; ++e)
+  {
+    const double share = total > 0 ? extra * length[e] / total : static_cast<double>(extra) / edges;
+    count[e] += static_cast<int>(share);
+    given += static_cast<int>(share);
+    remainders.emplace_back(-(share - static_cast<int>(share)), e);
+  }
+  std::sort(remainders.begin(), remainders.end());
+  for (int r = 0; given < extra; ++r, ++given)
+  {
+    ++count[remainders[r % edges].second];
+  }
+  std::vector<double>& control = piece.Curve.ControlPoints;
+  control.clear();
+  for (int e = 0; e < edges; ++e)
+  {
+    const double* a = &p[2 * e];
+    const double* b = &p[2 * e + 2];
+    for (int i = 0; i < count[e]; ++i)
+    {
+      for (int m = 0; m < 4; ++m)
+      {
+        const double s = (i + m / 3.0) / count[e];
+        // The ends of a segment exactly: they are shared with the neighbouring segments.
+        const double t = m == 0 ? static_cast<double>(i) / count[e] : m == 3 ? static_cast<double>(i + 1) / count[e] : s;
+        control.push_back(t == 1 ? b[0] : a[0] + t * (b[0] - a[0]));
+        control.push_back(t == 1 ? b[1] : a[1] + t * (b[1] - a[1]));
+      }
+    }
+  }
+  return true;
+}
+
 bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments,
   const double bounds[4], std::string& error) const
 {
@@ -693,7 +770,7 @@ bool OneCellSmoothing::RepairCrossings(
   const CrossingDetector detector(result, domainBounds, this->SamplesPerSegment);
   std::set<Index> crossing;
   int pairs = detector.FindCrossings(crossing);
-  std::set<Index> adapted;
+  std::set<Index> adapted, followsPolyline;
   while (pairs > 0)
   {
     bool raised = false;
@@ -721,6 +798,19 @@ bool OneCellSmoothing::RepairCrossings(
     }
     if (!raised)
     {
+      // No k can rise: the pieces still crossing follow their jagged 1-cells, which never
+      // cross (they are V-paths of one discrete gradient), in as many straight segments.
+      for (Index p : crossing)
+      {
+        if (followsPolyline.insert(p).second && FollowPolyline(result.Pieces[p], result.Nodes))
+        {
+          ++result.PolylinePieces;
+          raised = true;
+        }
+      }
+    }
+    if (!raised)
+    {
       break;
     }
     crossing.clear();
@@ -733,6 +823,45 @@ bool OneCellSmoothing::RepairCrossings(
 
 //------------------------------------------------------------------------------
 bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
+  const double domainBounds[4], OneCellSmoothingResult& result, std::string& error) const
+{
+  const PlanarFrame& frame = complex.Frame;
+  if (frame.IsIdentity())
+  {
+    return this->SmoothInFrame(complex, junctions, domainBounds, result, error);
+  }
+  // The fits, crossings and clamping in the complex's frame (see PlanarFrame); the per-vertex
+  // arrays are not needed here.
+  MorseSmaleComplex framed;
+  framed.CriticalPoints = complex.CriticalPoints;
+  framed.OneCells = complex.OneCells;
+  framed.TwoCells = complex.TwoCells;
+  framed.BoundaryJunctions = complex.BoundaryJunctions;
+  GeometryToFrame(frame, framed);
+  std::vector<JunctionPoint> framedJunctions = junctions;
+  for (JunctionPoint& junction : framedJunctions)
+  {
+    frame.ToFrame(junction.Position);
+  }
+  double bounds[4] = { domainBounds[0], domainBounds[1], domainBounds[2], domainBounds[3] };
+  frame.BoundsToFrame(bounds);
+  if (!this->SmoothInFrame(framed, framedJunctions, bounds, result, error))
+  {
+    return false;
+  }
+  for (SmoothingNode& node : result.Nodes)
+  {
+    frame.ToWorld(node.Position);
+  }
+  for (SmoothedPiece& piece : result.Pieces)
+  {
+    frame.ToWorld(piece.Points);
+    frame.ToWorld(piece.Curve.ControlPoints);
+  }
+  return true;
+}
+
+bool OneCellSmoothing::SmoothInFrame(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
   const double domainBounds[4], OneCellSmoothingResult& result, std::string& error) const
 {
   result = OneCellSmoothingResult();

@@ -54,6 +54,8 @@ struct OneCellSmoothingResult
   std::vector<SmoothedPiece> Pieces;
   std::vector<std::vector<Index>> PiecesOfOneCell; // per 1-cell, its pieces in order
   int AdaptedPieces = 0;       // pieces whose k was raised to remove crossings
+  int PolylinePieces = 0;      // of them, pieces that still crossed at their largest k and follow
+                               // their jagged 1-cell in straight segments instead
   int RemainingCrossings = 0;  // pairs of pieces that still cross (0 is the goal)
   int PiecesOutsideDomain = 0; // pieces whose curve leaves the domain's bounding box
   int ClampedPieces = 0;       // pieces kept inside it by clamping control points
@@ -79,15 +81,26 @@ public:
   int SamplesPerSegment = 8;
 
   // domainBounds: xmin, xmax, ymin, ymax of the domain (its corners become nodes when 1-cells
-  // run through them, so that the boundary keeps its corners). Returns false with a message.
+  // run through them, so that the boundary keeps its corners). Works in complex.Frame; the
+  // result is in the complex's coordinates. Returns false with a message.
   bool Smooth(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
     const double domainBounds[4], OneCellSmoothingResult& result, std::string& error) const;
+
+  // The piece's curve made its own jagged polyline (piece.Points, its ends moved onto its
+  // nodes), in the same number of cubic segments, so that stage 4's grid layouts still fit:
+  // each polyline edge gets at least one straight segment, the rest go by length, so that the
+  // curve's parameter still follows arc length, as the height's does. False (nothing changed)
+  // if the piece has more edges than segments. The fallback for pieces that still cross.
+  static bool FollowPolyline(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes);
 
   ProgressHooks Hooks;
   // The per-piece fits are independent (GLPK keeps its state per thread): they run on this.
   ParallelFor Parallel = SequentialFor;
 
 private:
+  // Smooth in the coordinates given (Smooth maps the complex into its frame and back).
+  bool SmoothInFrame(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
+    const double domainBounds[4], OneCellSmoothingResult& result, std::string& error) const;
   // Paper, section 4, step 1: cuts the 1-cells into pieces at their nodes and solves the
   // junction values; cuts again at rising nodes only when the first cut orders nodes both ways.
   bool CutAndSolveJunctionValues(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,

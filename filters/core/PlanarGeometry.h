@@ -2,6 +2,8 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
+#include <vector>
 
 namespace topospline
 {
@@ -15,4 +17,74 @@ inline double SegmentDistance2(const double* a, const double* b, double x, doubl
   const double ex = a[0] + fraction * dx - x, ey = a[1] + fraction * dy - y;
   return ex * ex + ey * ey;
 }
+} // namespace topospline
+
+namespace topospline
+{
+// The coordinates stages 3 and 4 work in: the domain's own, divided per axis by a power of two
+// close to its typical edge extent along that axis. Why: curve fits, crossings, triangulations
+// and mean value maps judge shapes by Euclidean lengths, so on an image of spacing 0.01 x 3 every
+// 2-cell is a sliver and its parameterization folds, while the same field on a square grid is
+// reconstructed; dividing by the spacing gives the square grid back. Powers of two make the map
+// exact both ways, so node positions, curve ends and vertices still coincide after the round
+// trip; a reconstruction of polynomials in the plane stays one under a per-axis scaling, so
+// its critical points, monotonicity and values are unchanged.
+struct PlanarFrame
+{
+  double Scale[2] = { 1, 1 }; // world = frame * Scale, per axis
+
+  bool IsIdentity() const { return this->Scale[0] == 1 && this->Scale[1] == 1; }
+  void ToFrame(double* xy) const
+  {
+    xy[0] /= this->Scale[0];
+    xy[1] /= this->Scale[1];
+  }
+  void ToWorld(double* xy) const
+  {
+    xy[0] *= this->Scale[0];
+    xy[1] *= this->Scale[1];
+  }
+  // x, y pairs.
+  void ToFrame(std::vector<double>& points) const
+  {
+    for (std::size_t i = 0; i + 1 < points.size(); i += 2)
+    {
+      this->ToFrame(&points[i]);
+    }
+  }
+  void ToWorld(std::vector<double>& points) const
+  {
+    for (std::size_t i = 0; i + 1 < points.size(); i += 2)
+    {
+      this->ToWorld(&points[i]);
+    }
+  }
+  // xmin, xmax, ymin, ymax.
+  void BoundsToFrame(double bounds[4]) const
+  {
+    bounds[0] /= this->Scale[0];
+    bounds[1] /= this->Scale[0];
+    bounds[2] /= this->Scale[1];
+    bounds[3] /= this->Scale[1];
+  }
+
+  // The power of two nearest to `extent` (1 for an extent that is not positive and finite).
+  static double PowerOfTwoNear(double extent)
+  {
+    if (!(extent > 0) || !std::isfinite(extent))
+    {
+      return 1;
+    }
+    return std::ldexp(1.0, static_cast<int>(std::lround(std::log2(extent))));
+  }
+  // From typical extents along x and y: a grid's spacings, or the root mean squares of a mesh's
+  // edges' dx and dy (a grid's triangles give 0.82 times its spacings: the same frame).
+  static PlanarFrame FromExtents(double x, double y)
+  {
+    PlanarFrame frame;
+    frame.Scale[0] = PowerOfTwoNear(x);
+    frame.Scale[1] = PowerOfTwoNear(y);
+    return frame;
+  }
+};
 } // namespace topospline

@@ -892,18 +892,35 @@ bool SolveMeanValueCoordinates(TwoCellMesh& mesh, std::string& error)
 
 // Phi is one-to-one if no triangle is degenerate or flipped in (u, v) and every interior vertex
 // lies strictly inside the square; records the smallest area and margin.
+//
+// In exact arithmetic it always is: the mean value weights are positive, the square is convex
+// and no edge joins two vertices of one side (Floater 2003). What fails is rounding: where the
+// cell has a long narrow arm, the map crowds the arm's interior vertices exponentially close to
+// the border of the square, and they land on it or 1e-16 beyond. Those are clamped onto the
+// square and their flattened triangles counted (CrowdedTriangles); anything beyond the
+// tolerances below is a real failure.
 bool CheckOneToOne(TwoCellMesh& mesh, std::string& error)
 {
+  // (u, v) lie in [0, 1]: solved coordinates are good to a few ulps times the system's
+  // condition; triangle areas are products of two such differences.
+  constexpr double marginTolerance = 1e-12;
+  constexpr double areaTolerance = 1e-14;
   const Index boundaryCount = mesh.BoundaryCount;
   const Index interiorCount = mesh.NumberOfPoints() - boundaryCount;
   mesh.MinimumInteriorMargin = interiorCount > 0 ? std::numeric_limits<double>::infinity() : 0.5;
   for (Index i = boundaryCount; i < mesh.NumberOfPoints(); ++i)
   {
-    const double u = mesh.Parameters[2 * i], v = mesh.Parameters[2 * i + 1];
-    const double margin = std::min(std::min(u, 1 - u), std::min(v, 1 - v));
+    double* uv = &mesh.Parameters[2 * i];
+    const double margin = std::min(std::min(uv[0], 1 - uv[0]), std::min(uv[1], 1 - uv[1]));
     mesh.MinimumInteriorMargin = std::isfinite(margin) ? std::min(mesh.MinimumInteriorMargin, margin) : -1;
+    if (margin > -marginTolerance)
+    {
+      uv[0] = std::clamp(uv[0], 0.0, 1.0);
+      uv[1] = std::clamp(uv[1], 0.0, 1.0);
+    }
   }
   mesh.MinimumParameterArea = std::numeric_limits<double>::infinity();
+  mesh.CrowdedTriangles = 0;
   Index flipped = 0;
   for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
   {
@@ -913,18 +930,22 @@ bool CheckOneToOne(TwoCellMesh& mesh, std::string& error)
     const double* c = &mesh.Parameters[2 * tri[2]];
     const double signedParameterArea =
       mesh.Orientation * 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
-    if (!(signedParameterArea > 0))
+    if (!(signedParameterArea > -areaTolerance))
     {
       ++flipped;
     }
+    else if (!(signedParameterArea > 0))
+    {
+      ++mesh.CrowdedTriangles;
+    }
     mesh.MinimumParameterArea = std::min(mesh.MinimumParameterArea, signedParameterArea);
   }
-  if (flipped > 0 || !(mesh.MinimumInteriorMargin > 0))
+  if (flipped > 0 || !(mesh.MinimumInteriorMargin > -marginTolerance))
   {
     std::ostringstream message;
     message << "TwoCellParameterization: the parameterization is not one-to-one (" << flipped << " of "
-            << mesh.NumberOfTriangles() << " triangles degenerate or flipped in (u, v), smallest interior margin "
-            << mesh.MinimumInteriorMargin << ")";
+            << mesh.NumberOfTriangles() << " triangles flipped in (u, v) beyond rounding, smallest area "
+            << mesh.MinimumParameterArea << ", smallest interior margin " << mesh.MinimumInteriorMargin << ")";
     error = message.str();
     return false;
   }

@@ -46,6 +46,11 @@ struct TwoCellMesh
   double MinimumParameterArea = 0;
   // Smallest distance of an interior vertex's (u, v) to the border of the square.
   double MinimumInteriorMargin = 0;
+  // Triangles flattened to zero area in (u, v) by rounding: a narrow arm of the cell crowds
+  // towards the border of the square, and its interior vertices land within 1e-12 of it (see
+  // CheckOneToOne). Phi is evaluated from (x, y), so they cost nothing there; the inverse map
+  // skips them.
+  Index CrowdedTriangles = 0;
 
   Index NumberOfPoints() const { return static_cast<Index>(this->Points.size() / 2); }
   Index NumberOfTriangles() const { return static_cast<Index>(this->Triangles.size() / 3); }

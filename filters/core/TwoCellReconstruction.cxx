@@ -846,6 +846,7 @@ void TwoCellReconstruction::Summarize()
     s.FittedCells += cell->Surface.FitReport().Fitted ? 1 : 0;
     s.AdjustedDiagonals += r.AdjustedDiagonals;
     s.MeshTriangles += cell->Parameterization.GetMesh().NumberOfTriangles();
+    s.CrowdedTriangles += cell->Parameterization.GetMesh().CrowdedTriangles;
     s.BezierTriangles += 4 * cell->GridSize * cell->GridSize;
     s.MaximumGridSize = std::max(s.MaximumGridSize, cell->GridSize);
   }

@@ -113,6 +113,7 @@ struct TwoCellReconstructionReport
   Index FittedCells = 0;       // interiors fitted to the input samples (Interior == Fitted)
   Index RefinedCells = 0;      // of them, cells whose grid was refined beyond the sides' need
   Index MeshTriangles = 0;     // triangles of all cell meshes
+  Index CrowdedTriangles = 0;  // of them, flattened in (u, v) by rounding (TwoCellMesh::CrowdedTriangles)
   Index BezierTriangles = 0;   // 4 N^2 per cell
   int MaximumGridSize = 0;
   double ParameterizationSeconds = 0; // wall time: triangulation + mean value coordinates

@@ -7,11 +7,14 @@
 //   without it), and the counts it reports are the differences counted here;
 // - the verdict: when it is 1, an independent count of the sampled field's interior PL minima
 //   and maxima (lower/upper links, written here) equals the complex's interior extrema;
-// - the same report with one thread and several.
+// - the same report with one thread and several;
+// - an image of spacing 0.01 x 3 is reconstructed and verified (in the complex's frame), its
+//   outputs in the image's coordinates.
 //
 // Usage: TestFieldReconstruction
 // Prints figures per case, then "N passed, N failed"; returns nonzero on failure.
 #include "FieldReconstruction.h"
+#include "MorseSmaleComplexExtraction.h"
 #include "TestSupport.h"
 #include "TestHarness.h"
 
@@ -250,6 +253,91 @@ TEST_CASE(FittedInteriorsFollowTheData)
     CHECK(f.RMS <= 0.02);
     CHECK(f.RMS <= 0.5 * q.RMS);
   }
+}
+
+TEST_CASE(AnisotropicSpacingIsReconstructedInTheComplexsFrame)
+{
+  // Spacing 0.01 x 3: in the image's own coordinates every 2-cell is 300 times longer than
+  // wide, and its triangulation and mean value map degenerate. Stages 3 and 4 work in the
+  // complex's frame (spacings divided by powers of two), where the cells have their shape on a
+  // square grid again; the outputs come back in the image's coordinates.
+  GridField grid = ShepardField(40, 2.0, 60, 5);
+  grid.Spacing[0] = 0.01;
+  grid.Spacing[1] = 3.0;
+  grid.Origin[0] = -7.5;
+  CheckCase("shepard 0.01 x 3", grid, 5, 4, 2);
+
+  Pipeline p;
+  std::string error;
+  CHECK(RunStages1To3(grid, 5, 4, p, error));
+  const PlanarFrame& frame = p.Simplified.Complex.Frame;
+  // The powers of two nearest the spacings, kept through simplification.
+  CHECK(frame.Scale[0] == 1.0 / 128 && frame.Scale[1] == 4);
+  CHECK(p.Input.Frame.Scale[0] == frame.Scale[0] && p.Input.Frame.Scale[1] == frame.Scale[1]);
+  // Exact both ways.
+  std::vector<double> points = p.Field.Points;
+  frame.ToFrame(points);
+  frame.ToWorld(points);
+  CHECK(points == p.Field.Points);
+  // The smoothed curves come back in the image's coordinates: every piece ends on its nodes,
+  // and its nodes that are critical points sit on their vertices.
+  bool onNodes = true, onVertices = true;
+  for (const SmoothedPiece& piece : p.Smoothed.Pieces)
+  {
+    const std::vector<double>& c = piece.Curve.ControlPoints;
+    const SmoothingNode& start = p.Smoothed.Nodes[piece.StartNode];
+    const SmoothingNode& end = p.Smoothed.Nodes[piece.EndNode];
+    onNodes = onNodes && c[0] == start.Position[0] && c[1] == start.Position[1] &&
+      c[c.size() - 2] == end.Position[0] && c[c.size() - 1] == end.Position[1];
+  }
+  for (const SmoothingNode& node : p.Smoothed.Nodes)
+  {
+    if (node.Type == SmoothingNode::Critical)
+    {
+      const Index v = p.Simplified.Complex.CriticalPoints[node.Source].Vertex;
+      onVertices = onVertices && node.Position[0] == p.Field.Points[2 * v] &&
+        node.Position[1] == p.Field.Points[2 * v + 1];
+    }
+  }
+  CHECK(onNodes);
+  CHECK(onVertices);
+
+  // For comparison (printed): the same pipeline in the image's own coordinates.
+  MorseSmaleComplex world = p.Simplified.Complex;
+  world.Frame = PlanarFrame();
+  OneCellSmoothing smoothing;
+  smoothing.Segments = 4;
+  OneCellSmoothingResult smoothedInWorld;
+  FieldReconstructionReport report;
+  FieldReconstruction reconstruction;
+  if (smoothing.Smooth(world, p.Simplified.JunctionPoints, p.Bounds, smoothedInWorld, error) &&
+    reconstruction.Run(p.Field, world, smoothedInWorld, report, error))
+  {
+    std::printf("  the same in the image's coordinates: %d of %d cells failed, verdict %d\n",
+      report.Cells.FailedCells, report.Cells.Cells, report.Verified ? 1 : 0);
+  }
+  else
+  {
+    std::printf("  the same in the image's coordinates: %s\n", error.c_str());
+  }
+}
+
+TEST_CASE(MeshFrameFollowsItsEdges)
+{
+  // A triangle mesh's frame: the root mean square dx and dy of its edges, to the nearest power
+  // of two. The triangles of a grid of spacing 1 x 1 give 0.82 x 0.82: the identity.
+  GridField grid = ShepardField(10, 2.0, 12, 1);
+  PlanarScalarField mesh = FieldOnGrid(grid);
+  mesh.GridDimensions[0] = mesh.GridDimensions[1] = 0;
+  mesh.Triangles = GridTriangles(12, 12);
+  CHECK(MorseSmaleComplexExtraction::DomainFrame(mesh).IsIdentity());
+  // Stretched by 100 along y (dx 0.82, dy 82): 1 x 64 (82 is nearer 64 than 128).
+  for (std::size_t v = 0; v < mesh.Values.size(); ++v)
+  {
+    mesh.Points[2 * v + 1] *= 100;
+  }
+  const PlanarFrame frame = MorseSmaleComplexExtraction::DomainFrame(mesh);
+  CHECK(frame.Scale[0] == 1 && frame.Scale[1] == 64);
 }
 
 TEST_CASE(SpuriousPointsAreCountedNearAndFarFromTheOneCells)

@@ -299,14 +299,37 @@ void CheckComplex(Failures& failures, const std::string& at, const PlanarScalarF
         oneCell.Points[2 * (n + 1)] == field.Points[2 * mv] && oneCell.Values[n + 1] == field.Values[mv];
       for (size_t i = 0; ok && i < n; ++i)
       {
+        // A triangle's point: its centroid (images; the maximum's triangle), or on a triangle
+        // mesh the midpoint of the edge to the triangle its V-path goes on to (which a merged
+        // 1-cell need not pass next: it may come back down that way, or skip the way up to a
+        // cancelled maximum and back). The order of the sums is the extraction's.
         const Index t = oneCell.MeshCells[i];
-        double cx = 0, value = 0;
-        for (Index v : mesh.TriangleVertices[t])
+        const auto& tv = mesh.TriangleVertices[t];
+        std::vector<std::array<double, 3>> candidates(1, { 0, 0, 0 });
+        for (Index v : tv)
         {
-          cx += field.Points[2 * v] / 3;
-          value += field.Values[v] / 3;
+          candidates[0][0] += field.Points[2 * v] / 3;
+          candidates[0][1] += field.Points[2 * v + 1] / 3;
+          candidates[0][2] += field.Values[v] / 3;
         }
-        ok = oneCell.Points[2 * (i + 1)] == cx && oneCell.Values[i + 1] == value;
+        for (int skip = 0; skip < 3 && !field.IsGrid(); ++skip)
+        {
+          std::array<double, 3> midpoint{ 0, 0, 0 };
+          for (int k = 0; k < 3; ++k)
+          {
+            if (k != skip)
+            {
+              midpoint[0] += field.Points[2 * tv[k]] / 2;
+              midpoint[1] += field.Points[2 * tv[k] + 1] / 2;
+              midpoint[2] += field.Values[tv[k]] / 2;
+            }
+          }
+          candidates.push_back(midpoint);
+        }
+        ok = std::any_of(candidates.begin(), candidates.end(), [&](const std::array<double, 3>& c) {
+          return oneCell.Points[2 * (i + 1)] == c[0] && oneCell.Points[2 * (i + 1) + 1] == c[1] &&
+            oneCell.Values[i + 1] == c[2];
+        });
         int shared = 0; // consecutive triangles share an edge
         for (Index e : mesh.TriangleEdges[t])
         {

@@ -235,6 +235,86 @@ TEST_CASE(ProgressAbortAndBadInput)
   CHECK(error == "the complex has no 1-cells");
 }
 
+//------------------------------------------------------------------------------
+TEST_CASE(PolylineFallbackFollowsTheJaggedOneCell)
+{
+  // A zigzag of 4 edges (lengths 1, 3, 1, 3) between two nodes, drawn as 8 cubic segments.
+  std::vector<SmoothingNode> nodes(2);
+  nodes[0].Position[0] = 0;
+  nodes[0].Position[1] = 0;
+  nodes[1].Position[0] = 4;
+  nodes[1].Position[1] = 6;
+  SmoothedPiece piece;
+  piece.StartNode = 0;
+  piece.EndNode = 1;
+  // The jagged ends lie off the nodes by 1e-3: they must be moved onto them.
+  piece.Points = { 1e-3, 0, 1, 0, 1, 3, 2, 3, 4, 6 };
+  piece.Curve.Segments = 8;
+  piece.Curve.Dimension = 2;
+  piece.Curve.ControlPoints.assign(8 * 4 * 2, 0.5);
+  CHECK(OneCellSmoothing::FollowPolyline(piece, nodes));
+  const CubicBezierSpline& curve = piece.Curve;
+  CHECK_EQ(curve.Segments, 8);
+  CHECK_EQ(curve.ControlPoints.size(), static_cast<std::size_t>(8 * 4 * 2));
+  // Ends on the nodes.
+  CHECK(curve.ControlPoints[0] == 0 && curve.ControlPoints[1] == 0);
+  CHECK(curve.ControlPoints[62] == 4 && curve.ControlPoints[63] == 6);
+  // Every segment is straight, joins the next exactly, and lies on one polyline edge; every
+  // polyline corner is a segment joint, and the segments of one edge share its length.
+  const double corners[5][2] = { { 0, 0 }, { 1, 0 }, { 1, 3 }, { 2, 3 }, { 4, 6 } };
+  std::vector<int> perEdge(4, 0);
+  bool straight = true, joined = true, onEdges = true;
+  for (int j = 0; j < 8; ++j)
+  {
+    const double* c = curve.Segment(j);
+    for (int m = 1; m < 3; ++m)
+    {
+      const double cross = (c[6] - c[0]) * (c[2 * m + 1] - c[1]) - (c[7] - c[1]) * (c[2 * m] - c[0]);
+      straight = straight && std::abs(cross) <= 1e-12;
+    }
+    if (j + 1 < 8)
+    {
+      joined = joined && c[6] == c[8] && c[7] == c[9];
+    }
+    int edge = -1;
+    for (int e = 0; e < 4; ++e)
+    {
+      const double* a = corners[e];
+      const double* b = corners[e + 1];
+      const auto onSegment = [&](double x, double y) {
+        const double cross = (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0]);
+        const double dot = (x - a[0]) * (b[0] - a[0]) + (y - a[1]) * (b[1] - a[1]);
+        const double length2 = (b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]);
+        return std::abs(cross) <= 1e-12 && dot >= -1e-12 && dot <= length2 + 1e-12;
+      };
+      if (edge < 0 && onSegment(c[0], c[1]) && onSegment(c[6], c[7]) && !(c[0] == b[0] && c[1] == b[1]))
+      {
+        edge = e;
+      }
+    }
+    onEdges = onEdges && edge >= 0;
+    if (edge >= 0)
+    {
+      ++perEdge[edge];
+    }
+  }
+  CHECK(straight);
+  CHECK(joined);
+  CHECK(onEdges);
+  // Lengths 1, 3, 1, sqrt(13) = 3.6: one segment each, the 4 others to the long edges.
+  CHECK(perEdge[0] >= 1 && perEdge[2] >= 1);
+  CHECK(perEdge[1] >= 2 && perEdge[3] >= 2);
+  CHECK_EQ(perEdge[0] + perEdge[1] + perEdge[2] + perEdge[3], 8);
+
+  // Fewer segments than edges: refused, nothing changed.
+  SmoothedPiece short3 = piece;
+  short3.Curve.Segments = 3;
+  short3.Curve.ControlPoints.assign(3 * 4 * 2, 0.5);
+  const std::vector<double> before = short3.Curve.ControlPoints;
+  CHECK(!OneCellSmoothing::FollowPolyline(short3, nodes));
+  CHECK(short3.Curve.ControlPoints == before);
+}
+
 int main()
 {
   return testing_harness::RunAll();

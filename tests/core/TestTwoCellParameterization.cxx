@@ -235,9 +235,13 @@ int CheckParameterization(const TwoCellParameterization& tcp, const Cell& cell, 
   }
   expect(boundaryExact, "boundary samples and parameters preserved exactly");
 
-  // Orientation in both planes, areas add up, uv inside.
+  // Orientation in both planes, areas add up, uv inside. Triangles flattened by rounding
+  // (CrowdedTriangles: a narrow arm pressed against a side of the square) may have areas down
+  // to -1e-14, never below; their vertices may sit on the border.
   bool xyPositive = true, uvPositive = true, indicesValid = true;
   double xyArea = 0, uvArea = 0;
+  Index crowded = 0;
+  std::vector<char> onCrowdedTriangle(mesh.NumberOfPoints(), 0);
   std::map<std::pair<Index, Index>, int> edges; // directed edge -> count
   for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
   {
@@ -254,7 +258,15 @@ int CheckParameterization(const TwoCellParameterization& tcp, const Cell& cell, 
     const double uv =
       TwiceSignedArea(&mesh.Parameters[2 * tri[0]], &mesh.Parameters[2 * tri[1]], &mesh.Parameters[2 * tri[2]]);
     xyPositive = xyPositive && xy > 0;
-    uvPositive = uvPositive && expectedOrientation * uv > 0;
+    uvPositive = uvPositive && expectedOrientation * uv > -2e-14;
+    if (!(expectedOrientation * uv > 0))
+    {
+      ++crowded;
+      for (int k = 0; k < 3; ++k)
+      {
+        onCrowdedTriangle[tri[k]] = 1;
+      }
+    }
     xyArea += xy / 2;
     uvArea += expectedOrientation * uv / 2;
     for (int k = 0; k < 3; ++k)
@@ -268,8 +280,9 @@ int CheckParameterization(const TwoCellParameterization& tcp, const Cell& cell, 
     return failures;
   }
   expect(xyPositive, "all triangles counter-clockwise in (x, y)");
-  expect(uvPositive, "all triangles positively oriented in (u, v) (times Orientation)");
-  expect(mesh.MinimumParameterArea > 0, "reported minimum parameter area > 0");
+  expect(uvPositive, "no triangle flipped in (u, v) beyond rounding (times Orientation)");
+  expect(crowded == mesh.CrowdedTriangles, "flattened triangles reported as CrowdedTriangles");
+  expect(mesh.MinimumParameterArea > (crowded ? -1e-14 : 0.0), "reported minimum parameter area > 0 (or rounding)");
   const double polygonArea = std::abs(PolygonArea(cell.Points));
   expect(std::abs(xyArea - polygonArea) <= 1e-9 * polygonArea, "triangles tile the polygon");
   expect(std::abs(uvArea - 1) <= 1e-9, "image triangles tile the unit square");
@@ -297,9 +310,10 @@ int CheckParameterization(const TwoCellParameterization& tcp, const Cell& cell, 
   for (Index i = n; i < mesh.NumberOfPoints(); ++i)
   {
     const double u = mesh.Parameters[2 * i], v = mesh.Parameters[2 * i + 1];
-    interiorInside = interiorInside && u > 0 && u < 1 && v > 0 && v < 1;
+    interiorInside = interiorInside &&
+      (onCrowdedTriangle[i] ? u >= 0 && u <= 1 && v >= 0 && v <= 1 : u > 0 && u < 1 && v > 0 && v < 1);
   }
-  expect(interiorInside, "interior (u, v) strictly inside (0,1)^2");
+  expect(interiorInside, "interior (u, v) strictly inside (0,1)^2 (on crowded triangles: in [0,1]^2)");
 
   double bounds[4] = { 1e300, -1e300, 1e300, -1e300 };
   for (Index i = 0; i < n; ++i)
@@ -333,10 +347,14 @@ int CheckParameterization(const TwoCellParameterization& tcp, const Cell& cell, 
       }
     }
     roundTrip = roundTrip && matched;
-    inverseAtVertices = inverseAtVertices && tcp.InverseEvaluate(mesh.Parameters[2 * i], mesh.Parameters[2 * i + 1], xy) &&
-      std::hypot(xy[0] - mesh.Points[2 * i], xy[1] - mesh.Points[2 * i + 1]) <= 1e-9 * size;
+    // Where triangles are flattened (crowded meshes), Phi^-1 is not defined on a whole arm's
+    // image; it is only checked on meshes without them.
+    inverseAtVertices = inverseAtVertices &&
+      (crowded > 0 ||
+        (tcp.InverseEvaluate(mesh.Parameters[2 * i], mesh.Parameters[2 * i + 1], xy) &&
+          std::hypot(xy[0] - mesh.Points[2 * i], xy[1] - mesh.Points[2 * i + 1]) <= 1e-9 * size));
   }
-  expect(inverseAtVertices, "InverseEvaluate maps every vertex's (u, v) to its (x, y)");
+  expect(inverseAtVertices, "InverseEvaluate maps every vertex's (u, v) to its (x, y) (meshes without crowded triangles)");
   for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
   {
     const Index* tri = &mesh.Triangles[3 * t];
@@ -397,7 +415,7 @@ int CheckParameterization(const TwoCellParameterization& tcp, const Cell& cell, 
   }
   expect(insideFound, "random inside points located, (u, v) in the square");
   expect(outsideRejected, "random outside points rejected");
-  expect(inverseError <= 1e-9 || inverseBackward <= 1e-14,
+  expect(crowded > 0 || inverseError <= 1e-9 || inverseBackward <= 1e-14,
     "InverseEvaluate(Evaluate(x, y)) = (x, y) at random inside points (1e-9, or exact backwards)");
   // The corners of the square: the corner samples; outside the square: nothing.
   bool corners = true;
@@ -620,7 +638,8 @@ TEST_CASE(RandomStress)
   // the tips, must all be valid. Beyond that, a tip that lies inside one side of the square
   // (or a very sharp tip mapped to a right angle) makes the exact map decay like
   // exp(-pi length / width) (resp. like r^(90 deg / tip angle)) towards the border, below double
-  // resolution: those cells may be reported as not one-to-one.
+  // resolution: those cells come out with crowded triangles (flattened by rounding, within
+  // the checks' tolerance) or, beyond rounding, reported as not one-to-one.
   struct Family
   {
     const char* Name;
@@ -1459,7 +1478,7 @@ TEST_CASE(ThinPouches)
           const Index* tri = &mesh.Triangles[3 * t];
           area += TwiceSignedArea(&mesh.Points[2 * tri[0]], &mesh.Points[2 * tri[1]], &mesh.Points[2 * tri[2]]) / 2;
         }
-        CHECK(mesh.MinimumParameterArea > 0);
+        CHECK(mesh.MinimumParameterArea > (mesh.CrowdedTriangles ? -1e-14 : 0.0));
         CHECK(std::abs(area - PolygonArea(cell.Points)) <= 1e-9 * area);
       }
       CHECK(ms < 2000);
