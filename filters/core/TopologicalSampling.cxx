@@ -148,21 +148,30 @@ private:
     return InvalidIndex;
   }
 
-  // Whether u has a neighbour before it that the region (the vertices marked `seen`) has not
-  // reached.
-  bool DrainsOutside(Index u, unsigned seen) const
+  // Whether v has a neighbour, other than those `skip` names, before `key` in the sweep
+  // (`before`), or after it.
+  template <typename Skip>
+  bool HasNeighbour(Index v, const Key& key, bool before, Skip&& skip) const
   {
     const Graph& g = this->Sweep.Neighbours;
-    const Key key{ this->Values[u], u };
-    for (Index i = g.Start[u]; i < g.Start[u + 1]; ++i)
+    for (Index i = g.Start[v]; i < g.Start[v + 1]; ++i)
     {
       const Index w = g.Adjacent[i];
-      if (this->Visits.Mark[w] != seen && this->Sweep.Before({ this->Values[w], w }, key))
+      const Key other{ this->Values[w], w };
+      if (!skip(w) && (before ? this->Sweep.Before(other, key) : this->Sweep.Before(key, other)))
       {
         return true;
       }
     }
     return false;
+  }
+
+  // Whether u has a neighbour before it that the region (the vertices marked `seen`) has not
+  // reached.
+  bool DrainsOutside(Index u, unsigned seen) const
+  {
+    return this->HasNeighbour(
+      u, { this->Values[u], u }, true, [this, seen](Index w) { return this->Visits.Mark[w] == seen; });
   }
 
   // From the outlet inwards, each region vertex gets the first key after the region neighbour
@@ -214,6 +223,68 @@ private:
         if (mark[r] == inRegion)
         {
           front.push(this->FirstAfter(p, r));
+        }
+      }
+    }
+    return changed + this->GiveEveryVertexOneAfter(outlet, region, revalued);
+  }
+
+  // The re-valued region lies on one level, its ties ordered by id. A vertex inside it (every
+  // neighbour in the region or the outlet) whose neighbours all come before it then has none
+  // after it: a new extremum of the other kind (a pit left by a cut, a peak by a fill), which
+  // the other sweep turns back, round after round. Each such vertex gets a neighbour just past
+  // it: one that keeps a neighbour of its own further on, and that no neighbour needs as the
+  // only one before it.
+  Index GiveEveryVertexOneAfter(Index outlet, const std::vector<Index>& region, std::vector<Index>* revalued)
+  {
+    const Graph& g = this->Sweep.Neighbours;
+    std::vector<unsigned>& mark = this->Visits.Mark;
+    const unsigned inRegion = this->Visits.NewStamp();
+    for (Index r : region)
+    {
+      mark[r] = inRegion;
+    }
+    Index changed = 0;
+    for (Index v : region)
+    {
+      const Key key{ this->Values[v], v };
+      if (this->HasNeighbour(v, key, false, [](Index) { return false; }))
+      {
+        continue;
+      }
+      for (Index i = g.Start[v]; i < g.Start[v + 1]; ++i)
+      {
+        const Index u = g.Adjacent[i];
+        if (u == outlet || mark[u] != inRegion)
+        {
+          continue;
+        }
+        const Key moved = this->FirstAfter(v, u);
+        if (!this->HasNeighbour(u, moved, false, [v](Index w) { return w == v; }))
+        {
+          continue;
+        }
+        // Neighbours that u was before and would no longer be must have another one before.
+        const Key old{ this->Values[u], u };
+        bool safe = true;
+        for (Index j = g.Start[u]; j < g.Start[u + 1] && safe; ++j)
+        {
+          const Index z = g.Adjacent[j];
+          const Key zKey{ this->Values[z], z };
+          if (z != v && this->Sweep.Before(old, zKey) && !this->Sweep.Before(moved, zKey))
+          {
+            safe = this->HasNeighbour(z, zKey, true, [u](Index w) { return w == u; });
+          }
+        }
+        if (safe)
+        {
+          this->Values[u] = moved.Value;
+          ++changed;
+          if (revalued)
+          {
+            revalued->push_back(u);
+          }
+          break;
         }
       }
     }

@@ -1,5 +1,6 @@
-// What several core tests share: grid fields as triangle meshes, a ParallelFor over real
-// threads, and the real stages 1-3 run on a synthetic grid (what the stage-4 tests start from).
+// What several core tests share: grid fields as triangle meshes, Delaunay meshes of random
+// points, a ParallelFor over real threads, and the real stages 1-3 run on a synthetic grid (what
+// the stage-4 tests start from).
 #pragma once
 
 #include "CoreTypes.h"
@@ -10,6 +11,8 @@
 #include "SyntheticFields.h"
 
 #include <algorithm>
+#include <array>
+#include <map>
 #include <string>
 #include <thread>
 #include <vector>
@@ -72,4 +75,62 @@ inline bool RunStages1To3(const GridField& grid, double percent, int k, Pipeline
   smoothing.Segments = k;
   return smoothing.Smooth(p.Simplified.Complex, p.Simplified.JunctionPoints, p.Bounds, p.Smoothed, error);
 }
+// The Delaunay triangulation of `points` (x, y pairs, in general position), counter-clockwise
+// (Bowyer-Watson, quadratic: for test meshes of a few hundred points).
+inline std::vector<Index> DelaunayTriangles(const std::vector<double>& points)
+{
+  const Index n = static_cast<Index>(points.size() / 2);
+  std::vector<double> p = points;
+  // A super-triangle far around the points.
+  p.insert(p.end(), { -1e3, -1e3, 1e3, -1e3, 0, 1e3 });
+  std::vector<std::array<Index, 3>> triangles = { { n, n + 1, n + 2 } };
+  const auto inCircumcircle = [&p](const std::array<Index, 3>& t, Index q) {
+    const double* a = &p[2 * t[0]];
+    const double* b = &p[2 * t[1]];
+    const double* c = &p[2 * t[2]];
+    const double ax = a[0] - p[2 * q], ay = a[1] - p[2 * q + 1];
+    const double bx = b[0] - p[2 * q], by = b[1] - p[2 * q + 1];
+    const double cx = c[0] - p[2 * q], cy = c[1] - p[2 * q + 1];
+    return (ax * ax + ay * ay) * (bx * cy - cx * by) - (bx * bx + by * by) * (ax * cy - cx * ay) +
+        (cx * cx + cy * cy) * (ax * by - bx * ay) > 0;
+  };
+  for (Index q = 0; q < n; ++q)
+  {
+    std::vector<std::array<Index, 3>> kept;
+    std::map<std::pair<Index, Index>, int> edges; // directed edges of the removed triangles
+    for (const auto& t : triangles)
+    {
+      if (inCircumcircle(t, q))
+      {
+        for (int k = 0; k < 3; ++k)
+        {
+          ++edges[{ t[k], t[(k + 1) % 3] }];
+        }
+      }
+      else
+      {
+        kept.push_back(t);
+      }
+    }
+    // The cavity's border: edges whose reverse was not removed too.
+    for (const auto& e : edges)
+    {
+      if (edges.count({ e.first.second, e.first.first }) == 0)
+      {
+        kept.push_back({ e.first.first, e.first.second, q });
+      }
+    }
+    triangles.swap(kept);
+  }
+  std::vector<Index> result;
+  for (const auto& t : triangles)
+  {
+    if (t[0] < n && t[1] < n && t[2] < n)
+    {
+      result.insert(result.end(), t.begin(), t.end());
+    }
+  }
+  return result;
+}
+
 } // namespace topospline

@@ -1,6 +1,7 @@
 // Tests of topological sampling's own mechanisms on made-up fields: the floods remove the
 // extrema noise adds and settle on plateaus, a dented boundary saddle gets a way up, a
-// ridge running between two rows of vertices is carved in, and wanted extrema taken away by
+// ridge running between two rows of vertices is carved in, a cut leaves no pit on its plateau
+// of a triangle mesh, and wanted extrema taken away by
 // the floods of the other kind are restored. Each sampled result is checked by
 // extracting its critical points again (stage 1) against the wanted complex. (The whole
 // sequence on real reconstructions is tested in TestFieldReconstruction.)
@@ -85,6 +86,75 @@ TEST_CASE(TopologicalSamplingRemovesNoiseExtrema)
     CHECK(comparison.Expected == comparison.Found);
     CHECK(report.MaximumChange <= 1.0 + 1e-12); // at most the noise range
   }
+}
+
+TEST_CASE(ACutLeavesNoPitOnItsPlateau)
+{
+  // A spurious peak B with A, C and D below it and above the outlet O: the cut lowers them to
+  // O's level, ties ordered by id. A (id 0) lies inside the region, every neighbour (O, B, C, D)
+  // on that level with a higher id: it was left a pit, which the next fill made a peak again,
+  // round after round (a Delaunay mesh of the stress test, #288, where a vertex had those 4
+  // neighbours only). Mesh: A at the centre, ring O, B, C, D at radius 1, 8 boundary vertices
+  // at radius 2; the wanted complex is the one of the field without the peak.
+  PlanarScalarField field;
+  const Index ring1[4] = { 9, 1, 2, 3 };            // O, B, C, D at 0, 90, 180, 270 degrees
+  const Index ring2[8] = { 4, 5, 6, 7, 8, 10, 11, 12 }; // every 45 degrees, from 0
+  field.Points.assign(2 * 13, 0);
+  for (int k = 0; k < 4; ++k)
+  {
+    field.Points[2 * ring1[k]] = std::cos(k * M_PI / 2);
+    field.Points[2 * ring1[k] + 1] = std::sin(k * M_PI / 2);
+  }
+  for (int k = 0; k < 8; ++k)
+  {
+    field.Points[2 * ring2[k]] = 2 * std::cos(k * M_PI / 4);
+    field.Points[2 * ring2[k] + 1] = 2 * std::sin(k * M_PI / 4);
+  }
+  for (int k = 0; k < 4; ++k)
+  {
+    const Index a = ring1[k], b = ring1[(k + 1) % 4];
+    const Index r0 = ring2[2 * k], r1 = ring2[2 * k + 1], r2 = ring2[(2 * k + 2) % 8];
+    field.Triangles.insert(field.Triangles.end(), { 0, a, b, a, r0, r1, a, r1, b, b, r1, r2 });
+  }
+  // Without the peak: a maximum at H (ring2 at 0 degrees), a minimum on the far side.
+  field.Values = std::vector<double>(13, 0);
+  const double ringValues[8] = { 2.0, 0.4, 0.3, 0.2, 0.1, 0.15, 0.25, 0.4 };
+  for (int k = 0; k < 8; ++k)
+  {
+    field.Values[ring2[k]] = ringValues[k];
+  }
+  field.Values[0] = 0.35;  // A
+  field.Values[9] = 0.5;   // O
+  field.Values[1] = 0.33;  // B
+  field.Values[2] = 0.15;  // C
+  field.Values[3] = 0.3;   // D
+  MorseSmaleComplexExtraction extraction;
+  MorseSmaleComplex wanted;
+  std::string error;
+  CHECK(extraction.Extract(field, wanted, error));
+  TriangleMeshTopology mesh;
+  CHECK(mesh.Build(13, field.Triangles, SequentialFor, error));
+  const SamplingConstraints constraints = ComplexConstraints(wanted, mesh, mesh, [](Index v) { return v; });
+
+  PlanarScalarField peaked = field;
+  peaked.Values[1] = 1.0;  // B, the spurious peak
+  peaked.Values[2] = 0.9;  // C
+  peaked.Values[3] = 0.85; // D
+  peaked.Values[0] = 0.8;  // A
+  const auto report = EnforceCriticalVertices(mesh, constraints, peaked.Values);
+  MorseSmaleComplex after;
+  CHECK(extraction.Extract(peaked, after, error));
+  bool aIsCritical = false;
+  for (const CriticalPoint& cp : after.CriticalPoints)
+  {
+    aIsCritical = aIsCritical || cp.Vertex == 0;
+  }
+  std::printf("  wanted %d/%d/%d, after the floods %d/%d/%d (%d rounds, converged %d); A critical: %d\n",
+    wanted.CountByIndex()[0], wanted.CountByIndex()[1], wanted.CountByIndex()[2], after.CountByIndex()[0],
+    after.CountByIndex()[1], after.CountByIndex()[2], report.Rounds, report.Converged ? 1 : 0, aIsCritical ? 1 : 0);
+  CHECK(after.CountByIndex() == wanted.CountByIndex());
+  CHECK(!aIsCritical);
+  CHECK(report.Converged);
 }
 
 TEST_CASE(BoundarySaddleAboveItsLinkGetsAWayUp)
