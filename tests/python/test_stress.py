@@ -30,7 +30,13 @@ both are lower; inside, every lower-link component touching neither boundary nei
 saddle, and a lower link covering the whole link path adds a maximum.
 
 TOPOSPLINE_STRESS=full runs the full set (>= 300 cases, a few hours); the default is the CI
-subset (about 5 minutes). TOPOSPLINE_STRESS_SEED changes the seed of both. The full set's last
+subset (about 5 minutes). TOPOSPLINE_STRESS_SEED changes the seed of both.
+TOPOSPLINE_STRESS_ONLY=3,27 runs only those case ids (of the chosen set). With
+TOPOSPLINE_STRESS_DIAGNOSE=1, every case that is not ok also prints the filters' warnings and
+the vertex ids of the complex's nodes with no critical point of their index within one edge
+(missing) and of critical points with no node of their index within one edge (extra); with
+TOPOSPLINE_STRESS_DUMP=<folder> every case writes its smoothed complex and reconstruction there
+(`<id>_smoothed.vtm`, `<id>_reconstruction.*`), to open in ParaView. The full set's last
 result is in docs/StressTest.md."""
 import json
 import os
@@ -45,6 +51,9 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 FULL = os.environ.get("TOPOSPLINE_STRESS") == "full"
 SEED = int(os.environ.get("TOPOSPLINE_STRESS_SEED", "13"))
+ONLY = set(int(c) for c in os.environ.get("TOPOSPLINE_STRESS_ONLY", "").split(",") if c.strip())
+DIAGNOSE = os.environ.get("TOPOSPLINE_STRESS_DIAGNOSE") == "1"
+DUMP = os.environ.get("TOPOSPLINE_STRESS_DUMP", "")
 # Each worker process runs this many cases, then a fresh one goes on: what ParaView keeps of
 # hundreds of pipelines adds up (2.4 GB after 3 minutes of the full set).
 CASES_PER_WORKER = 10
@@ -294,8 +303,16 @@ def worker(cases_file, first):
         def on_error(caller, event, text):
             result["errors"].append("%s: %s" % (caller.GetClassName(), text.strip()[-400:]))
 
+        result["warnings"] = []
+
+        @calldata_type(VTK_STRING)
+        def on_warning(caller, event, text):
+            result["warnings"].append("%s: %s" % (caller.GetClassName(), text.strip()[-300:]))
+
         for proxy in (ms, simplify, smooth, reconstruct):
             proxy.GetClientSideObject().AddObserver(vtkCommand.ErrorEvent, on_error)
+            if DIAGNOSE:
+                proxy.GetClientSideObject().AddObserver(vtkCommand.WarningEvent, on_warning)
         reconstruct.UpdatePipeline()
         # the built-in session: the outputs are here, no need for Fetch's reduction filters
         out = reconstruct.GetClientSideObject().GetOutputDataObject(0)
@@ -350,6 +367,10 @@ def worker(cases_file, first):
                 hops = 3 if junctions and index < 2 else 2
                 far += len(graph_distance_ok([v for v, i, m in found if i == index], near_nodes, neighbours, hops))
             result["far"] = far
+            if DIAGNOSE:
+                result["missing"], result["extra"] = unmatched_points(found, nodes, junctions, neighbours)
+            if DUMP:
+                dump_case(case["id"], smooth, out)
             # of the range (constant fields: of the magnitude)
             scale = np.ptp(values) if np.ptp(values) > 0 else max(float(np.max(np.abs(values))), 1.0)
             result["max_error_percent"] = float(100 * np.max(np.abs(sampled - values)) / scale)
@@ -398,6 +419,32 @@ def judge(r, totals):
     return problems
 
 
+def unmatched_points(found, nodes, junctions, neighbours):
+    """Per index: node vertices with no found critical point of that index on them or one edge
+    away (missing), and found ones with no such node (extra)."""
+    found_at = [set(v for v, i, m in found if i == index) for index in range(3)]
+    missing, extra = {}, {}
+    for index in range(3):
+        wanted = set(nodes[index] + (junctions if index < 2 else []))
+        missing[index] = sorted(v for v in wanted if not ({v} | neighbours[v]) & found_at[index])
+        extra[index] = sorted(v for v in found_at[index] if not ({v} | neighbours[v]) & wanted)
+    return missing, extra
+
+
+def dump_case(case_id, smooth, reconstruction):
+    from paraview.vtk.vtkIOXML import vtkXMLMultiBlockDataWriter, vtkXMLDataSetWriter
+    os.makedirs(DUMP, exist_ok=True)
+    writer = vtkXMLMultiBlockDataWriter()
+    writer.SetInputData(smooth.GetClientSideObject().GetOutputDataObject(0))
+    writer.SetFileName(os.path.join(DUMP, "%d_smoothed.vtm" % case_id))
+    writer.Write()
+    data_writer = vtkXMLDataSetWriter()
+    data_writer.SetInputData(reconstruction)
+    extension = "vtp" if reconstruction.IsA("vtkPolyData") else "vtu" if reconstruction.IsA("vtkUnstructuredGrid") else "vti"
+    data_writer.SetFileName(os.path.join(DUMP, "%d_reconstruction.%s" % (case_id, extension)))
+    data_writer.Write()
+
+
 def main():
     sys.path.insert(0, HERE)
     import topospline_testing as tt
@@ -408,6 +455,8 @@ def main():
         else:
             print("SKIP %s: not found (large data sets live in ../shared/data)" % entry["file"], flush=True)
     cases = make_cases(present, FULL, SEED)
+    if ONLY:
+        cases = [c for c in cases if c["id"] in ONLY]
     if not FULL:
         # the CI subset: crops of the data sets shipped in the repo only, so it runs the same
         # everywhere
@@ -457,6 +506,11 @@ def main():
                 print("%s %s: %.1f s, L_inf %.1f %% of the range%s" % (
                     "FAIL" if problems else "ok", describe(by_id[r["id"]]), r["seconds"], r.get("max_error_percent", -1),
                     (": " + "; ".join(problems)) if problems else ""), flush=True)
+                if DIAGNOSE and problems:
+                    for warning in r.get("warnings", []):
+                        print("   warning: " + " ".join(warning.split())[-400:], flush=True)
+                    print("   missing (vertex ids by index 0/1/2): %s; extra: %s" % (r.get("missing"), r.get("extra")),
+                          flush=True)
             elif line.strip() and current is not None and ("ERR" in line or "rror" in line or "Segmentation" in line):
                 printed_errors.append(line.strip()[:300])
         code = proc.wait()
