@@ -111,8 +111,8 @@ struct JunctionPoint
   std::vector<Index> OneCells;    // output 1-cells through it, ascending order
 };
 
-// Maps the complex's geometry (1-cell points, 2-cell centroids) into `frame` or back to the
-// domain's coordinates.
+// Maps the complex's geometry (1-cell points, 2-cell centroids) from the domain's coordinates
+// into `frame`.
 inline void GeometryToFrame(const PlanarFrame& frame, MorseSmaleComplex& complex)
 {
   for (OneCell& oneCell : complex.OneCells)
