@@ -224,15 +224,7 @@ bool FieldReconstruction::Run(const PlanarScalarField& field, const MorseSmaleCo
   MorseSmaleComplex framedComplex = complex;
   GeometryToFrame(frame, framedComplex);
   OneCellSmoothingResult framedSmoothed = smoothed;
-  for (SmoothingNode& node : framedSmoothed.Nodes)
-  {
-    frame.ToFrame(node.Position);
-  }
-  for (SmoothedPiece& piece : framedSmoothed.Pieces)
-  {
-    frame.ToFrame(piece.Points);
-    frame.ToFrame(piece.Curve.ControlPoints);
-  }
+  MapSmoothedGeometry(framedSmoothed, [&frame](double* xy) { frame.ToFrame(xy); });
   if (!this->RunInFrame(framedField, framedComplex, framedSmoothed, report, error))
   {
     return false;

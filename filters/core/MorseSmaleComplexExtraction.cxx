@@ -1,6 +1,7 @@
 #include "MorseSmaleComplexExtraction.h"
 
 #include "DisjointSets.h"
+#include "PlanarGeometry.h"
 
 #include <algorithm>
 #include <atomic>
@@ -60,7 +61,7 @@ Index ThirdVertex(const TriangleMeshTopology& mesh, Index t, Index a, Index b)
 
 double Orientation(const std::vector<double>& p, Index a, Index b, Index c)
 {
-  return (p[2 * b] - p[2 * a]) * (p[2 * c + 1] - p[2 * a + 1]) - (p[2 * b + 1] - p[2 * a + 1]) * (p[2 * c] - p[2 * a]);
+  return Orientation2D(&p[2 * a], &p[2 * b], &p[2 * c]);
 }
 
 // Counter-clockwise angle in [0, 2pi) from direction (rx, ry) to (dx, dy).
@@ -384,12 +385,7 @@ bool TraceAscendingOneCell(const ExtractionState& state, Index saddle, Index t, 
       centroid(oneCell.MeshCells[i + 1], d);
       const double* a = &field.Points[2 * shared[0]];
       const double* b = &field.Points[2 * shared[1]];
-      const auto side = [](const double* p, const double* q, const double* r) {
-        const double cross = (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
-        return (cross > 0) - (cross < 0);
-      };
-      const bool crosses = side(c, d, a) * side(c, d, b) < 0 && side(a, b, c) * side(a, b, d) < 0;
-      if (!crosses)
+      if (!SegmentsCrossProperly(c, d, a, b))
       {
         c[0] = a[0] / 2 + b[0] / 2;
         c[1] = a[1] / 2 + b[1] / 2;

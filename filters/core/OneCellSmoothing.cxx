@@ -391,17 +391,10 @@ struct Segment2
   int Count;    // number of segments of that polyline
 };
 
-double Cross(const double* o, const double* a, const double* b)
-{
-  return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
-}
-
 // Proper crossing or overlap of two segments (touching end points excluded by the caller).
 bool SegmentsIntersect(const Segment2& s, const Segment2& t)
 {
-  const double d1 = Cross(s.A, s.B, t.A), d2 = Cross(s.A, s.B, t.B);
-  const double d3 = Cross(t.A, t.B, s.A), d4 = Cross(t.A, t.B, s.B);
-  return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
+  return SegmentsCrossProperly(s.A, s.B, t.A, t.B);
 }
 
 // Finds the pairs of pieces whose smoothed curves cross: samples every curve, buckets the
@@ -602,8 +595,6 @@ int CountPiecesOutsideDomain(
 } // namespace
 
 //------------------------------------------------------------------------------
-// Paper, section 4, steps 2 and 3 for one piece: a strictly increasing height (and the
-// unconstrained one, for comparison) and a planar curve, both as k cubic Beziers.
 bool OneCellSmoothing::FollowPolyline(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes)
 {
   std::vector<double> p = piece.Points;
@@ -651,9 +642,8 @@ bool OneCellSmoothing::FollowPolyline(SmoothedPiece& piece, const std::vector<Sm
     {
       for (int m = 0; m < 4; ++m)
       {
-        const double s = (i + m / 3.0) / count[e];
-        // The ends of a segment exactly: they are shared with the neighbouring segments.
-        const double t = m == 0 ? static_cast<double>(i) / count[e] : m == 3 ? static_cast<double>(i + 1) / count[e] : s;
+        // i + m / 3 is exact at the segment's ends (m = 0, 3), which its neighbours share.
+        const double t = (i + m / 3.0) / count[e];
         control.push_back(t == 1 ? b[0] : a[0] + t * (b[0] - a[0]));
         control.push_back(t == 1 ? b[1] : a[1] + t * (b[1] - a[1]));
       }
@@ -662,6 +652,8 @@ bool OneCellSmoothing::FollowPolyline(SmoothedPiece& piece, const std::vector<Sm
   return true;
 }
 
+// Paper, section 4, steps 2 and 3 for one piece: a strictly increasing height (and the
+// unconstrained one, for comparison) and a planar curve, both as k cubic Beziers.
 bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments,
   const double bounds[4], std::string& error) const
 {
@@ -849,15 +841,7 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
   {
     return false;
   }
-  for (SmoothingNode& node : result.Nodes)
-  {
-    frame.ToWorld(node.Position);
-  }
-  for (SmoothedPiece& piece : result.Pieces)
-  {
-    frame.ToWorld(piece.Points);
-    frame.ToWorld(piece.Curve.ControlPoints);
-  }
+  MapSmoothedGeometry(result, [&frame](double* xy) { frame.ToWorld(xy); });
   return true;
 }
 

@@ -113,4 +113,24 @@ private:
   bool FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments, const double bounds[4],
     std::string& error) const;
 };
+// Applies `map` (an (x, y) in place: a PlanarFrame's ToFrame or ToWorld) to every position of
+// a smoothing: its nodes, the pieces' samples and curves. Heights stay as they are.
+template <typename Map>
+void MapSmoothedGeometry(OneCellSmoothingResult& result, Map&& map)
+{
+  for (SmoothingNode& node : result.Nodes)
+  {
+    map(node.Position);
+  }
+  for (SmoothedPiece& piece : result.Pieces)
+  {
+    for (std::vector<double>* points : { &piece.Points, &piece.Curve.ControlPoints })
+    {
+      for (std::size_t i = 0; i + 1 < points->size(); i += 2)
+      {
+        map(&(*points)[i]);
+      }
+    }
+  }
+}
 } // namespace topospline

@@ -17,10 +17,22 @@ inline double SegmentDistance2(const double* a, const double* b, double x, doubl
   const double ex = a[0] + fraction * dx - x, ey = a[1] + fraction * dy - y;
   return ex * ex + ey * ey;
 }
-} // namespace topospline
 
-namespace topospline
+// Twice the signed area of the triangle (o, a, b): positive when it turns counter-clockwise.
+inline double Orientation2D(const double* o, const double* a, const double* b)
 {
+  return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+}
+
+// Whether segments ab and cd cross at a point inside both: each separates the other's ends
+// strictly (touching ends and collinear overlaps are not crossings).
+inline bool SegmentsCrossProperly(const double* a, const double* b, const double* c, const double* d)
+{
+  const double d1 = Orientation2D(a, b, c), d2 = Orientation2D(a, b, d);
+  const double d3 = Orientation2D(c, d, a), d4 = Orientation2D(c, d, b);
+  return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
+}
+
 // The coordinates stages 3 and 4 work in: the domain's own, divided per axis by a power of two
 // close to its typical edge extent along that axis. Why: curve fits, crossings, triangulations
 // and mean value maps judge shapes by Euclidean lengths, so on an image of spacing 0.01 x 3 every

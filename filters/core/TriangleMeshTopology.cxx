@@ -1,6 +1,7 @@
 #include "TriangleMeshTopology.h"
 
 #include "DisjointSets.h"
+#include "PlanarGeometry.h"
 
 #include <algorithm>
 
@@ -479,8 +480,7 @@ bool CheckNoHole(const TriangleMeshTopology& mesh, std::string& error)
 // Signed doubled area of (a, b, c); points: x, y per vertex.
 double Orientation(const std::vector<double>& points, Index a, Index b, Index c)
 {
-  return (points[2 * b] - points[2 * a]) * (points[2 * c + 1] - points[2 * a + 1]) -
-    (points[2 * b + 1] - points[2 * a + 1]) * (points[2 * c] - points[2 * a]);
+  return Orientation2D(&points[2 * a], &points[2 * b], &points[2 * c]);
 }
 
 double SquaredDistance(const std::vector<double>& points, Index a, Index b)

@@ -422,12 +422,12 @@ def judge(r, totals):
 def unmatched_points(found, nodes, junctions, neighbours):
     """Per index: node vertices with no found critical point of that index on them or one edge
     away (missing), and found ones with no such node (extra)."""
-    found_at = [set(v for v, i, m in found if i == index) for index in range(3)]
     missing, extra = {}, {}
     for index in range(3):
-        wanted = set(nodes[index] + (junctions if index < 2 else []))
-        missing[index] = sorted(v for v in wanted if not ({v} | neighbours[v]) & found_at[index])
-        extra[index] = sorted(v for v in found_at[index] if not ({v} | neighbours[v]) & wanted)
+        wanted = nodes[index] + (junctions if index < 2 else [])
+        found_here = [v for v, i, m in found if i == index]
+        missing[index] = sorted(set(graph_distance_ok(wanted, found_here, neighbours, 1)))
+        extra[index] = sorted(set(graph_distance_ok(found_here, wanted, neighbours, 1)))
     return missing, extra
 
 
