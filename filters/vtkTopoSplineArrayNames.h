@@ -105,6 +105,7 @@ constexpr const char* PersistenceCurveCriticalPoints = "PersistenceCurveCritical
 // Field data of "Smooth 1-Cells".
 constexpr const char* CurveSegments = "CurveSegments";
 constexpr const char* NumberOfPieces = "NumberOfPieces";
+constexpr const char* ShortPieces = "ShortPieces";
 constexpr const char* AdaptedPieces = "AdaptedPieces";
 constexpr const char* PolylinePieces = "PolylinePieces";
 constexpr const char* RemainingCrossings = "RemainingCrossings";

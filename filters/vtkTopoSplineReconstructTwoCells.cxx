@@ -328,6 +328,13 @@ void WriteReport(const topospline::FieldReconstructionReport& report, vtkFieldDa
   AddPoints(fd, names::MissingCriticalPoints, report.Missing);
   AddFieldNumbers(fd, names::VerificationSeconds, { report.VerificationSeconds });
 }
+
+// Physical memory available now (0 if unknown).
+double AvailableBytes()
+{
+  vtksys::SystemInformation system;
+  return 1024.0 * static_cast<double>(system.GetAvailablePhysicalMemory()) * 1024.0;
+}
 } // namespace
 
 int vtkTopoSplineReconstructTwoCells::RequestData(
@@ -393,6 +400,8 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
   reconstruction.OutputResolution = this->OutputResolution;
   reconstruction.TopologicalSampling = this->TopologicalSampling != 0;
   reconstruction.VerifyTopology = this->VerifyTopology != 0;
+  // The surfaces' own check, once their grid sizes are known (FitsInMemory counts cells only).
+  reconstruction.MemoryBudget = 0.8 * AvailableBytes();
   reconstruction.Parallel = conversion::SMPParallelFor();
   reconstruction.Hooks.Progress = [this](double f) { this->UpdateProgress(f); };
   reconstruction.Hooks.AbortRequested = [this]() { return this->GetAbortExecute() != 0; };
@@ -432,8 +441,7 @@ bool vtkTopoSplineReconstructTwoCells::FitsInMemory(vtkIdType points, std::size_
   const double finer = f > 1 ? static_cast<double>(points) * f * f : 0.0;
   const double cells = static_cast<double>(twoCells);
   const double needed = topospline::FieldReconstruction::MemoryEstimate(cells, finer);
-  vtksys::SystemInformation system;
-  const double available = 1024.0 * static_cast<double>(system.GetAvailablePhysicalMemory()) * 1024.0;
+  const double available = AvailableBytes();
   if (available > 0 && needed > 0.8 * available)
   {
     vtkErrorMacro("Reconstruct 2-Cells: " << cells << " 2-cells" << (f > 1 ? " and the finer sampling" : "")

@@ -52,6 +52,7 @@ void WriteSmoothingReport(const topospline::OneCellSmoothingResult& result, int 
   using vtkTopoSplineDomainConversion::AddFieldNumbers;
   AddFieldNumbers(fd, names::CurveSegments, { static_cast<double>(curveSegments) });
   AddFieldNumbers(fd, names::NumberOfPieces, { static_cast<double>(result.Pieces.size()) });
+  AddFieldNumbers(fd, names::ShortPieces, { static_cast<double>(result.ShortPieces) });
   AddFieldNumbers(fd, names::AdaptedPieces, { static_cast<double>(result.AdaptedPieces) });
   AddFieldNumbers(fd, names::PolylinePieces, { static_cast<double>(result.PolylinePieces) });
   AddFieldNumbers(fd, names::RemainingCrossings, { static_cast<double>(result.RemainingCrossings) });

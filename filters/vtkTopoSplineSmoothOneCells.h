@@ -8,12 +8,14 @@
  * increasing along every 1-cell); every piece gets a strictly increasing uniform quadratic
  * B-spline height (L1 fit, He & Shi) and a least-squares quadratic B-spline curve in the
  * plane with the same CurveSegments knots, both converted to CurveSegments cubic Beziers.
+ * Pieces of fewer jagged edges than CurveSegments get the smallest divisor of it that gives
+ * each edge a segment (at least 2).
  * Where smoothed curves would cross, the pieces involved get more segments.
  *
  * Output: the input blocks, plus "SmoothedOneCells" (one VTK_BEZIER_CURVE cell of degree 3
  * per Bezier segment, control points in the plane of the input, point data "Height": the
  * height's Bezier ordinates) and "SampledOneCells" (every 1-cell densely sampled as a
- * polyline with "Height"). Field data: CurveSegments, AdaptedPieces, RemainingCrossings,
+ * polyline with "Height"). Field data: CurveSegments, ShortPieces, AdaptedPieces, RemainingCrossings,
  * PiecesOutsideDomain, L1Error and UnconstrainedL1Error (sums over the pieces).
  */
 #pragma once

@@ -19,9 +19,11 @@ double SecondsSince(std::chrono::steady_clock::time_point start)
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// Stage 1 on `sampling`, compared with the complex's critical points.
+// Stage 1 on `sampling`, compared with the complex's critical points (within `tolerance`, and
+// within their Hops of `mesh` when the sampling is on the input's vertices).
 SamplingTopologyCheck CheckSampling(const PlanarScalarField& sampling,
-  const std::vector<CriticalPointLocation>& expected, double tolerance, const ParallelFor& parallel)
+  const std::vector<CriticalPointLocation>& expected, double tolerance, const ParallelFor& parallel,
+  const TriangleMeshTopology* mesh = nullptr)
 {
   SamplingTopologyCheck check;
   MorseSmaleComplexExtraction extraction;
@@ -32,7 +34,7 @@ SamplingTopologyCheck CheckSampling(const PlanarScalarField& sampling,
   {
     return check;
   }
-  check.Comparison = CompareCriticalPoints(expected, CriticalPointLocations(found, sampling.Points), tolerance);
+  check.Comparison = CompareCriticalPoints(expected, CriticalPointLocations(found, sampling.Points), tolerance, mesh);
   check.Ran = true;
   return check;
 }
@@ -277,6 +279,7 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
   this->Cells.MinimumMeshEdgeLength = 2 * edge;
   this->Cells.NegligibleArea = edge * edge;
   this->Cells.Interior = this->Interior;
+  this->Cells.MemoryBudget = this->MemoryBudget;
   if (!field.Values.empty())
   {
     const auto [lowest, highest] = std::minmax_element(field.Values.begin(), field.Values.end());
@@ -317,7 +320,7 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
   this->Hooks.Report(0.85);
   if (this->VerifyTopology)
   {
-    this->Verify(field, complex, smoothed, report);
+    this->Verify(field, mesh, complex, smoothed, report);
   }
   this->Hooks.Report(1.0);
   return true;
@@ -492,8 +495,8 @@ void CountByDistanceToOneCells(const std::vector<CriticalPointLocation>& points,
 // The verdict covers the whole reconstruction: a failed 2-cell or a vertex outside every
 // reconstructed cell keeps input values, which no critical-point count can vouch for. The raw
 // F o Phi before topological sampling is only reported.
-void FieldReconstruction::Verify(const PlanarScalarField& field, const MorseSmaleComplex& complex,
-  const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const
+void FieldReconstruction::Verify(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const
 {
   const auto start = std::chrono::steady_clock::now();
   report.VerificationRan = true;
@@ -513,14 +516,15 @@ void FieldReconstruction::Verify(const PlanarScalarField& field, const MorseSmal
   };
   if (report.Sampled)
   {
-    report.RawInput = CheckSampling(WithValues(field, report.Exact), report.Expected, tolerance, this->Parallel);
+    report.RawInput =
+      CheckSampling(WithValues(field, report.Exact), report.Expected, tolerance, this->Parallel, &mesh);
     if (report.RawInput.Ran)
     {
       CountByDistanceToOneCells(report.RawInput.Comparison.Spurious, smoothed, 2 * GridSpacing(field),
         report.RawSpuriousNearOneCells, report.RawSpuriousFarFromOneCells);
     }
   }
-  report.Input = CheckSampling(WithValues(field, report.Values), report.Expected, tolerance, this->Parallel);
+  report.Input = CheckSampling(WithValues(field, report.Values), report.Expected, tolerance, this->Parallel, &mesh);
   judge(report.Input);
   if (this->OutputResolution > 1)
   {

@@ -89,6 +89,7 @@ public:
   double SurfaceTolerance = 0.01;
   bool TopologicalSampling = true;
   bool VerifyTopology = true;
+  double MemoryBudget = 0; // bytes for the 2-cells' surfaces (TwoCellReconstruction::MemoryBudget)
   ParallelFor Parallel = SequentialFor;
   ProgressHooks Hooks;
 
@@ -125,8 +126,8 @@ private:
   void CollectPatches(FieldReconstructionReport& report) const;
   void Resample(const PlanarScalarField& field, const TriangleMeshTopology& mesh, const MorseSmaleComplex& complex,
     const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const;
-  void Verify(const PlanarScalarField& field, const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
-    FieldReconstructionReport& report) const;
+  void Verify(const PlanarScalarField& field, const TriangleMeshTopology& mesh, const MorseSmaleComplex& complex,
+    const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const;
 
   topospline::TopologicalSampling SamplingOf(const MorseSmaleComplex& complex, const TriangleMeshTopology& mesh,
     const PlanarScalarField& field, const OneCellSmoothingResult& smoothed) const;

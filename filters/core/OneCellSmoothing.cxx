@@ -652,6 +652,30 @@ bool OneCellSmoothing::FollowPolyline(SmoothedPiece& piece, const std::vector<Sm
   return true;
 }
 
+// k for a piece: the k asked for, or on a piece of fewer edges, the smallest divisor of k that
+// gives each edge a segment (at least 2). Segments beyond the samples fit nothing, and stage 4
+// pays for them: a 2-cell's Sibson grid is at least as fine as its busiest side, and its
+// patches grow with the square of that. Noise at a low threshold leaves thousands of pieces of
+// 2-3 edges: 100^2 noise at 2 %, k 21 took over 24 GB. Divisors of k, because stage 4 needs one
+// grid count that every side's pieces reach by whole multiples (ChooseGridLayout): counts that
+// divide k keep every grid at most as fine as with k everywhere, while counts such as 13 and 19
+// on one cell need a grid of 247.
+namespace
+{
+int SegmentsOfPiece(const SmoothedPiece& piece, int asked)
+{
+  const int edges = static_cast<int>(piece.Points.size() / 2) - 1;
+  for (int d = std::max(2, edges); d < asked; ++d)
+  {
+    if (asked % d == 0)
+    {
+      return d;
+    }
+  }
+  return asked;
+}
+} // namespace
+
 // Paper, section 4, steps 2 and 3 for one piece: a strictly increasing height (and the
 // unconstrained one, for comparison) and a planar curve, both as k cubic Beziers.
 bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments,
@@ -733,11 +757,13 @@ bool OneCellSmoothing::FitAllPieces(
       {
         SmoothedPiece& piece = result.Pieces[p];
         piece.Parameters = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
-        failed[p] = !this->FitPiece(piece, result.Nodes, this->Segments, domainBounds, pieceErrors[p]);
+        failed[p] = !this->FitPiece(piece, result.Nodes, SegmentsOfPiece(piece, this->Segments), domainBounds,
+          pieceErrors[p]);
       }
     });
     for (Index p = first; p < last; ++p)
     {
+      result.ShortPieces += result.Pieces[p].Segments < this->Segments ? 1 : 0;
       if (failed[p])
       {
         error = "1-cell piece " + std::to_string(p) + ": " + pieceErrors[p];

@@ -53,6 +53,7 @@ struct OneCellSmoothingResult
   std::vector<SmoothingNode> Nodes;
   std::vector<SmoothedPiece> Pieces;
   std::vector<std::vector<Index>> PiecesOfOneCell; // per 1-cell, its pieces in order
+  int ShortPieces = 0;         // pieces of fewer edges than k, fitted with fewer segments (a divisor of k)
   int AdaptedPieces = 0;       // pieces whose k was raised to remove crossings
   int PolylinePieces = 0;      // of them, pieces that still crossed at their largest k and follow
                                // their jagged 1-cell in straight segments instead
@@ -106,7 +107,7 @@ private:
   bool CutAndSolveJunctionValues(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
     const std::vector<Index>& junctionNode, const double domainBounds[4], OneCellSmoothingResult& result,
     std::string& error) const;
-  // Steps 2 and 3 on every piece with k = Segments.
+  // Steps 2 and 3 on every piece with k = Segments (fewer on pieces of fewer edges).
   bool FitAllPieces(OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const;
   // Raises k on crossing pieces and fits them again (sets AdaptedPieces, RemainingCrossings).
   bool RepairCrossings(OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const;

@@ -20,6 +20,7 @@ std::vector<CriticalPointLocation> CriticalPointLocations(
     location.Position[0] = points[2 * static_cast<std::size_t>(cp.Vertex)];
     location.Position[1] = points[2 * static_cast<std::size_t>(cp.Vertex) + 1];
     location.Value = cp.Value;
+    location.Vertex = cp.Vertex;
     result.push_back(location);
   }
   // A boundary junction: the boundary 1-cells fall into it and on into the domain, so it is a
@@ -35,6 +36,8 @@ std::vector<CriticalPointLocation> CriticalPointLocations(
       location.Position[1] = points[2 * static_cast<std::size_t>(v) + 1];
       location.Value = std::nan("");
       location.Reach = BoundaryJunctionReach;
+      location.Vertex = v;
+      location.Hops = BoundaryJunctionHops;
       result.push_back(location);
     }
   }
@@ -114,10 +117,37 @@ std::vector<std::size_t> MatchAsManyAsPossible(
   }
   return partnerOfExpected;
 }
+
+// The vertices within `hops` edges of v (v included), sorted.
+std::vector<Index> VerticesWithin(const TriangleMeshTopology& mesh, Index v, int hops)
+{
+  std::vector<Index> reached{ v }, frontier{ v };
+  for (int h = 0; h < hops; ++h)
+  {
+    std::vector<Index> next;
+    for (Index u : frontier)
+    {
+      for (Index i = mesh.VertexTriangleBegin(u); i < mesh.VertexTriangleEnd(u); ++i)
+      {
+        for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
+        {
+          if (std::find(reached.begin(), reached.end(), w) == reached.end())
+          {
+            reached.push_back(w);
+            next.push_back(w);
+          }
+        }
+      }
+    }
+    frontier = std::move(next);
+  }
+  std::sort(reached.begin(), reached.end());
+  return reached;
+}
 } // namespace
 
 std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLocation>& expected,
-  const std::vector<CriticalPointLocation>& found, double tolerance)
+  const std::vector<CriticalPointLocation>& found, double tolerance, const TriangleMeshTopology* mesh)
 {
   // Candidate pairs within the tolerance, closest first. The found points are bucketed in
   // squares of the largest reach, so each expected point looks at its 3 x 3 neighbourhood
@@ -137,8 +167,13 @@ std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLoca
     buckets[bucketOf(found[f].Position[0], found[f].Position[1])].push_back(f);
   }
   std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
+  const auto onMesh = [mesh](const CriticalPointLocation& cp) {
+    return mesh != nullptr && cp.Vertex != InvalidIndex && cp.Vertex < mesh->NumberOfVertices();
+  };
   for (std::size_t e = 0; e < expected.size(); ++e)
   {
+    const std::vector<Index> near =
+      onMesh(expected[e]) ? VerticesWithin(*mesh, expected[e].Vertex, expected[e].Hops) : std::vector<Index>();
     const auto home = bucketOf(expected[e].Position[0], expected[e].Position[1]);
     for (long long i = home.first - 1; i <= home.first + 1; ++i)
     {
@@ -157,7 +192,8 @@ std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLoca
           }
           const double d = std::hypot(expected[e].Position[0] - found[f].Position[0],
             expected[e].Position[1] - found[f].Position[1]);
-          if (d <= tolerance * expected[e].Reach)
+          if (d <= tolerance * expected[e].Reach &&
+            (near.empty() || !onMesh(found[f]) || std::binary_search(near.begin(), near.end(), found[f].Vertex)))
           {
             pairs.emplace_back(d, e, f);
           }
@@ -170,7 +206,7 @@ std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLoca
 }
 
 TopologyComparison CompareCriticalPoints(const std::vector<CriticalPointLocation>& expected,
-  const std::vector<CriticalPointLocation>& found, double tolerance)
+  const std::vector<CriticalPointLocation>& found, double tolerance, const TriangleMeshTopology* mesh)
 {
   TopologyComparison comparison;
   for (const auto& cp : expected)
@@ -181,7 +217,7 @@ TopologyComparison CompareCriticalPoints(const std::vector<CriticalPointLocation
   {
     ++comparison.Found[std::clamp(cp.MorseIndex, 0, 2)];
   }
-  const std::vector<std::size_t> partner = MatchCriticalPoints(expected, found, tolerance);
+  const std::vector<std::size_t> partner = MatchCriticalPoints(expected, found, tolerance, mesh);
   std::vector<char> usedFound(found.size(), 0);
   for (std::size_t e = 0; e < expected.size(); ++e)
   {

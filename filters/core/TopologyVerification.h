@@ -5,6 +5,7 @@
 
 #include "CoreTypes.h"
 #include "MorseSmaleComplexExtraction.h"
+#include "TriangleMeshTopology.h"
 
 #include <array>
 #include <vector>
@@ -21,10 +22,19 @@ struct CriticalPointLocation
   // junction turn into the domain (no critical point of the field itself: its place along
   // the boundary is wherever the sampled valley meets it).
   double Reach = 1;
+  // The vertex it is on (InvalidIndex: none), and how many mesh edges away from it it may be
+  // found when the comparison is given the mesh (below).
+  Index Vertex = InvalidIndex;
+  int Hops = 2;
 };
 
 // How far (in tolerances) from a boundary junction its stage-1 pair may lie along the boundary.
 constexpr double BoundaryJunctionReach = 3;
+// "On or next to its node", in edges: 2 takes in the 8 vertices around a grid vertex (the one
+// in the diagonal the triangles do not cut is 2 edges away), as one grid diagonal of tolerance
+// does; the pair of a boundary junction, 3. On an irregular mesh the longest edge (the
+// tolerance) can span 3 or more typical edges: with the mesh, both limits hold.
+constexpr int BoundaryJunctionHops = 3;
 
 // The critical points of `complex`, placed at their vertices of `points` (x, y per vertex),
 // and a minimum and a saddle at each of its boundary junctions (MorseSmaleComplex).
@@ -46,10 +56,12 @@ struct TopologyComparison
 // first, then augmenting paths: a row of saddles found each one vertex along from its node is
 // matched whole). Returns the found point of each expected one (UnmatchedCriticalPoint: none).
 constexpr std::size_t UnmatchedCriticalPoint = static_cast<std::size_t>(-1);
+// With `mesh` (whose vertices both sets' Vertex name), a pair also needs the found vertex
+// within the expected point's Hops edges.
 std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLocation>& expected,
-  const std::vector<CriticalPointLocation>& found, double tolerance);
+  const std::vector<CriticalPointLocation>& found, double tolerance, const TriangleMeshTopology* mesh = nullptr);
 
 // The comparison of MatchCriticalPoints: counts, the points left over on either side.
 TopologyComparison CompareCriticalPoints(const std::vector<CriticalPointLocation>& expected,
-  const std::vector<CriticalPointLocation>& found, double tolerance);
+  const std::vector<CriticalPointLocation>& found, double tolerance, const TriangleMeshTopology* mesh = nullptr);
 } // namespace topospline

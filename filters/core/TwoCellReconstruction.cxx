@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <sstream>
 
 namespace topospline
 {
@@ -597,6 +598,10 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
   }
   this->Summary.ParameterizationSeconds = Seconds(start);
   this->Hooks.Report(0.7);
+  if (!this->SurfacesFitInMemory(boundaries, data != nullptr, error))
+  {
+    return false;
+  }
 
   // Pass 2 (the paper's "time III"): subdivision to a common count and the Sibson surface,
   // fitted to the cell's input samples when asked.
@@ -797,6 +802,41 @@ bool TwoCellReconstruction::FitSurface(ReconstructedTwoCell& cell, const Monoton
     refined = true;
   }
   return refined;
+}
+
+bool TwoCellReconstruction::SurfacesFitInMemory(
+  const std::vector<MonotoneSurfaceBoundary>& boundaries, bool fit, std::string& error) const
+{
+  if (this->MemoryBudget <= 0)
+  {
+    return true;
+  }
+  double triangles = 0;
+  std::size_t finest = 0;
+  for (std::size_t c = 0; c < boundaries.size(); ++c)
+  {
+    double n = static_cast<double>(boundaries[c].Bottom.size());
+    finest = std::max(finest, boundaries[c].Bottom.size());
+    if (fit && this->Interior == TwoCellInterior::Fitted && this->SurfaceTolerance > 0 &&
+      2 * n <= this->MaximumRefinedGridSize)
+    {
+      n = this->MaximumRefinedGridSize; // refinement may double the grid up to this
+    }
+    triangles += 4 * n * n;
+  }
+  const double needed = triangles * BytesPerBezierTriangle;
+  if (needed <= this->MemoryBudget)
+  {
+    return true;
+  }
+  std::ostringstream message;
+  message.precision(3);
+  message << "the 2-cells' surfaces need about " << needed / 1e9 << " GB (" << triangles / 1e6
+          << " million Bezier triangles, grids up to " << finest << " x " << finest << "), more than the "
+          << this->MemoryBudget / 1e9 << " GB available to them; choose fewer Curve Segments or a "
+          << "higher Persistence Threshold";
+  error = message.str();
+  return false;
 }
 
 // The monotone Sibson surface on the square from the cell's subdivided sides.

@@ -38,6 +38,33 @@ TEST_CASE(TopologyComparisonMatchesClosestFirst)
   CHECK(CompareCriticalPoints(expected, expected, 0).Identical());
 }
 
+// "Next to its node" is counted in edges when the comparison has the mesh: the Euclidean
+// tolerance alone (the longest edge, on an irregular mesh) can reach 3 or more edges.
+TEST_CASE(TopologyComparisonOnAMeshCountsEdges)
+{
+  TriangleMeshTopology mesh;
+  mesh.BuildGrid(5, 5, SequentialFor); // triangles cut by the (i + 1, j)-(i, j + 1) diagonals
+  auto at = [](int i, int j) {
+    CriticalPointLocation cp;
+    cp.MorseIndex = 1;
+    cp.Position[0] = i;
+    cp.Position[1] = j;
+    cp.Vertex = i + 5 * j;
+    return cp;
+  };
+  const std::vector<CriticalPointLocation> node{ at(0, 0) };
+  // (1, 1) is 2 edges from (0, 0); (2, 1) is 3 (no vertex neighbours both), 2.24 away.
+  CHECK(CompareCriticalPoints(node, { at(1, 1) }, 3.0, &mesh).Identical());
+  CHECK(CompareCriticalPoints(node, { at(2, 1) }, 3.0).Identical());
+  const auto far = CompareCriticalPoints(node, { at(2, 1) }, 3.0, &mesh);
+  CHECK(far.Missing.size() == 1 && far.Spurious.size() == 1);
+  // A boundary junction's pair may be 3 edges away, as far as its reach allows.
+  std::vector<CriticalPointLocation> junction{ at(0, 0) };
+  junction[0].Hops = BoundaryJunctionHops;
+  CHECK(CompareCriticalPoints(junction, { at(2, 1) }, 3.0, &mesh).Identical());
+  CHECK(!CompareCriticalPoints(junction, { at(2, 2) }, 3.0, &mesh).Identical()); // 4 edges, 2.83 away
+}
+
 // Closest pairs first would take A-X here and leave B alone, although A-Y and B-X are both
 // within the tolerance: the comparison must find the one-to-one assignment.
 TEST_CASE(TopologyComparisonFindsAOneToOneAssignment)

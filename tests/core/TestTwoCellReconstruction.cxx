@@ -460,6 +460,32 @@ TEST_CASE(PlanarBezierTrianglesEvaluateToTheSurface)
   CHECK(worst < 1e-9);
 }
 
+// The surfaces' memory is checked once the grid sizes are known: over the budget, nothing is
+// built and the error gives the estimate; within it, the same reconstruction as without one.
+TEST_CASE(SurfacesOverTheMemoryBudgetAreRefusedWithTheEstimate)
+{
+  Pipeline p;
+  std::string error;
+  CHECK(RunStages1To3(ShepardField(50, 2.0, 120, 1), 5, 7, p, error));
+  TwoCellReconstruction unlimited;
+  CHECK(unlimited.Reconstruct(p.Simplified.Complex, p.Smoothed, error));
+  const double needed = unlimited.Report().BezierTriangles * TwoCellReconstruction::BytesPerBezierTriangle;
+  CHECK(needed > 0);
+
+  TwoCellReconstruction tight;
+  tight.MemoryBudget = 0.5 * needed;
+  error.clear();
+  CHECK(!tight.Reconstruct(p.Simplified.Complex, p.Smoothed, error));
+  CHECK(error.find(" GB (") != std::string::npos && error.find("Curve Segments") != std::string::npos);
+  std::printf("  budget %.3g GB: %s\n", tight.MemoryBudget / 1e9, error.c_str());
+
+  TwoCellReconstruction enough;
+  enough.MemoryBudget = 1.01 * needed;
+  error.clear();
+  CHECK(enough.Reconstruct(p.Simplified.Complex, p.Smoothed, error));
+  CHECK_EQ(enough.Report().BezierTriangles, unlimited.Report().BezierTriangles);
+}
+
 int main()
 {
   return testing_harness::RunAll();
