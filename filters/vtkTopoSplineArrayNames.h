@@ -128,6 +128,7 @@ constexpr const char* LinearizedDiagonals = "LinearizedDiagonals";
 constexpr const char* BezierTriangles = "BezierTriangles";
 constexpr const char* MeshTriangles = "MeshTriangles";
 constexpr const char* CrowdedTriangles = "CrowdedTriangles";
+constexpr const char* PinchedTwoCells = "PinchedTwoCells";
 constexpr const char* MaximumGridSize = "MaximumGridSize";
 constexpr const char* FittedCells = "FittedCells";
 constexpr const char* RefinedCells = "RefinedCells";

@@ -24,6 +24,18 @@ inline double Orientation2D(const double* o, const double* a, const double* b)
   return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
 }
 
+// Twice the signed area of a closed walk (x, y per point): positive when counter-clockwise.
+inline double DoubleSignedArea(const std::vector<double>& walk)
+{
+  double area = 0;
+  for (std::size_t i = 0, count = walk.size() / 2; i < count; ++i)
+  {
+    const std::size_t j = (i + 1) % count;
+    area += walk[2 * i] * walk[2 * j + 1] - walk[2 * j] * walk[2 * i + 1];
+  }
+  return area;
+}
+
 // Whether segments ab and cd cross at a point inside both: each separates the other's ends
 // strictly (touching ends and collinear overlaps are not crossings).
 inline bool SegmentsCrossProperly(const double* a, const double* b, const double* c, const double* d)

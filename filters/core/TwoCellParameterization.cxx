@@ -132,6 +132,7 @@ struct BoundaryGraph
   std::vector<Index> PointOf;      // sample -> distinct point
   std::size_t PointCount = 0;
   std::vector<Index> Loop;         // one sample per outer loop point, in walk order
+  std::vector<Index> Pinched;      // loop samples on a point the loop visits twice (FindOuterLoop)
   // Distinct undirected edges as point pairs: the Loop.size() loop edges, then the slit edges.
   std::vector<std::pair<Index, Index>> Edges;
 };
@@ -211,18 +212,100 @@ bool FindOuterLoop(std::size_t n, BoundaryGraph& graph, std::string& error)
     error = "TwoCellParameterization: the boundary encloses no area (it only runs out and back along slits)";
     return false;
   }
-  std::vector<char> onLoop(graph.PointCount, 0);
+  std::vector<int> visits(graph.PointCount, 0);
   for (const Index s : graph.Loop)
   {
-    if (onLoop[point[s]])
+    ++visits[point[s]];
+  }
+  graph.Pinched.clear();
+  for (const Index s : graph.Loop)
+  {
+    if (visits[point[s]] > 1)
     {
-      std::ostringstream message;
-      message << "TwoCellParameterization: the boundary touches itself at sample " << s
-              << " (a repeated point that is not on a slit retraced straight back)";
-      error = message.str();
+      graph.Pinched.push_back(s);
+    }
+  }
+  if (!graph.Pinched.empty())
+  {
+    std::ostringstream message;
+    message << "TwoCellParameterization: the boundary touches itself at sample " << graph.Pinched.front()
+            << " (a repeated point that is not on a slit retraced straight back)";
+    error = message.str();
+    return false;
+  }
+  return true;
+}
+
+// A pinched cell: its outer loop passes one point twice. Uniform noise makes two kinds: two
+// lobes touching there (a cell in two opposite sectors of one saddle), and a lens of two
+// 1-cells between the same nodes that the cell wraps around, touching it at one end (a hole
+// reached along a stem of no length; a stem of some length is the same, pinched at both of its
+// ends). Either way the cell is still a disk, but its boundary is no simple polygon. Each visit
+// is moved off the point by 1e-3 of its shorter edge, along the bisector of one of its two
+// corners: the inner one (on the cell's side of the walk) if the other visit's edges lie
+// outside it (the lens: a slot of that width then joins it to the outside), else the outer one
+// (touching lobes: a neck of that width then joins them). The loop becomes simple, each visit
+// keeps its (u, v), and the geometry moves by a thousandth of a sample spacing at one point
+// (vertices there are snapped onto the nearest cell, as along every smoothed boundary). Only
+// points visited exactly twice, whose visits do not cross (one visit's edges on both sides of
+// the other's corner: a bow tie): false otherwise, and nothing is moved. `orientation`: +1 for
+// a counter-clockwise walk.
+bool OpenPinches(const BoundaryGraph& graph, std::size_t n, int orientation, std::vector<double>& xy)
+{
+  const std::vector<double> original = xy;
+  const double pi = std::acos(-1.0);
+  auto direction = [&original](std::size_t from, std::size_t to) {
+    return std::atan2(original[2 * to + 1] - original[2 * from + 1], original[2 * to] - original[2 * from]);
+  };
+  // The angle swept from direction `from` to direction `to` on the cell's side of the walk,
+  // in (0, 2 pi]: counter-clockwise for a counter-clockwise walk.
+  auto sweep = [orientation, pi](double from, double to) {
+    double angle = std::remainder((to - from) * orientation, 2 * pi);
+    return angle <= 0 ? angle + 2 * pi : angle;
+  };
+  // Per visit: the directions to its next and previous samples.
+  auto rays = [&](std::size_t i) {
+    return std::array<double, 2>{ { direction(i, (i + 1) % n), direction(i, (i + n - 1) % n) } };
+  };
+  std::vector<std::vector<std::size_t>> visits(graph.PointCount);
+  for (const Index s : graph.Pinched)
+  {
+    visits[graph.PointOf[s]].push_back(static_cast<std::size_t>(s));
+  }
+  std::vector<std::pair<std::size_t, bool>> moves; // (sample, into its inner corner)
+  for (const auto& pair : visits)
+  {
+    if (pair.empty())
+    {
+      continue;
+    }
+    if (pair.size() != 2)
+    {
       return false;
     }
-    onLoop[point[s]] = 1;
+    for (int k = 0; k < 2; ++k)
+    {
+      const auto own = rays(pair[k]), other = rays(pair[1 - k]);
+      const double corner = sweep(own[0], own[1]);
+      const int inside = (sweep(own[0], other[0]) < corner ? 1 : 0) + (sweep(own[0], other[1]) < corner ? 1 : 0);
+      if (inside == 1)
+      {
+        return false; // the visits cross
+      }
+      moves.emplace_back(pair[k], inside == 0);
+    }
+  }
+  for (const auto& [i, inward] : moves)
+  {
+    const auto own = rays(i);
+    const double bisector = own[0] + orientation * 0.5 * sweep(own[0], own[1]) + (inward ? 0 : pi);
+    const double* x = &original[2 * i];
+    const double* p = &original[2 * ((i + n - 1) % n)];
+    const double* q = &original[2 * ((i + 1) % n)];
+    // edges have length (IdentifyEqualPoints)
+    const double step = 1e-3 * std::min(std::hypot(q[0] - x[0], q[1] - x[1]), std::hypot(p[0] - x[0], p[1] - x[1]));
+    xy[2 * i] = x[0] + step * std::cos(bisector);
+    xy[2 * i + 1] = x[1] + step * std::sin(bisector);
   }
   return true;
 }
@@ -434,6 +517,95 @@ struct CellBoundary
   int PolygonOrientation = 1; // +1 if the outer loop is counter-clockwise in (x, y)
   double Area = 0;            // enclosed by the outer loop
 };
+
+// Two sides of a cell that run along one stretch of straight boundary, each sampled its own
+// way: uniform noise makes them where two 1-cells share part of their V-path and both follow
+// it as straight segments (OneCellSmoothing::FollowPolyline), and the cell between them has no
+// width there. Their samples interleave on one line, so the walk is neither a slit nor a
+// simple polygon. Every sample lying inside another walk edge (within 1e-9 of its length) is
+// copied into that edge, bit for bit, with the (u, v) interpolated along it: both sides then
+// carry the same samples and the stretch is an ordinary slit. Edges whose (u, v) do not lie on
+// one side of the square are left alone. Returns false if nothing was changed.
+bool SampleOverlapsAlike(const CellBoundary& cell, std::vector<double>& points, std::vector<double>& parameters)
+{
+  const std::size_t n = cell.Count;
+  const double* uv = cell.UV;
+  // The two samplings' common points agree up to rounding: first made equal (the earlier
+  // sample's coordinates win), or each would land next to the other one.
+  std::vector<double> welded(cell.XY, cell.XY + 2 * n);
+  const double* xy = welded.data();
+  bool weldedAny = false;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const std::size_t h = (i + n - 1) % n, j = (i + 1) % n;
+    const double edge = std::min(std::hypot(xy[2 * j] - xy[2 * i], xy[2 * j + 1] - xy[2 * i + 1]),
+      std::hypot(xy[2 * h] - xy[2 * i], xy[2 * h + 1] - xy[2 * i + 1]));
+    for (std::size_t k = i + 1; k < n; ++k)
+    {
+      const double d = std::hypot(xy[2 * k] - xy[2 * i], xy[2 * k + 1] - xy[2 * i + 1]);
+      if (d > 0 && d <= 1e-9 * edge)
+      {
+        welded[2 * k] = xy[2 * i];
+        welded[2 * k + 1] = xy[2 * i + 1];
+        weldedAny = true;
+      }
+    }
+  }
+  // (edge, fraction along it, sample copied)
+  std::vector<std::tuple<std::size_t, double, std::size_t>> inserts;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const std::size_t j = (i + 1) % n;
+    const bool onOneSide = (uv[2 * i] == uv[2 * j] && (uv[2 * i] == 0 || uv[2 * i] == 1)) ||
+      (uv[2 * i + 1] == uv[2 * j + 1] && (uv[2 * i + 1] == 0 || uv[2 * i + 1] == 1));
+    const double length2 = (xy[2 * j] - xy[2 * i]) * (xy[2 * j] - xy[2 * i]) +
+      (xy[2 * j + 1] - xy[2 * i + 1]) * (xy[2 * j + 1] - xy[2 * i + 1]);
+    if (!onOneSide || length2 == 0)
+    {
+      continue;
+    }
+    for (std::size_t k = 0; k < n; ++k)
+    {
+      const double* p = &xy[2 * k];
+      if ((p[0] == xy[2 * i] && p[1] == xy[2 * i + 1]) || (p[0] == xy[2 * j] && p[1] == xy[2 * j + 1]))
+      {
+        continue;
+      }
+      double fraction;
+      if (SegmentDistance2(&xy[2 * i], &xy[2 * j], p[0], p[1], fraction) <= 1e-18 * length2 && fraction > 0 &&
+        fraction < 1)
+      {
+        inserts.emplace_back(i, fraction, k);
+      }
+    }
+  }
+  if (inserts.empty() && !weldedAny)
+  {
+    return false;
+  }
+  std::sort(inserts.begin(), inserts.end());
+  points.clear();
+  parameters.clear();
+  std::size_t next = 0;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const std::size_t j = (i + 1) % n;
+    points.insert(points.end(), { xy[2 * i], xy[2 * i + 1] });
+    parameters.insert(parameters.end(), { uv[2 * i], uv[2 * i + 1] });
+    for (; next < inserts.size() && std::get<0>(inserts[next]) == i; ++next)
+    {
+      const auto [edge, f, k] = inserts[next];
+      const double x = xy[2 * k], y = xy[2 * k + 1];
+      if (x == points[points.size() - 2] && y == points.back())
+      {
+        continue; // the same point from another sample (the visits of a slit)
+      }
+      points.insert(points.end(), { x, y });
+      parameters.insert(parameters.end(), { (1 - f) * uv[2 * i] + f * uv[2 * j], (1 - f) * uv[2 * i + 1] + f * uv[2 * j + 1] });
+    }
+  }
+  return true;
+}
 
 // Pairs of equal count, finite, at least one sample per corner of the square.
 bool ReadBoundarySamples(const std::vector<double>& boundaryPoints, const std::vector<double>& boundaryParameters,
@@ -964,8 +1136,54 @@ bool TwoCellParameterization::Parameterize(
   // then the mesh of the cell (paper, section 5.1).
   CellBoundary cell;
   TwoCellMesh& mesh = this->Mesh;
+  this->OpenedPinches = 0;
+  this->ResampledOverlaps = false;
+  // Walks that are not an outer loop with slits as given: the sides resampled alike where they
+  // overlap (SampleOverlapsAlike), then pinch points opened (OpenPinches). The first error
+  // stands if neither helps.
+  std::vector<double> alikePoints, alikeParameters, opened;
+  auto analyze = [&]() {
+    if (AnalyzeBoundary(cell.XY, cell.Count, cell.Graph, error))
+    {
+      return true;
+    }
+    std::string ignored;
+    if (SampleOverlapsAlike(cell, alikePoints, alikeParameters))
+    {
+      CellBoundary alike;
+      if (!ReadBoundarySamples(alikePoints, alikeParameters, alike, ignored) || !CheckBorderParameters(alike, ignored))
+      {
+        return false;
+      }
+      cell = alike;
+      this->ResampledOverlaps = true;
+      if (AnalyzeBoundary(cell.XY, cell.Count, cell.Graph, ignored))
+      {
+        error.clear();
+        return true;
+      }
+    }
+    if (cell.Graph.Pinched.empty())
+    {
+      return false;
+    }
+    opened.assign(cell.XY, cell.XY + 2 * cell.Count);
+    const int pinched = static_cast<int>(cell.Graph.Pinched.size());
+    if (!OpenPinches(cell.Graph, cell.Count, DoubleSignedArea(opened) >= 0 ? 1 : -1, opened))
+    {
+      return false;
+    }
+    cell.XY = opened.data();
+    if (!AnalyzeBoundary(cell.XY, cell.Count, cell.Graph, ignored))
+    {
+      return false;
+    }
+    this->OpenedPinches = pinched;
+    error.clear();
+    return true;
+  };
   if (!ReadBoundarySamples(boundaryPoints, boundaryParameters, cell, error) || !CheckBorderParameters(cell, error) ||
-    !AnalyzeBoundary(cell.XY, cell.Count, cell.Graph, error) || !CheckOuterLoop(cell, error) ||
+    !analyze() || !CheckOuterLoop(cell, error) ||
     !TriangulateCell(cell, InteriorEdgeLength(cell, this->TargetEdgeLength, this->MaximumVertices), this->ShapeBound,
       this->MaximumFixRounds, mesh, error))
   {

@@ -84,8 +84,15 @@ public:
   // degenerate input (n < 4, non-finite values, a zero-length edge, a self-crossing or
   // self-touching boundary that is not of this form, zero area, (u, v) off the border or not
   // monotone) or if the map could not be made one-to-one.
+  // A walk of another form is repaired where it can be: sides that overlap along a straight
+  // stretch, each sampled its own way, get each other's samples (a slit then); a loop that
+  // touches itself at a point (a pinched cell) is opened there by 1e-3 of an edge.
   bool Parameterize(const std::vector<double>& boundaryPoints, const std::vector<double>& boundaryParameters,
     std::string& error);
+  // Visits of pinch points the last Parameterize moved apart (0: none).
+  int OpenedPinches = 0;
+  // Whether it copied samples between overlapping straight sides (a slit sampled two ways).
+  bool ResampledOverlaps = false;
 
   // The result of the last successful Parameterize (empty otherwise).
   const TwoCellMesh& GetMesh() const { return this->Mesh; }

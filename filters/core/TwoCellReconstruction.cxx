@@ -481,18 +481,6 @@ std::array<SideSegments, 4> TwoCellSideSegments(
 
 namespace
 {
-// Twice the signed area of a closed walk (x, y per point).
-double DoubleSignedArea(const std::vector<double>& walk)
-{
-  double area = 0;
-  for (std::size_t i = 0, count = walk.size() / 2; i < count; ++i)
-  {
-    const std::size_t j = (i + 1) % count;
-    area += walk[2 * i] * walk[2 * j + 1] - walk[2 * j] * walk[2 * i + 1];
-  }
-  return area;
-}
-
 // The mean distance between consecutive points of a closed walk.
 double MeanSampleSpacing(const std::vector<double>& walk)
 {
@@ -879,6 +867,7 @@ void TwoCellReconstruction::Summarize()
       continue;
     }
     s.SlitCells += cell->Sides.Slit ? 1 : 0;
+    s.PinchedCells += cell->Parameterization.OpenedPinches > 0 ? 1 : 0;
     s.ShiftedCorners += (cell->Sides.MinimumShifted ? 1 : 0) + (cell->Sides.MaximumShifted ? 1 : 0);
     const MonotoneSurfaceReport& r = cell->Surface.Report();
     s.ViolatingPatches += r.ViolatingCells;

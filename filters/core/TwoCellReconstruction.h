@@ -106,6 +106,7 @@ struct TwoCellReconstructionReport
   Index FailedCells = 0;       // not reconstructed (see ReconstructedTwoCell::Error)
   Index NegligibleCells = 0;   // skipped for having no area
   Index SlitCells = 0;         // pouch cells parameterized with a slit
+  Index PinchedCells = 0;      // cells whose boundary touches itself, opened there (TwoCellParameterization)
   Index ShiftedCorners = 0;    // corners taken by junction points
   Index ViolatingPatches = 0;  // Sibson grid cells failing the monotonicity conditions (0 is the goal)
   Index LinearizedDiagonals = 0; // the paper's fallback for non-increasing Laplace values
