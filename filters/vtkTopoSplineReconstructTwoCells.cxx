@@ -34,6 +34,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <functional>
 #include <sstream>
 
@@ -330,11 +331,21 @@ void WriteReport(const topospline::FieldReconstructionReport& report, vtkFieldDa
   AddFieldNumbers(fd, names::VerificationSeconds, { report.VerificationSeconds });
 }
 
-// Physical memory available now (0 if unknown).
+// Physical memory available now (0 if unknown), or less if the environment variable
+// TOPOSPLINE_MEMORY_LIMIT (bytes) says so: a share of a machine that others use too.
+// SystemInformation reports 0 until its memory check has run: without it every memory check
+// here passed.
 double AvailableBytes()
 {
   vtksys::SystemInformation system;
-  return 1024.0 * static_cast<double>(system.GetAvailablePhysicalMemory()) * 1024.0;
+  system.RunMemoryCheck();
+  double available = 1024.0 * static_cast<double>(system.GetAvailablePhysicalMemory()) * 1024.0;
+  if (const char* limit = std::getenv("TOPOSPLINE_MEMORY_LIMIT"))
+  {
+    const double bytes = std::atof(limit);
+    available = bytes > 0 && (available <= 0 || bytes < available) ? bytes : available;
+  }
+  return available;
 }
 } // namespace
 
@@ -401,8 +412,9 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
   reconstruction.OutputResolution = this->OutputResolution;
   reconstruction.TopologicalSampling = this->TopologicalSampling != 0;
   reconstruction.VerifyTopology = this->VerifyTopology != 0;
-  // The surfaces' own check, once their grid sizes are known (FitsInMemory counts cells only).
-  reconstruction.MemoryBudget = 0.8 * AvailableBytes();
+  // The surfaces' own check, once their grid sizes are known (FitsInMemory counts cells only);
+  // half of what is available: the sampling, verification and outputs come on top.
+  reconstruction.MemoryBudget = 0.5 * AvailableBytes();
   reconstruction.Parallel = conversion::SMPParallelFor();
   reconstruction.Hooks.Progress = [this](double f) { this->UpdateProgress(f); };
   reconstruction.Hooks.AbortRequested = [this]() { return this->GetAbortExecute() != 0; };
@@ -462,6 +474,13 @@ void vtkTopoSplineReconstructTwoCells::WarnAbout(const topospline::FieldReconstr
   for (const auto& [cell, why] : report.FailedCells)
   {
     vtkWarningMacro("Reconstruct 2-Cells: 2-cell " << cell << " was not reconstructed: " << why << ".");
+  }
+  if (report.PatchesOmitted)
+  {
+    vtkWarningMacro("Reconstruct 2-Cells: the Bezier Patches output is left empty: "
+      << report.Cells.BezierTriangles << " Bezier triangles are more than "
+      << static_cast<long long>(topospline::FieldReconstruction().MaximumPatchTriangles)
+      << " (fewer Curve Segments or a higher Persistence Threshold give fewer).");
   }
   if (report.Cells.ViolatingPatches > 0)
   {

@@ -421,6 +421,11 @@ void FieldReconstruction::MeasureErrors(const PlanarScalarField& field, FieldRec
 
 void FieldReconstruction::CollectPatches(FieldReconstructionReport& report) const
 {
+  report.PatchesOmitted = static_cast<double>(report.Cells.BezierTriangles) > this->MaximumPatchTriangles;
+  if (report.PatchesOmitted)
+  {
+    return;
+  }
   report.Patches.resize(this->Cells.NumberOfCells());
   this->Parallel(0, this->Cells.NumberOfCells(), [&](Index begin, Index end) {
     for (Index c = begin; c < end; ++c)

@@ -54,8 +54,10 @@ struct FieldReconstructionReport
   GridField Finer;
   std::vector<char> FinerValid;
 
-  // The Bezier triangles of every cell, in the plane.
+  // The Bezier triangles of every cell, in the plane; none when there are more than
+  // FieldReconstruction::MaximumPatchTriangles (PatchesOmitted).
   std::vector<std::vector<PlanarBezierTriangle>> Patches;
+  bool PatchesOmitted = false;
 
   // Topological sampling (both samplings summed).
   bool Sampled = false;
@@ -90,6 +92,10 @@ public:
   bool TopologicalSampling = true;
   bool VerifyTopology = true;
   double MemoryBudget = 0; // bytes for the 2-cells' surfaces (TwoCellReconstruction::MemoryBudget)
+  // The planar Bezier triangles (the filter's "Bezier Patches") are collected up to this many:
+  // each costs about 600 bytes more with its VTK output, three times its surface's share, and
+  // millions of them are more than anyone inspects. Beyond it the patches are left out.
+  double MaximumPatchTriangles = 4e6;
   ParallelFor Parallel = SequentialFor;
   ProgressHooks Hooks;
 

@@ -174,9 +174,10 @@ public:
   // is built: the patches grow with the square of a cell's busiest side (4 N^2 triangles),
   // which a count of cells does not see.
   double MemoryBudget = 0;
-  // Peak memory per Bezier triangle, all copies included (the surface's, the patches' and the
-  // VTK output's): 790 bytes measured on 100^2 uniform noise at 2 %, k 8 (2.2 million triangles).
-  static constexpr double BytesPerBezierTriangle = 800;
+  // Memory of a surface per Bezier triangle: 180 bytes measured on 100^2 uniform noise at 2 %,
+  // k 8 (0.74 million triangles). The planar patches and their VTK output take about 600 more
+  // (FieldReconstruction::MaximumPatchTriangles bounds them).
+  static constexpr double BytesPerBezierTriangle = 200;
   ParallelFor Parallel = SequentialFor;
   ProgressHooks Hooks;
 

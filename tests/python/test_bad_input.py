@@ -132,6 +132,12 @@ RECONSTRUCTION_CASES = {
                            "Boundary Samples must be in [1, 1000]", 0),
     "output resolution absurd": (SMOOTHED + "ms = Reconstruct2Cells(Input=sm1, OutputResolution=1000)",
                                  "Output Resolution must be in [1, 16]", 0),
+    # Memory-hungry settings are refused with the estimate (the limit set for this run only:
+    # the machine's own memory would need a huge input): by the count of 2-cells and finer
+    # points up front, and by the surfaces' grid sizes once those are known.
+    "over the memory limit up front": ("import os; os.environ['TOPOSPLINE_MEMORY_LIMIT'] = '1e6'\n" + SMOOTHED +
+                                       "ms = Reconstruct2Cells(Input=sm1, OutputResolution=16)",
+                                       "GB available", 0),
     "one step on a 3D image": ("ms = TopoSplineReconstruction(Input=Wavelet())", "the image is 3D", 0),
     "one step with NaN values": ("v = np.random.rand(100); v[3] = np.nan\n"
                                  "ms = TopoSplineReconstruction(Input=producer(image(v, (10, 10, 1))))", "non-finite", 0),
