@@ -586,10 +586,6 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
   }
   this->Summary.ParameterizationSeconds = Seconds(start);
   this->Hooks.Report(0.7);
-  if (!this->SurfacesFitInMemory(boundaries, data != nullptr, error))
-  {
-    return false;
-  }
 
   // Pass 2 (the paper's "time III"): subdivision to a common count and the Sibson surface,
   // fitted to the cell's input samples when asked.
@@ -604,6 +600,10 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
     // often not the region stage 1 put it in).
     this->BuildCellLocator();
     this->LocateSamples(*data, complex.TwoCellId, firstVertex, vertices, parameters);
+  }
+  if (!this->SurfacesFitInMemory(boundaries, firstVertex, error))
+  {
+    return false;
   }
   std::vector<char> refined(n, 0);
   this->Parallel(0, n, [&](Index begin, Index end) {
@@ -793,7 +793,7 @@ bool TwoCellReconstruction::FitSurface(ReconstructedTwoCell& cell, const Monoton
 }
 
 bool TwoCellReconstruction::SurfacesFitInMemory(
-  const std::vector<MonotoneSurfaceBoundary>& boundaries, bool fit, std::string& error) const
+  const std::vector<MonotoneSurfaceBoundary>& boundaries, const std::vector<Index>& firstVertex, std::string& error) const
 {
   if (this->MemoryBudget <= 0)
   {
@@ -803,14 +803,20 @@ bool TwoCellReconstruction::SurfacesFitInMemory(
   std::size_t finest = 0;
   for (std::size_t c = 0; c < boundaries.size(); ++c)
   {
-    double n = static_cast<double>(boundaries[c].Bottom.size());
+    const double n = static_cast<double>(boundaries[c].Bottom.size());
     finest = std::max(finest, boundaries[c].Bottom.size());
-    if (fit && this->Interior == TwoCellInterior::Fitted && this->SurfaceTolerance > 0 &&
-      2 * n <= this->MaximumRefinedGridSize)
+    // The finest grid refinement may reach (FitSurface: doubling while every grid cell keeps
+    // 4 samples, up to MaximumRefinedGridSize), for fitted cells.
+    double refined = n;
+    if (!firstVertex.empty() && this->SurfaceTolerance > 0 && n > 0 && n <= this->MaximumFittedGridSize)
     {
-      n = this->MaximumRefinedGridSize; // refinement may double the grid up to this
+      const double samples = static_cast<double>(firstVertex[c + 1] - firstVertex[c]);
+      while (2 * refined <= this->MaximumRefinedGridSize && samples >= 4 * (2 * refined) * (2 * refined))
+      {
+        refined *= 2;
+      }
     }
-    triangles += 4 * n * n;
+    triangles += 4 * refined * refined;
   }
   const double needed = triangles * BytesPerBezierTriangle;
   if (needed <= this->MemoryBudget)

@@ -214,7 +214,9 @@ private:
     MonotoneSurfaceBoundary& boundary) const;
   static void BuildSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided);
   // False, with the estimate, when the surfaces of these grids would exceed MemoryBudget.
-  bool SurfacesFitInMemory(const std::vector<MonotoneSurfaceBoundary>& boundaries, bool fit, std::string& error) const;
+  // firstVertex: the cells' input samples (LocateSamples; empty when not fitting).
+  bool SurfacesFitInMemory(const std::vector<MonotoneSurfaceBoundary>& boundaries,
+    const std::vector<Index>& firstVertex, std::string& error) const;
   // Where each input vertex lies: the cell containing it (hints: a likely cell per vertex) and
   // its (u, v) there; the vertices of cell c are vertices[firstVertex[c] .. firstVertex[c + 1]).
   void LocateSamples(const PlanarScalarField& data, const std::vector<Index>& hints, std::vector<Index>& firstVertex,
