@@ -399,7 +399,8 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
     vtkErrorMacro("Reconstruct 2-Cells: " << error << ".");
     return 1;
   }
-  if (!this->FitsInMemory(domain->GetNumberOfPoints(), complex.TwoCells.size()))
+  const double available = AvailableBytes();
+  if (!this->FitsInMemory(domain->GetNumberOfPoints(), complex.TwoCells.size(), available))
   {
     return 1;
   }
@@ -414,7 +415,7 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
   reconstruction.VerifyTopology = this->VerifyTopology != 0;
   // The surfaces' own check, once their grid sizes are known (FitsInMemory counts cells only);
   // half of what is available: the sampling, verification and outputs come on top.
-  reconstruction.MemoryBudget = 0.5 * AvailableBytes();
+  reconstruction.MemoryBudget = 0.5 * available;
   reconstruction.Parallel = conversion::SMPParallelFor();
   reconstruction.Hooks.Progress = [this](double f) { this->UpdateProgress(f); };
   reconstruction.Hooks.AbortRequested = [this]() { return this->GetAbortExecute() != 0; };
@@ -448,13 +449,12 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
 }
 
 // Refused before anything is allocated, with the estimate.
-bool vtkTopoSplineReconstructTwoCells::FitsInMemory(vtkIdType points, std::size_t twoCells)
+bool vtkTopoSplineReconstructTwoCells::FitsInMemory(vtkIdType points, std::size_t twoCells, double available)
 {
   const double f = this->OutputResolution;
   const double finer = f > 1 ? static_cast<double>(points) * f * f : 0.0;
   const double cells = static_cast<double>(twoCells);
   const double needed = topospline::FieldReconstruction::MemoryEstimate(cells, finer);
-  const double available = AvailableBytes();
   if (available > 0 && needed > 0.8 * available)
   {
     vtkErrorMacro("Reconstruct 2-Cells: " << cells << " 2-cells" << (f > 1 ? " and the finer sampling" : "")
@@ -479,7 +479,7 @@ void vtkTopoSplineReconstructTwoCells::WarnAbout(const topospline::FieldReconstr
   {
     vtkWarningMacro("Reconstruct 2-Cells: the Bezier Patches output is left empty: "
       << report.Cells.BezierTriangles << " Bezier triangles are more than "
-      << static_cast<long long>(topospline::FieldReconstruction().MaximumPatchTriangles)
+      << static_cast<long long>(topospline::FieldReconstruction::MaximumPatchTriangles)
       << " (fewer Curve Segments or a higher Persistence Threshold give fewer).");
   }
   if (report.Cells.ViolatingPatches > 0)

@@ -125,8 +125,9 @@ protected:
   bool TopologicalSampling = true;
 
 private:
-  // False, with an error naming the estimate, when the reconstruction would not fit in memory.
-  bool FitsInMemory(vtkIdType points, std::size_t twoCells);
+  // False, with an error naming the estimate, when the reconstruction would not fit in the
+  // `available` bytes.
+  bool FitsInMemory(vtkIdType points, std::size_t twoCells, double available);
   void WarnAbout(const topospline::FieldReconstructionReport& report);
 
   vtkTopoSplineReconstructTwoCells(const vtkTopoSplineReconstructTwoCells&) = delete;

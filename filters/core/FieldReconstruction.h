@@ -95,7 +95,7 @@ public:
   // The planar Bezier triangles (the filter's "Bezier Patches") are collected up to this many:
   // each costs about 600 bytes more with its VTK output, three times its surface's share, and
   // millions of them are more than anyone inspects. Beyond it the patches are left out.
-  double MaximumPatchTriangles = 4e6;
+  static constexpr double MaximumPatchTriangles = 4e6;
   ParallelFor Parallel = SequentialFor;
   ProgressHooks Hooks;
 

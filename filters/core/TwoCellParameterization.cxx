@@ -272,7 +272,7 @@ bool OpenPinches(const BoundaryGraph& graph, std::size_t n, int orientation, std
   {
     visits[graph.PointOf[s]].push_back(static_cast<std::size_t>(s));
   }
-  std::vector<std::pair<std::size_t, bool>> moves; // (sample, into its inner corner)
+  std::vector<std::pair<std::size_t, double>> moves; // (sample, direction it moves in)
   for (const auto& pair : visits)
   {
     if (pair.empty())
@@ -292,13 +292,12 @@ bool OpenPinches(const BoundaryGraph& graph, std::size_t n, int orientation, std
       {
         return false; // the visits cross
       }
-      moves.emplace_back(pair[k], inside == 0);
+      // the bisector of the inner corner, or the opposite one
+      moves.emplace_back(pair[k], own[0] + orientation * 0.5 * corner + (inside == 0 ? 0 : pi));
     }
   }
-  for (const auto& [i, inward] : moves)
+  for (const auto& [i, bisector] : moves)
   {
-    const auto own = rays(i);
-    const double bisector = own[0] + orientation * 0.5 * sweep(own[0], own[1]) + (inward ? 0 : pi);
     const double* x = &original[2 * i];
     const double* p = &original[2 * ((i + n - 1) % n)];
     const double* q = &original[2 * ((i + 1) % n)];
@@ -530,6 +529,7 @@ bool SampleOverlapsAlike(const CellBoundary& cell, std::vector<double>& points, 
 {
   const std::size_t n = cell.Count;
   const double* uv = cell.UV;
+  const std::vector<int>& sideMasks = cell.SideMasks; // CheckBorderParameters
   // The two samplings' common points agree up to rounding: first made equal (the earlier
   // sample's coordinates win), or each would land next to the other one.
   std::vector<double> welded(cell.XY, cell.XY + 2 * n);
@@ -556,8 +556,7 @@ bool SampleOverlapsAlike(const CellBoundary& cell, std::vector<double>& points, 
   for (std::size_t i = 0; i < n; ++i)
   {
     const std::size_t j = (i + 1) % n;
-    const bool onOneSide = (uv[2 * i] == uv[2 * j] && (uv[2 * i] == 0 || uv[2 * i] == 1)) ||
-      (uv[2 * i + 1] == uv[2 * j + 1] && (uv[2 * i + 1] == 0 || uv[2 * i + 1] == 1));
+    const bool onOneSide = (sideMasks[i] & sideMasks[j]) != 0;
     const double length2 = (xy[2 * j] - xy[2 * i]) * (xy[2 * j] - xy[2 * i]) +
       (xy[2 * j + 1] - xy[2 * i + 1]) * (xy[2 * j + 1] - xy[2 * i + 1]);
     if (!onOneSide || length2 == 0)
@@ -1136,12 +1135,12 @@ bool TwoCellParameterization::Parameterize(
   // then the mesh of the cell (paper, section 5.1).
   CellBoundary cell;
   TwoCellMesh& mesh = this->Mesh;
-  this->OpenedPinches = 0;
-  this->ResampledOverlaps = false;
   // Walks that are not an outer loop with slits as given: the sides resampled alike where they
   // overlap (SampleOverlapsAlike), then pinch points opened (OpenPinches). The first error
   // stands if neither helps.
   std::vector<double> alikePoints, alikeParameters, opened;
+  bool resampled = false;
+  int pinched = 0;
   auto analyze = [&]() {
     if (AnalyzeBoundary(cell.XY, cell.Count, cell.Graph, error))
     {
@@ -1156,7 +1155,7 @@ bool TwoCellParameterization::Parameterize(
         return false;
       }
       cell = alike;
-      this->ResampledOverlaps = true;
+      resampled = true;
       if (AnalyzeBoundary(cell.XY, cell.Count, cell.Graph, ignored))
       {
         error.clear();
@@ -1168,17 +1167,16 @@ bool TwoCellParameterization::Parameterize(
       return false;
     }
     opened.assign(cell.XY, cell.XY + 2 * cell.Count);
-    const int pinched = static_cast<int>(cell.Graph.Pinched.size());
     if (!OpenPinches(cell.Graph, cell.Count, DoubleSignedArea(opened) >= 0 ? 1 : -1, opened))
     {
       return false;
     }
     cell.XY = opened.data();
+    pinched = static_cast<int>(cell.Graph.Pinched.size());
     if (!AnalyzeBoundary(cell.XY, cell.Count, cell.Graph, ignored))
     {
       return false;
     }
-    this->OpenedPinches = pinched;
     error.clear();
     return true;
   };
@@ -1190,6 +1188,8 @@ bool TwoCellParameterization::Parameterize(
     this->Mesh = TwoCellMesh();
     return false;
   }
+  mesh.OpenedPinches = pinched;
+  mesh.ResampledOverlaps = resampled;
   // Phi on the mesh.
   mesh.Orientation = cell.PolygonOrientation * cell.ParameterOrientation;
   if (!SolveMeanValueCoordinates(mesh, error) || !CheckOneToOne(mesh, error))

@@ -51,6 +51,10 @@ struct TwoCellMesh
   // CheckOneToOne). Phi is evaluated from (x, y), so they cost nothing there; the inverse map
   // skips them.
   Index CrowdedTriangles = 0;
+  // Visits of pinch points moved apart (0: none), and whether samples were copied between
+  // overlapping straight sides (a slit sampled two ways): TwoCellParameterization::Parameterize.
+  int OpenedPinches = 0;
+  bool ResampledOverlaps = false;
 
   Index NumberOfPoints() const { return static_cast<Index>(this->Points.size() / 2); }
   Index NumberOfTriangles() const { return static_cast<Index>(this->Triangles.size() / 3); }
@@ -89,10 +93,6 @@ public:
   // touches itself at a point (a pinched cell) is opened there by 1e-3 of an edge.
   bool Parameterize(const std::vector<double>& boundaryPoints, const std::vector<double>& boundaryParameters,
     std::string& error);
-  // Visits of pinch points the last Parameterize moved apart (0: none).
-  int OpenedPinches = 0;
-  // Whether it copied samples between overlapping straight sides (a slit sampled two ways).
-  bool ResampledOverlaps = false;
 
   // The result of the last successful Parameterize (empty otherwise).
   const TwoCellMesh& GetMesh() const { return this->Mesh; }

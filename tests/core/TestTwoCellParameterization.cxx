@@ -807,7 +807,7 @@ TEST_CASE(DegenerateInputs)
   bad[15] = bad[3];
   TwoCellParameterization pinched;
   std::string pinchError;
-  CHECK(pinched.Parameterize(bad, square.Parameters, pinchError) && pinched.OpenedPinches == 2);
+  CHECK(pinched.Parameterize(bad, square.Parameters, pinchError) && pinched.GetMesh().OpenedPinches == 2);
   const Cell bowTie = MakeCell(SamplePolyline({ { 0, 0 }, { 1, 1 }, { 2, 2 }, { 2, 0 }, { 1, 1 }, { 0, 2 } }, 2));
   CHECK(Fails(bowTie.Points, bowTie.Parameters, "bow tie"));
   // Zero area: all samples on a line.
@@ -827,7 +827,7 @@ TEST_CASE(DegenerateInputs)
   // Retraced up to rounding (one ulp off): the samples are welded, still a slit ...
   slit[16] = std::nextafter(1.0, 2.0);
   TwoCellParameterization welded;
-  CHECK(welded.Parameterize(slit, square.Parameters, pouchError) && welded.ResampledOverlaps);
+  CHECK(welded.Parameterize(slit, square.Parameters, pouchError) && welded.GetMesh().ResampledOverlaps);
   // ... but not beyond it.
   slit[16] = 1 + 1e-6;
   CHECK(Fails(slit, square.Parameters, "slit not retraced (1e-6 off)"));
@@ -840,7 +840,7 @@ TEST_CASE(DegenerateInputs)
   const std::vector<double> twoWayParameters = SquareParameters(14, twoWayCorners);
   TwoCellParameterization resampled;
   std::string resampledError;
-  CHECK(resampled.Parameterize(twoWays, twoWayParameters, resampledError) && resampled.ResampledOverlaps &&
+  CHECK(resampled.Parameterize(twoWays, twoWayParameters, resampledError) && resampled.GetMesh().ResampledOverlaps &&
     resampled.GetMesh().BoundaryCount == 16 && resampled.GetMesh().MinimumParameterArea > 0);
   std::printf("  straight slit sampled two ways: %s\n", resampledError.empty() ? "resampled alike" : resampledError.c_str());
   // Touching at a single point without repeating a sample: still not simple.
@@ -1396,7 +1396,7 @@ TEST_CASE(PinchedCellIsOpenedAtItsPinch)
       continue;
     }
     const TwoCellMesh& mesh = tcp.GetMesh();
-    CHECK_EQ(tcp.OpenedPinches, 2);
+    CHECK_EQ(tcp.GetMesh().OpenedPinches, 2);
     CHECK(mesh.MinimumParameterArea > 0);
     // Every sample kept but the two visits of P, which moved by less than 1e-3 of an edge.
     int moved = 0;
@@ -1424,7 +1424,7 @@ TEST_CASE(PinchedCellIsOpenedAtItsPinch)
   TwoCellParameterization tcp;
   std::string error;
   CHECK(tcp.Parameterize(lens.Points, lens.Parameters, error) && error.empty());
-  CHECK(tcp.OpenedPinches == 2 && tcp.GetMesh().MinimumParameterArea > 0);
+  CHECK(tcp.GetMesh().OpenedPinches == 2 && tcp.GetMesh().MinimumParameterArea > 0);
   double uv[2];
   CHECK(tcp.Evaluate(0.25, 0.5, uv) && !tcp.Evaluate(0.6, 0.5, uv)); // the cell, the lens
   std::printf("  cell around a lens: %s, min uv area %.2e\n", error.empty() ? "opened" : error.c_str(),
@@ -1477,7 +1477,7 @@ TEST_CASE(SlitRefusals)
   const Cell lollipop = withSlit({ { 0, 0.5 }, { 0.2, 0.3 }, { -0.2, 0.3 }, { 0, 0.5 } }, false);
   TwoCellParameterization opened;
   std::string openedError;
-  CHECK(opened.Parameterize(lollipop.Points, lollipop.Parameters, openedError) && opened.OpenedPinches == 4 &&
+  CHECK(opened.Parameterize(lollipop.Points, lollipop.Parameters, openedError) && opened.GetMesh().OpenedPinches == 4 &&
     opened.GetMesh().MinimumParameterArea > 0);
   std::printf("  excursion around a loop (a hole on a stem): %s\n", openedError.empty() ? "opened" : openedError.c_str());
   const Cell wrongOrder = MultiSlitPouch(true);
