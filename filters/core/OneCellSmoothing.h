@@ -62,7 +62,7 @@ struct OneCellSmoothingResult
   int ClampedPieces = 0;       // pieces kept inside it by clamping control points
   double JunctionMargin = 0;
   double JunctionTotalChange = 0;
-  bool RisingCutsOnly = false;  // cut only where nodes rise (see CutAndSolveJunctionValues)
+  int DroppedCuts = 0;          // cuts at junctions left out to break cycles of the relations (RankNodes)
   int SpreadCriticalValues = 0; // critical values raised to make room for strict monotonicity
   double MaximumSpread = 0;     // the largest raise (see JunctionValueProgram)
 };
@@ -103,7 +103,7 @@ private:
   bool SmoothInFrame(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
     const double domainBounds[4], OneCellSmoothingResult& result, std::string& error) const;
   // Paper, section 4, step 1: cuts the 1-cells into pieces at their nodes and solves the
-  // junction values; cuts again at rising nodes only when the first cut orders nodes both ways.
+  // junction values; a 1-cell on a cycle of the relations is not cut where it runs down.
   bool CutAndSolveJunctionValues(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
     const std::vector<Index>& junctionNode, const double domainBounds[4], OneCellSmoothingResult& result,
     std::string& error) const;
