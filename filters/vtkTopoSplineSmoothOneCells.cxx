@@ -53,6 +53,7 @@ void WriteSmoothingReport(const topospline::OneCellSmoothingResult& result, int 
   AddFieldNumbers(fd, names::CurveSegments, { static_cast<double>(curveSegments) });
   AddFieldNumbers(fd, names::NumberOfPieces, { static_cast<double>(result.Pieces.size()) });
   AddFieldNumbers(fd, names::ShortPieces, { static_cast<double>(result.ShortPieces) });
+  AddFieldNumbers(fd, names::ErasedLoops, { static_cast<double>(result.ErasedLoops) });
   AddFieldNumbers(fd, names::DroppedCuts, { static_cast<double>(result.DroppedCuts) });
   AddFieldNumbers(fd, names::AdaptedPieces, { static_cast<double>(result.AdaptedPieces) });
   AddFieldNumbers(fd, names::PolylinePieces, { static_cast<double>(result.PolylinePieces) });

@@ -276,17 +276,92 @@ std::vector<Index> RankNodes(const std::vector<SmoothingNode>& nodes, const std:
   return rank;
 }
 
+// A 1-cell merged by cancellations runs out to a cancelled extremum and back along the path it
+// came (V-paths into one extremum merge and never split again, so the way back retraces the
+// way out), and it may pass its own end's vertex before it ends there. Such a retraced loop
+// bounds nothing: it is erased (the path goes on from the loop's first visit of the repeated
+// point), so that the piece does not carry a spike out and back, and stage 4 does not get a
+// side that runs out and back along another 1-cell (a slit outside the cell, or a stretch of
+// boundary walked three times). Only loops that retrace every edge as often one way as the
+// other are erased, and never a 1-cell that is a loop as a whole (a saddle and a maximum on
+// one boundary vertex). Returns the number of loops erased.
+int EraseRetracedLoops(OneCell& oneCell)
+{
+  const std::size_t n = oneCell.Values.size();
+  const std::vector<double>& p = oneCell.Points;
+  std::vector<std::size_t> kept;
+  std::map<std::pair<double, double>, std::size_t> keptAt; // point -> position in kept
+  int erased = 0;
+  auto retraced = [&p](const std::vector<std::size_t>& path, std::size_t from, std::size_t closing) {
+    // Every undirected edge of the loop as often one way as the other.
+    std::map<std::array<double, 4>, int> balance;
+    for (std::size_t k = from; k < path.size(); ++k)
+    {
+      const std::size_t a = path[k], b = k + 1 < path.size() ? path[k + 1] : closing;
+      std::array<double, 4> forward{ p[2 * a], p[2 * a + 1], p[2 * b], p[2 * b + 1] };
+      std::array<double, 4> backward{ p[2 * b], p[2 * b + 1], p[2 * a], p[2 * a + 1] };
+      if (forward < backward)
+      {
+        ++balance[forward];
+      }
+      else
+      {
+        --balance[backward];
+      }
+    }
+    return std::all_of(balance.begin(), balance.end(), [](const auto& entry) { return entry.second == 0; });
+  };
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const std::pair<double, double> point{ p[2 * i], p[2 * i + 1] };
+    const auto seen = keptAt.find(point);
+    if (seen != keptAt.end() && !(seen->second == 0 && i + 1 == n) && retraced(kept, seen->second, i))
+    {
+      for (std::size_t k = seen->second + 1; k < kept.size(); ++k)
+      {
+        keptAt.erase({ p[2 * kept[k]], p[2 * kept[k] + 1] });
+      }
+      kept.resize(seen->second + 1);
+      ++erased;
+      continue;
+    }
+    keptAt[point] = kept.size();
+    kept.push_back(i);
+  }
+  if (erased == 0)
+  {
+    return 0;
+  }
+  // Ascending 1-cells carry the saddle's and the maximum's vertex around their triangles.
+  const std::size_t offset = oneCell.Type == OneCell::Ascending ? 1 : 0;
+  OneCell trimmed;
+  trimmed.Type = oneCell.Type;
+  trimmed.Source = oneCell.Source;
+  trimmed.Destination = oneCell.Destination;
+  for (std::size_t i : kept)
+  {
+    trimmed.Points.insert(trimmed.Points.end(), { p[2 * i], p[2 * i + 1] });
+    trimmed.Values.push_back(oneCell.Values[i]);
+    if (i >= offset && i - offset < oneCell.MeshCells.size())
+    {
+      trimmed.MeshCells.push_back(oneCell.MeshCells[i - offset]);
+    }
+  }
+  oneCell = std::move(trimmed);
+  return erased;
+}
+
 // The cuts of every 1-cell at the junction points it passes (not at its ends).
-std::vector<std::vector<Cut>> CutsAtJunctions(const MorseSmaleComplex& complex,
+std::vector<std::vector<Cut>> CutsAtJunctions(const std::vector<OneCell>& oneCells,
   const std::vector<JunctionPoint>& junctions, const std::vector<Index>& junctionNode)
 {
-  std::vector<std::vector<Cut>> cuts(complex.OneCells.size());
+  std::vector<std::vector<Cut>> cuts(oneCells.size());
   for (size_t j = 0; j < junctions.size(); ++j)
   {
     for (Index a : junctions[j].OneCells)
     {
-      const long at = PointIndexOfCell(complex.OneCells[a], junctions[j].Cell);
-      if (at > 0 && at + 1 < static_cast<long>(complex.OneCells[a].Values.size()))
+      const long at = PointIndexOfCell(oneCells[a], junctions[j].Cell);
+      if (at > 0 && at + 1 < static_cast<long>(oneCells[a].Values.size()))
       {
         cuts[a].push_back({ at, junctionNode[j] });
       }
@@ -416,26 +491,26 @@ void AddPiecesOfOneCell(Index a, const OneCell& oneCell, const std::vector<Cut>&
 // meets, which are added to `nodes`) into pieces; identical pieces (merged 1-cells) are kept
 // once. A 1-cell keeps only the cuts that rise in one order of all nodes (RankNodes), which
 // drops cuts on cycles only. Node positions become the ends of the pieces that meet there.
-void CutIntoPieces(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
+void CutIntoPieces(const std::vector<OneCell>& oneCells, const std::vector<JunctionPoint>& junctions,
   const std::vector<Index>& junctionNode, const double domainBounds[4], std::vector<SmoothingNode>& nodes,
   OneCellSmoothingResult& result)
 {
-  std::vector<std::vector<Cut>> cuts = CutsAtJunctions(complex, junctions, junctionNode);
+  std::vector<std::vector<Cut>> cuts = CutsAtJunctions(oneCells, junctions, junctionNode);
   DomainCornerNodes corners(domainBounds);
-  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
+  for (Index a = 0; a < static_cast<Index>(oneCells.size()); ++a)
   {
-    corners.AddCuts(complex.OneCells[a], nodes, cuts[a]);
-    AddEndsAndOrderCuts(complex.OneCells[a], cuts[a]);
+    corners.AddCuts(oneCells[a], nodes, cuts[a]);
+    AddEndsAndOrderCuts(oneCells[a], cuts[a]);
   }
   const std::vector<Index> rank = RankNodes(nodes, cuts);
   std::map<std::vector<double>, Index> pieceOfGeometry;
-  result.PiecesOfOneCell.resize(complex.OneCells.size());
-  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
+  result.PiecesOfOneCell.resize(oneCells.size());
+  for (Index a = 0; a < static_cast<Index>(oneCells.size()); ++a)
   {
     const size_t before = cuts[a].size();
     KeepRisingCuts(cuts[a], rank);
     result.DroppedCuts += static_cast<int>(before - cuts[a].size());
-    AddPiecesOfOneCell(a, complex.OneCells[a], cuts[a], pieceOfGeometry, result);
+    AddPiecesOfOneCell(a, oneCells[a], cuts[a], pieceOfGeometry, result);
   }
   // Node positions: the ends of the pieces that meet there.
   for (const SmoothedPiece& piece : result.Pieces)
@@ -955,7 +1030,13 @@ bool OneCellSmoothing::CutAndSolveJunctionValues(const MorseSmaleComplex& comple
   // cycle (see RankNodes).
   result.Pieces.clear();
   result.PiecesOfOneCell.clear();
-  CutIntoPieces(complex, junctions, junctionNode, domainBounds, result.Nodes, result);
+  std::vector<OneCell> oneCells = complex.OneCells;
+  result.ErasedLoops = 0;
+  for (OneCell& oneCell : oneCells)
+  {
+    result.ErasedLoops += EraseRetracedLoops(oneCell);
+  }
+  CutIntoPieces(oneCells, junctions, junctionNode, domainBounds, result.Nodes, result);
   this->Hooks.Report(0.1);
   JunctionValueProgram program;
   if (!SolveJunctionValues(result.Nodes, result, program, error))

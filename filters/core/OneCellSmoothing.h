@@ -62,6 +62,7 @@ struct OneCellSmoothingResult
   int ClampedPieces = 0;       // pieces kept inside it by clamping control points
   double JunctionMargin = 0;
   double JunctionTotalChange = 0;
+  int ErasedLoops = 0;          // retraced loops of merged 1-cells erased before cutting (EraseRetracedLoops)
   int DroppedCuts = 0;          // cuts at junctions left out to break cycles of the relations (RankNodes)
   int SpreadCriticalValues = 0; // critical values raised to make room for strict monotonicity
   double MaximumSpread = 0;     // the largest raise (see JunctionValueProgram)

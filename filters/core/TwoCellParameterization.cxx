@@ -20,6 +20,7 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <sstream>
 #include <tuple>
@@ -606,6 +607,84 @@ bool SampleOverlapsAlike(const CellBoundary& cell, std::vector<double>& points, 
   return true;
 }
 
+// Slits that lie outside the outer loop. A merged 1-cell that runs out to a cancelled
+// extremum and back along its own path (an excursion stage 3 keeps inside one piece, or a
+// 1-cell left uncut where its cuts would order nodes in a cycle) is retraced in the walk like a
+// slit, but its geometry can lie in the neighbouring 2-cell: the cell's other sides pass it on
+// the wrong side. It bounds no area of this cell, so the walk goes on without it: the slit's
+// samples and the return visit of its base are left out (the base keeps its first visit and
+// its (u, v)). Phi then maps the loop edge after the base onto a chord of the square that skips
+// the slit's stretch of the border; the square's image is still convex, so Phi stays one to
+// one (Floater), and F o Phi departs from the 1-cell's heights only along that one edge.
+// Writes the walk without such slits; returns how many were left out.
+int DropSlitsOutsideTheLoop(const CellBoundary& cell, std::vector<double>& points, std::vector<double>& parameters)
+{
+  const BoundaryGraph& graph = cell.Graph;
+  const std::size_t n = cell.Count;
+  const double* xy = cell.XY;
+  if (graph.Loop.size() >= n || graph.Loop.empty())
+  {
+    return 0;
+  }
+  std::vector<Point> loop;
+  std::vector<unsigned char> onLoop(n, 0), loopPoint(graph.PointCount, 0);
+  for (Index i : graph.Loop)
+  {
+    loop.emplace_back(xy[2 * i], xy[2 * i + 1]);
+    onLoop[i] = 1;
+    loopPoint[graph.PointOf[i]] = 1;
+  }
+  // Walking once around from a loop sample, a tree is the stretch between two visits of one
+  // loop point (the most recent one before) that holds no loop sample; it lies on one side of
+  // the loop (slits cross nothing), which the midpoint of its first edge tells.
+  std::vector<unsigned char> keep(n, 1);
+  int dropped = 0;
+  std::map<Index, std::size_t> lastVisit; // point -> walk position (unrolled)
+  const std::size_t start = graph.Loop.front();
+  // (p = start + n visits the first sample again: a tree across the walk's first sample closes.)
+  for (std::size_t p = start; p <= start + n; ++p)
+  {
+    const std::size_t i = p % n;
+    const auto seen = lastVisit.find(graph.PointOf[i]);
+    bool tree = loopPoint[graph.PointOf[i]] && seen != lastVisit.end() && seen->second + 1 < p;
+    for (std::size_t q = tree ? seen->second + 1 : p; q < p && tree; ++q)
+    {
+      tree = !onLoop[q % n]; // a stretch of the loop itself (a pinch) is no slit
+    }
+    if (tree)
+    {
+      const std::size_t u = seen->second % n, first = (seen->second + 1) % n;
+      const Point middle(0.5 * (xy[2 * u] + xy[2 * first]), 0.5 * (xy[2 * u + 1] + xy[2 * first + 1]));
+      if (CGAL::bounded_side_2(loop.begin(), loop.end(), middle, Kernel()) == CGAL::ON_UNBOUNDED_SIDE)
+      {
+        for (std::size_t q = seen->second + 1; q < p; ++q)
+        {
+          keep[q % n] = 0;
+        }
+        // One visit of the base stays: the loop's own one.
+        keep[onLoop[i] ? u : i] = 0;
+        ++dropped;
+      }
+    }
+    lastVisit[graph.PointOf[i]] = p;
+  }
+  if (dropped == 0)
+  {
+    return 0;
+  }
+  points.clear();
+  parameters.clear();
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    if (keep[i])
+    {
+      points.insert(points.end(), { xy[2 * i], xy[2 * i + 1] });
+      parameters.insert(parameters.end(), { cell.UV[2 * i], cell.UV[2 * i + 1] });
+    }
+  }
+  return dropped;
+}
+
 // Pairs of equal count, finite, at least one sample per corner of the square.
 bool ReadBoundarySamples(const std::vector<double>& boundaryPoints, const std::vector<double>& boundaryParameters,
   CellBoundary& cell, std::string& error)
@@ -1180,8 +1259,27 @@ bool TwoCellParameterization::Parameterize(
     error.clear();
     return true;
   };
+  // Slits outside the outer loop are left out (DropSlitsOutsideTheLoop).
+  std::vector<double> withoutPoints, withoutParameters;
+  int outsideSlits = 0;
+  auto dropOutsideSlits = [&]() {
+    outsideSlits = DropSlitsOutsideTheLoop(cell, withoutPoints, withoutParameters);
+    if (outsideSlits == 0)
+    {
+      return true;
+    }
+    CellBoundary without;
+    if (!ReadBoundarySamples(withoutPoints, withoutParameters, without, error) ||
+      !CheckBorderParameters(without, error) || !AnalyzeBoundary(without.XY, without.Count, without.Graph, error) ||
+      !CheckOuterLoop(without, error))
+    {
+      return false;
+    }
+    cell = without;
+    return true;
+  };
   if (!ReadBoundarySamples(boundaryPoints, boundaryParameters, cell, error) || !CheckBorderParameters(cell, error) ||
-    !analyze() || !CheckOuterLoop(cell, error) ||
+    !analyze() || !CheckOuterLoop(cell, error) || !dropOutsideSlits() ||
     !TriangulateCell(cell, InteriorEdgeLength(cell, this->TargetEdgeLength, this->MaximumVertices), this->ShapeBound,
       this->MaximumFixRounds, mesh, error))
   {
@@ -1190,6 +1288,7 @@ bool TwoCellParameterization::Parameterize(
   }
   mesh.OpenedPinches = pinched;
   mesh.ResampledOverlaps = resampled;
+  mesh.OutsideSlits = outsideSlits;
   // Phi on the mesh.
   mesh.Orientation = cell.PolygonOrientation * cell.ParameterOrientation;
   if (!SolveMeanValueCoordinates(mesh, error) || !CheckOneToOne(mesh, error))

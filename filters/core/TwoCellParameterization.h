@@ -55,6 +55,8 @@ struct TwoCellMesh
   // overlapping straight sides (a slit sampled two ways): TwoCellParameterization::Parameterize.
   int OpenedPinches = 0;
   bool ResampledOverlaps = false;
+  // Slits outside the outer loop left out of the walk (DropSlitsOutsideTheLoop in the .cxx).
+  int OutsideSlits = 0;
 
   Index NumberOfPoints() const { return static_cast<Index>(this->Points.size() / 2); }
   Index NumberOfTriangles() const { return static_cast<Index>(this->Triangles.size() / 3); }

@@ -1457,8 +1457,26 @@ TEST_CASE(SlitRefusals)
   };
   const Cell crossing = withSlit({ { 0, 0.5 }, { 0, -0.5 }, { 0, -1.5 } });
   CHECK(Fails(crossing.Points, crossing.Parameters, "slit crossing the outer loop"));
+  // A slit outside the loop bounds nothing of the cell: it is left out of the walk (its two
+  // samples and the base's second visit), and Phi maps the rest one to one.
   const Cell outside = withSlit({ { 0, 1.3 }, { 0, 1.6 } });
-  CHECK(Fails(outside.Points, outside.Parameters, "slit outside the outer loop"));
+  {
+    TwoCellParameterization tcp;
+    std::string error;
+    CHECK(tcp.Parameterize(outside.Points, outside.Parameters, error));
+    const TwoCellMesh& mesh = tcp.GetMesh();
+    CHECK_EQ(mesh.OutsideSlits, 1);
+    CHECK_EQ(static_cast<std::size_t>(mesh.BoundaryCount), outside.Points.size() / 2 - 4);
+    CHECK(mesh.MinimumParameterArea > 0);
+    for (Index i = 0; i < mesh.BoundaryCount; ++i)
+    {
+      CHECK(std::hypot(mesh.Points[2 * i], mesh.Points[2 * i + 1]) <= 1 + 1e-12); // on the circle
+    }
+    double uv[2];
+    CHECK(tcp.Evaluate(0, 0.5, uv) && !tcp.Evaluate(0, 1.45, uv)); // the cell, the slit
+    std::printf("  slit outside the outer loop -> left out (%d of %zu samples kept)\n",
+      static_cast<int>(mesh.BoundaryCount), outside.Points.size() / 2);
+  }
   const std::pair<double, double> c30 = CirclePoint(30, 40);
   const Cell touchingVertex = withSlit({ { 0, 0.5 }, { c30.first, c30.second } });
   CHECK(Fails(touchingVertex.Points, touchingVertex.Parameters, "slit tip on an outer loop sample"));
