@@ -131,6 +131,7 @@ constexpr const char* BezierTriangles = "BezierTriangles";
 constexpr const char* MeshTriangles = "MeshTriangles";
 constexpr const char* CrowdedTriangles = "CrowdedTriangles";
 constexpr const char* PinchedTwoCells = "PinchedTwoCells";
+constexpr const char* OutsideSlitTwoCells = "OutsideSlitTwoCells";
 constexpr const char* MaximumGridSize = "MaximumGridSize";
 constexpr const char* FittedCells = "FittedCells";
 constexpr const char* RefinedCells = "RefinedCells";

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <set>
 
@@ -276,6 +277,19 @@ std::vector<Index> RankNodes(const std::vector<SmoothingNode>& nodes, const std:
   return rank;
 }
 
+// Whether the 1-cell passes one point twice (most do not: found without the maps of
+// EraseRetracedLoops).
+bool RepeatsAPoint(const OneCell& oneCell)
+{
+  std::vector<std::pair<double, double>> sorted(oneCell.Values.size());
+  for (std::size_t i = 0; i < sorted.size(); ++i)
+  {
+    sorted[i] = { oneCell.Points[2 * i], oneCell.Points[2 * i + 1] };
+  }
+  std::sort(sorted.begin(), sorted.end());
+  return std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end();
+}
+
 // A 1-cell merged by cancellations runs out to a cancelled extremum and back along the path it
 // came (V-paths into one extremum merge and never split again, so the way back retraces the
 // way out), and it may pass its own end's vertex before it ends there. Such a retraced loop
@@ -352,7 +366,7 @@ int EraseRetracedLoops(OneCell& oneCell)
 }
 
 // The cuts of every 1-cell at the junction points it passes (not at its ends).
-std::vector<std::vector<Cut>> CutsAtJunctions(const std::vector<OneCell>& oneCells,
+std::vector<std::vector<Cut>> CutsAtJunctions(const std::vector<const OneCell*>& oneCells,
   const std::vector<JunctionPoint>& junctions, const std::vector<Index>& junctionNode)
 {
   std::vector<std::vector<Cut>> cuts(oneCells.size());
@@ -360,8 +374,8 @@ std::vector<std::vector<Cut>> CutsAtJunctions(const std::vector<OneCell>& oneCel
   {
     for (Index a : junctions[j].OneCells)
     {
-      const long at = PointIndexOfCell(oneCells[a], junctions[j].Cell);
-      if (at > 0 && at + 1 < static_cast<long>(oneCells[a].Values.size()))
+      const long at = PointIndexOfCell(*oneCells[a], junctions[j].Cell);
+      if (at > 0 && at + 1 < static_cast<long>(oneCells[a]->Values.size()))
       {
         cuts[a].push_back({ at, junctionNode[j] });
       }
@@ -491,7 +505,7 @@ void AddPiecesOfOneCell(Index a, const OneCell& oneCell, const std::vector<Cut>&
 // meets, which are added to `nodes`) into pieces; identical pieces (merged 1-cells) are kept
 // once. A 1-cell keeps only the cuts that rise in one order of all nodes (RankNodes), which
 // drops cuts on cycles only. Node positions become the ends of the pieces that meet there.
-void CutIntoPieces(const std::vector<OneCell>& oneCells, const std::vector<JunctionPoint>& junctions,
+void CutIntoPieces(const std::vector<const OneCell*>& oneCells, const std::vector<JunctionPoint>& junctions,
   const std::vector<Index>& junctionNode, const double domainBounds[4], std::vector<SmoothingNode>& nodes,
   OneCellSmoothingResult& result)
 {
@@ -499,8 +513,8 @@ void CutIntoPieces(const std::vector<OneCell>& oneCells, const std::vector<Junct
   DomainCornerNodes corners(domainBounds);
   for (Index a = 0; a < static_cast<Index>(oneCells.size()); ++a)
   {
-    corners.AddCuts(oneCells[a], nodes, cuts[a]);
-    AddEndsAndOrderCuts(oneCells[a], cuts[a]);
+    corners.AddCuts(*oneCells[a], nodes, cuts[a]);
+    AddEndsAndOrderCuts(*oneCells[a], cuts[a]);
   }
   const std::vector<Index> rank = RankNodes(nodes, cuts);
   std::map<std::vector<double>, Index> pieceOfGeometry;
@@ -510,7 +524,7 @@ void CutIntoPieces(const std::vector<OneCell>& oneCells, const std::vector<Junct
     const size_t before = cuts[a].size();
     KeepRisingCuts(cuts[a], rank);
     result.DroppedCuts += static_cast<int>(before - cuts[a].size());
-    AddPiecesOfOneCell(a, oneCells[a], cuts[a], pieceOfGeometry, result);
+    AddPiecesOfOneCell(a, *oneCells[a], cuts[a], pieceOfGeometry, result);
   }
   // Node positions: the ends of the pieces that meet there.
   for (const SmoothedPiece& piece : result.Pieces)
@@ -1030,11 +1044,25 @@ bool OneCellSmoothing::CutAndSolveJunctionValues(const MorseSmaleComplex& comple
   // cycle (see RankNodes).
   result.Pieces.clear();
   result.PiecesOfOneCell.clear();
-  std::vector<OneCell> oneCells = complex.OneCells;
+  // The 1-cells as cut: the complex's own, or a copy with its retraced loops erased.
+  std::vector<const OneCell*> oneCells(complex.OneCells.size());
+  std::vector<std::unique_ptr<OneCell>> trimmed(complex.OneCells.size());
   result.ErasedLoops = 0;
-  for (OneCell& oneCell : oneCells)
+  for (std::size_t a = 0; a < oneCells.size(); ++a)
   {
-    result.ErasedLoops += EraseRetracedLoops(oneCell);
+    oneCells[a] = &complex.OneCells[a];
+    if (!RepeatsAPoint(complex.OneCells[a]))
+    {
+      continue;
+    }
+    auto copy = std::make_unique<OneCell>(complex.OneCells[a]);
+    const int erased = EraseRetracedLoops(*copy);
+    if (erased > 0)
+    {
+      result.ErasedLoops += erased;
+      trimmed[a] = std::move(copy);
+      oneCells[a] = trimmed[a].get();
+    }
   }
   CutIntoPieces(oneCells, junctions, junctionNode, domainBounds, result.Nodes, result);
   this->Hooks.Report(0.1);

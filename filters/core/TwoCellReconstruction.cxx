@@ -874,6 +874,7 @@ void TwoCellReconstruction::Summarize()
     }
     s.SlitCells += cell->Sides.Slit ? 1 : 0;
     s.PinchedCells += cell->Parameterization.GetMesh().OpenedPinches > 0 ? 1 : 0;
+    s.OutsideSlitCells += cell->Parameterization.GetMesh().OutsideSlits > 0 ? 1 : 0;
     s.ShiftedCorners += (cell->Sides.MinimumShifted ? 1 : 0) + (cell->Sides.MaximumShifted ? 1 : 0);
     const MonotoneSurfaceReport& r = cell->Surface.Report();
     s.ViolatingPatches += r.ViolatingCells;

@@ -106,6 +106,7 @@ struct TwoCellReconstructionReport
   Index FailedCells = 0;       // not reconstructed (see ReconstructedTwoCell::Error)
   Index NegligibleCells = 0;   // skipped for having no area
   Index SlitCells = 0;         // pouch cells parameterized with a slit
+  Index OutsideSlitCells = 0;  // cells with slits outside their outer loop, left out of the walk
   Index PinchedCells = 0;      // cells whose boundary touches itself, opened there (TwoCellParameterization)
   Index ShiftedCorners = 0;    // corners taken by junction points
   Index ViolatingPatches = 0;  // Sibson grid cells failing the monotonicity conditions (0 is the goal)
