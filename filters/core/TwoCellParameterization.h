@@ -112,7 +112,7 @@ public:
 
 private:
   // Uniform grid over the bounding box of some vertex coordinates; cell c holds the triangles
-  // Triangles[Start[c] .. Start[c+1]) whose bounding boxes (grown by Tolerance) overlap it.
+  // Triangles[Start[c] .. Start[c+1]) that come within Tolerance of it.
   struct BucketGrid
   {
     double Origin[2] = { 0, 0 };
