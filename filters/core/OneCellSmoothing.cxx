@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <numeric>
 #include <set>
 #include <unordered_map>
 
@@ -1073,6 +1074,10 @@ int SegmentsOfPiece(const SmoothedPiece& piece, int asked)
 bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments,
   const double bounds[4], std::string& error) const
 {
+  if (piece.Parameters.size() != piece.Values.size())
+  {
+    piece.Parameters = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
+  }
   MonotoneBSplineFit fitter;
   fitter.Segments = segments;
   HeightFit height, free;
@@ -1140,37 +1145,51 @@ bool OneCellSmoothing::CutAndSolveJunctionValues(const MorseSmaleComplex& comple
 bool OneCellSmoothing::FitAllPieces(
   OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const
 {
-  // In parallel, in chunks between which progress is reported and an abort is seen (from this
-  // thread only); the first failing piece in order names the error.
+  // In chunks between which progress is reported and an abort is seen (from this thread only).
   const Index count = static_cast<Index>(result.Pieces.size());
   const Index chunk = std::max<Index>(256, count / 16);
-  std::vector<std::string> pieceErrors(static_cast<std::size_t>(count));
-  std::vector<unsigned char> failed(static_cast<std::size_t>(count), 0);
   for (Index first = 0; first < count; first += chunk)
   {
     const Index last = std::min(count, first + chunk);
-    this->Parallel(first, last, [&](Index begin, Index end) {
-      for (Index p = begin; p < end; ++p)
-      {
-        SmoothedPiece& piece = result.Pieces[p];
-        piece.Parameters = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
-        failed[p] = !this->FitPiece(piece, result.Nodes, SegmentsOfPiece(piece, this->Segments), domainBounds,
-          pieceErrors[p]);
-      }
-    });
+    std::vector<Index> pieces(static_cast<std::size_t>(last - first));
+    std::iota(pieces.begin(), pieces.end(), first);
+    if (!this->FitInParallel(result, pieces,
+          [this](const SmoothedPiece& piece) { return SegmentsOfPiece(piece, this->Segments); }, domainBounds,
+          error))
+    {
+      return false;
+    }
     for (Index p = first; p < last; ++p)
     {
       result.ShortPieces += result.Pieces[p].Segments < this->Segments ? 1 : 0;
-      if (failed[p])
-      {
-        error = "1-cell piece " + std::to_string(p) + ": " + pieceErrors[p];
-        return false;
-      }
     }
     this->Hooks.Report(0.2 + 0.5 * static_cast<double>(last) / count);
     if (this->Hooks.Aborted())
     {
       error = "aborted";
+      return false;
+    }
+  }
+  return true;
+}
+
+bool OneCellSmoothing::FitInParallel(OneCellSmoothingResult& result, const std::vector<Index>& pieces,
+  const std::function<int(const SmoothedPiece&)>& segmentsOf, const double domainBounds[4], std::string& error) const
+{
+  std::vector<std::string> pieceErrors(pieces.size());
+  std::vector<unsigned char> failed(pieces.size(), 0);
+  this->Parallel(0, static_cast<Index>(pieces.size()), [&](Index begin, Index end) {
+    for (Index i = begin; i < end; ++i)
+    {
+      SmoothedPiece& piece = result.Pieces[pieces[i]];
+      failed[i] = !this->FitPiece(piece, result.Nodes, segmentsOf(piece), domainBounds, pieceErrors[i]);
+    }
+  });
+  for (std::size_t i = 0; i < pieces.size(); ++i)
+  {
+    if (failed[i])
+    {
+      error = "1-cell piece " + std::to_string(pieces[i]) + ": " + pieceErrors[i];
       return false;
     }
   }
@@ -1204,24 +1223,12 @@ bool OneCellSmoothing::RepairCrossings(
         raise.push_back(p);
       }
     }
-    std::vector<std::string> pieceErrors(raise.size());
-    std::vector<unsigned char> failed(raise.size(), 0);
-    this->Parallel(0, static_cast<Index>(raise.size()), [&](Index begin, Index end) {
-      for (Index i = begin; i < end; ++i)
-      {
-        SmoothedPiece& piece = result.Pieces[raise[i]];
-        failed[i] = !this->FitPiece(piece, result.Nodes, 2 * piece.Segments, domainBounds, pieceErrors[i]);
-      }
-    });
-    for (std::size_t i = 0; i < raise.size(); ++i)
+    if (!this->FitInParallel(
+          result, raise, [](const SmoothedPiece& piece) { return 2 * piece.Segments; }, domainBounds, error))
     {
-      if (failed[i])
-      {
-        error = "1-cell piece " + std::to_string(raise[i]) + ": " + pieceErrors[i];
-        return false;
-      }
-      adapted.insert(raise[i]);
+      return false;
     }
+    adapted.insert(raise.begin(), raise.end());
     std::vector<Index> changed = raise;
     if (changed.empty())
     {

@@ -9,6 +9,7 @@
 #include "MonotoneBSplineFit.h"
 #include "MorseSmaleComplex.h"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -112,6 +113,12 @@ private:
   bool FitAllPieces(OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const;
   // Raises k on crossing pieces and fits them again (sets AdaptedPieces, RemainingCrossings).
   bool RepairCrossings(OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const;
+  // Fits the listed pieces in parallel, each with segmentsOf(piece) segments; false with the
+  // first failing piece in list order named in `error`.
+  bool FitInParallel(OneCellSmoothingResult& result, const std::vector<Index>& pieces,
+    const std::function<int(const SmoothedPiece&)>& segmentsOf, const double domainBounds[4],
+    std::string& error) const;
+  // One piece (its arc-length parameters are derived from its samples on the first fit).
   bool FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments, const double bounds[4],
     std::string& error) const;
 };

@@ -759,13 +759,12 @@ bool TwoCellReconstruction::FitSurface(ReconstructedTwoCell& cell, const Monoton
     return false;
   }
   // Refinement: double the grid while the fit misses the tolerance, every grid cell keeps a
-  // few samples, and each doubling gains (the spaces are not nested: keep the best).
-  const double minimumSamplesPerGridCell = 4;
+  // few samples (FinestRefinedGridSize), and each doubling gains (the spaces are not nested:
+  // keep the best).
   bool refined = false;
   MonotoneSurfaceBoundary boundary = subdivided;
-  for (int n = cell.GridSize * 2; this->SurfaceTolerance > 0 && n <= this->MaximumRefinedGridSize &&
-       cell.Surface.FitReport().MaximumResidual > this->SurfaceTolerance &&
-       static_cast<double>(samples.size()) >= minimumSamplesPerGridCell * n * n;
+  const int finest = this->FinestRefinedGridSize(cell.GridSize, samples.size());
+  for (int n = cell.GridSize * 2; n <= finest && cell.Surface.FitReport().MaximumResidual > this->SurfaceTolerance;
        n *= 2)
   {
     MonotoneSurfaceBoundary finer;
@@ -792,6 +791,19 @@ bool TwoCellReconstruction::FitSurface(ReconstructedTwoCell& cell, const Monoton
   return refined;
 }
 
+int TwoCellReconstruction::FinestRefinedGridSize(int gridSize, std::size_t samples) const
+{
+  // Every grid cell keeps this many of the cell's samples.
+  constexpr double minimumSamplesPerGridCell = 4;
+  int n = gridSize;
+  while (this->SurfaceTolerance > 0 && n > 0 && 2 * n <= this->MaximumRefinedGridSize &&
+    static_cast<double>(samples) >= minimumSamplesPerGridCell * (2.0 * n) * (2.0 * n))
+  {
+    n *= 2;
+  }
+  return n;
+}
+
 bool TwoCellReconstruction::SurfacesFitInMemory(
   const std::vector<MonotoneSurfaceBoundary>& boundaries, const std::vector<Index>& firstVertex, std::string& error) const
 {
@@ -805,17 +817,10 @@ bool TwoCellReconstruction::SurfacesFitInMemory(
   {
     const double n = static_cast<double>(boundaries[c].Bottom.size());
     finest = std::max(finest, boundaries[c].Bottom.size());
-    // The finest grid refinement may reach (FitSurface: doubling while every grid cell keeps
-    // 4 samples, up to MaximumRefinedGridSize), for fitted cells.
-    double refined = n;
-    if (!firstVertex.empty() && this->SurfaceTolerance > 0 && n > 0 && n <= this->MaximumFittedGridSize)
-    {
-      const double samples = static_cast<double>(firstVertex[c + 1] - firstVertex[c]);
-      while (2 * refined <= this->MaximumRefinedGridSize && samples >= 4 * (2 * refined) * (2 * refined))
-      {
-        refined *= 2;
-      }
-    }
+    // Fitted cells may be refined up to FinestRefinedGridSize.
+    const double refined = !firstVertex.empty() && n <= this->MaximumFittedGridSize
+      ? this->FinestRefinedGridSize(static_cast<int>(n), static_cast<std::size_t>(firstVertex[c + 1] - firstVertex[c]))
+      : n;
     triangles += 4 * refined * refined;
   }
   const double needed = triangles * BytesPerBezierTriangle;

@@ -214,6 +214,10 @@ private:
   void ParameterizeCell(const TwoCell& twoCell, const OneCellSmoothingResult& smoothed, ReconstructedTwoCell& cell,
     MonotoneSurfaceBoundary& boundary) const;
   static void BuildSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided);
+  // The finest grid FitSurface's refinement may reach from `gridSize` with `samples` input
+  // samples in the cell: doubling while every grid cell keeps 4 samples, up to
+  // MaximumRefinedGridSize (it stops earlier once the fit meets SurfaceTolerance or stops gaining).
+  int FinestRefinedGridSize(int gridSize, std::size_t samples) const;
   // False, with the estimate, when the surfaces of these grids would exceed MemoryBudget.
   // firstVertex: the cells' input samples (LocateSamples; empty when not fitting).
   bool SurfacesFitInMemory(const std::vector<MonotoneSurfaceBoundary>& boundaries,
