@@ -353,12 +353,16 @@ NearestPoint NearestOnOneCell(const SaddleOneCell& cell, double x, double y)
 // instead: the interior is searched, highest vertices first, for the nearest vertex with a
 // neighbour above the saddle, and the path to it is raised to rise from just above the saddle
 // towards that neighbour. Path vertices keep a lower and a higher neighbour, so no extremum
-// appears, and the boundary curve is not touched. Returns the number of changed vertices (0: no
-// way up). (Tried and dropped: following the saddle's smoothed ascending 1-cell instead, and
-// keeping the path off wanted saddles or their lower neighbours; the first two left more
-// saddles off their nodes on the climate field, the last broke convergence.)
+// appears, and the boundary curve is not touched. The path leaves out the vertices `avoided`
+// names (a wanted saddle and the neighbours below it: raising one takes a wanted saddle away,
+// and on heavy noise a way up would run straight through one); if there is no such way, the
+// caller searches again without them. Returns the number of changed vertices (0: no way up).
+// (Tried and dropped: following the saddle's smoothed ascending 1-cell instead; it left more
+// saddles off their nodes on the climate field. Keeping off wanted saddles with no second
+// search broke convergence: a saddle with no way up is cut, and the boundary pass fills it
+// again.)
 Index RaiseWayUp(const Graph& g, const TriangleMeshTopology& mesh, std::vector<double>& values, Index v,
-  VisitMarks& visits)
+  VisitMarks& visits, const std::function<bool(Index)>& avoided)
 {
   std::vector<unsigned>& mark = visits.Mark;
   const Key top{ values[v], v };
@@ -369,7 +373,7 @@ Index RaiseWayUp(const Graph& g, const TriangleMeshTopology& mesh, std::vector<d
   mark[v] = seen;
   depth[v] = 0;
   auto visit = [&](Index w, Index from) {
-    if (mark[w] != seen && !mesh.IsBoundaryVertex(w))
+    if (mark[w] != seen && !mesh.IsBoundaryVertex(w) && !(avoided && avoided(w)))
     {
       mark[w] = seen;
       parent[w] = from;
@@ -528,7 +532,8 @@ public:
     WantedMinimum = 1,
     WantedMaximum = 2,
     WantedBoundaryMinimum = 4,
-    WantedBoundaryMaximum = 8
+    WantedBoundaryMaximum = 8,
+    WantedSaddle = 16
   };
 
   FloodPass(const TriangleMeshTopology& mesh, const SamplingConstraints& constraints)
@@ -552,6 +557,10 @@ public:
     for (Index v : constraints.BoundaryMaxima)
     {
       this->Wanted[v] |= WantedBoundaryMaximum;
+    }
+    for (Index v : constraints.Saddles)
+    {
+      this->Wanted[v] |= WantedSaddle;
     }
   }
 
@@ -611,7 +620,7 @@ private:
         continue;
       }
       ++fills;
-      const Index raised = getsWayUp(v) ? RaiseWayUp(this->Graphs.All, mesh, values, v, this->Visits) : 0;
+      const Index raised = getsWayUp(v) ? this->RaiseWayUpAroundWantedPoints(v, values) : 0;
       revalued.clear();
       changed += raised > 0 ? raised : flood.Fill(v, &revalued);
       for (Index r : revalued)
@@ -632,6 +641,32 @@ private:
       this->Visits.Stamp = 0;
     }
     return changed;
+  }
+
+  // RaiseWayUp off the wanted minima and saddles and the neighbours below a wanted saddle,
+  // else anywhere.
+  Index RaiseWayUpAroundWantedPoints(Index v, std::vector<double>& values)
+  {
+    const Graph& g = this->Graphs.All;
+    const std::vector<unsigned char>& wanted = this->Wanted;
+    auto avoided = [&](Index w) {
+      if (wanted[w] & (WantedMinimum | WantedSaddle))
+      {
+        return true;
+      }
+      const Key key{ values[w], w };
+      for (Index i = g.Start[w]; i < g.Start[w + 1]; ++i)
+      {
+        const Index s = g.Adjacent[i];
+        if ((wanted[s] & WantedSaddle) && key < Key{ values[s], s })
+        {
+          return true;
+        }
+      }
+      return false;
+    };
+    const Index raised = RaiseWayUp(g, this->Mesh, values, v, this->Visits, avoided);
+    return raised > 0 ? raised : RaiseWayUp(g, this->Mesh, values, v, this->Visits, nullptr);
   }
 
   const TriangleMeshTopology& Mesh;
@@ -979,13 +1014,15 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   // are as many as the complex's: min - saddle + max is the same on every disk. A flood of
   // one kind can take a wanted extremum of the other kind away (a cut peak sinking below a
   // wanted pit beside it), and so can moving a saddle: such extrema are restored, the floods
-  // run again, and the saddles are moved back again.
+  // run again, and the saddles are moved back again. After the last relocation too: a
+  // relocation can take a wanted extremum away (a carved chain running down past a wanted
+  // minimum beside it), and equal counts come before saddles on their nodes.
   constexpr int restoreRounds = 4;
   for (int round = 0; round <= restoreRounds; ++round)
   {
     report.DisplacedSaddles =
       RelocateSaddles(sampling, mesh, constraints, this->Spacing * (1 + 1e-9), reach, values, 3, 10, this->Parallel);
-    if (round == restoreRounds || RestoreWantedExtrema(mesh, constraints, values) == 0)
+    if (RestoreWantedExtrema(mesh, constraints, values) == 0)
     {
       break;
     }
@@ -1152,29 +1189,61 @@ struct SaddleRelocation
   std::vector<double>& Values;
   SaddleMatch Current;
 
-  // Floods `trial` again and keeps it if it matches better.
-  bool KeepIfBetter(std::vector<double>& trial)
+  // Floods `trial` again and matches its saddles.
+  SaddleMatch Settle(std::vector<double>& trial)
   {
     EnforceCriticalVertices(this->Mesh, this->Constraints, trial);
-    SaddleMatch match = this->Matcher.Match(trial);
+    return this->Matcher.Match(trial);
+  }
+
+  // Keeps a settled `trial` if its `match` is better.
+  bool KeepIfBetter(const std::vector<double>& trial, const SaddleMatch& match)
+  {
     if (!match.IsBetterThan(this->Current))
     {
       return false;
     }
-    this->Values = std::move(trial);
-    this->Current = std::move(match);
+    this->Values = trial;
+    this->Current = match;
     return true;
   }
 
-  // Carves the 1-cells of every unmatched wanted saddle, in one trial.
-  void TryCarvingMissingOneCells()
+  // Carves the 1-cells of every unmatched wanted saddle, in one trial. Carving one can take
+  // away a neighbouring wanted saddle that shared a link vertex with it (a monkey saddle and a
+  // saddle beside it, both needing a vertex above them, which the first carve raises only past
+  // its own saddle): the saddles the trial leaves unmatched are carved as well, round after
+  // round. On noise a saddle can be off at the end of a chain of wanted saddles each one vertex
+  // from its node; each carve moves the gap one saddle along (4 rounds on a 32² field at 0.5 %).
+  // Each round costs an extraction of the whole sampling: the rounds after the first are for a
+  // few displaced saddles (at most `maximumMissing`), not for a sampling with many off.
+  void TryCarvingMissingOneCells(int maximumMissing)
   {
+    const int rounds = static_cast<int>(this->Current.Missing.size()) <= maximumMissing ? 8 : 1;
     std::vector<double> trial = this->Values;
-    for (Index w : this->Current.Missing)
+    std::vector<Index> carved;
+    SaddleMatch match = this->Current;
+    for (int round = 0; round < rounds; ++round)
     {
-      CarveSaddleOneCells(this->Field, this->Mesh, this->Constraints, w, this->Reach, trial);
+      bool added = false;
+      for (Index w : match.Missing)
+      {
+        if (std::find(carved.begin(), carved.end(), w) == carved.end())
+        {
+          carved.push_back(w);
+          added = true;
+        }
+      }
+      if (!added)
+      {
+        break;
+      }
+      for (Index w : carved)
+      {
+        CarveSaddleOneCells(this->Field, this->Mesh, this->Constraints, w, this->Reach, trial);
+      }
+      match = this->Settle(trial);
+      this->KeepIfBetter(trial, match);
     }
-    this->KeepIfBetter(trial);
   }
 
   // Moves the nearest spare saddle within reach of each unmatched wanted saddle just past the
@@ -1209,7 +1278,7 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
   const std::vector<Index>& missing = relocation.Current.Missing;
   if (!missing.empty() && !constraints.SaddleOneCells.empty())
   {
-    relocation.TryCarvingMissingOneCells();
+    relocation.TryCarvingMissingOneCells(maximumMissing);
   }
   // Each round costs an extraction of the whole sampling: worth it for the few saddles of a
   // flat pass, not when many are missing (a failed 2-cell keeps the input's own saddles).
@@ -1220,7 +1289,7 @@ int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& 
   for (int round = 0; round < maximumRounds && !missing.empty(); ++round)
   {
     std::vector<double> trial = values;
-    if (!relocation.MoveSpareSaddlesPastMissing(trial) || !relocation.KeepIfBetter(trial))
+    if (!relocation.MoveSpareSaddlesPastMissing(trial) || !relocation.KeepIfBetter(trial, relocation.Settle(trial)))
     {
       break;
     }
@@ -1320,6 +1389,43 @@ TurningOrders TurningOrdersOf(const SaddleStar& star)
   turning.CellOrder = ByAngle(turning.CellAngle);
   turning.LinkOrder = ByAngle(turning.LinkAngle);
   return turning;
+}
+
+// For each 1-cell, the one whose link vertex it takes (itself, or the 1-cell before it in
+// turning order if that one is of its kind). A multiple saddle (a monkey saddle is two saddles
+// of the complex on one vertex) has its saddles' 1-cells leave in sectors: the 1-cells of one
+// kind between two of the other kind (copies of a shared 1-cell, or two that part further out)
+// lie in one sector of the link, which one vertex serves; a vertex each would need 8 of a link
+// of 6. A simple saddle's 1-cells are left one vertex each.
+std::vector<std::size_t> SectorLeaders(const SaddleStar& star)
+{
+  const std::size_t m = star.Cells.size();
+  std::vector<std::size_t> leader(m);
+  std::iota(leader.begin(), leader.end(), 0);
+  if (m <= 4)
+  {
+    return leader;
+  }
+  const TurningOrders turning = TurningOrdersOf(star);
+  auto kind = [&](std::size_t j) { return star.Cells[turning.CellOrder[j % m]]->Ascending; };
+  // Start after a change of kind, so that a sector is not cut where the order wraps around.
+  std::size_t start = 0;
+  while (start < m && kind(start) == kind(start + m - 1))
+  {
+    ++start;
+  }
+  if (start == m)
+  {
+    return leader; // all of one kind: nothing to share
+  }
+  for (std::size_t j = start + 1; j < start + m; ++j)
+  {
+    if (kind(j) == kind(j - 1))
+    {
+      leader[turning.CellOrder[j % m]] = leader[turning.CellOrder[(j - 1) % m]];
+    }
+  }
+  return leader;
 }
 
 // The angle between two directions.
@@ -1482,7 +1588,24 @@ private:
 Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, Index saddle, double radius, std::vector<double>& values)
 {
-  const SaddleStar star(field, mesh, constraints, saddle);
+  SaddleStar star(field, mesh, constraints, saddle);
+  // One link vertex per sector: the leaders are assigned, the others carved from theirs.
+  const std::vector<std::size_t> leader = SectorLeaders(star);
+  const std::vector<const SaddleOneCell*> all = star.Cells;
+  star.Cells.clear();
+  std::vector<std::size_t> assigned(all.size());
+  for (std::size_t c = 0; c < all.size(); ++c)
+  {
+    if (leader[c] == c)
+    {
+      assigned[c] = star.Cells.size();
+      star.Cells.push_back(all[c]);
+    }
+  }
+  for (std::size_t c = 0; c < all.size(); ++c)
+  {
+    assigned[c] = assigned[leader[c]];
+  }
   // The assignment tries every subset of the link: a handful of vertices on grids, but an
   // unstructured mesh can have vertices of very high valence; those are left as they are.
   constexpr std::size_t maximumLinkSize = 16;
@@ -1494,9 +1617,9 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
   SaddleChains chains{ star, radius, values[saddle], { saddle }, values };
   chains.Taken.insert(chains.Taken.end(), vertexOfCell.begin(), vertexOfCell.end());
   Index changed = 0;
-  for (std::size_t c = 0; c < star.Cells.size(); ++c)
+  for (std::size_t c = 0; c < all.size(); ++c)
   {
-    changed += chains.Carve(*star.Cells[c], vertexOfCell[c]);
+    changed += chains.Carve(*all[c], vertexOfCell[assigned[c]]);
   }
   return changed;
 }

@@ -8,6 +8,9 @@
 // - the verdict: when it is 1, an independent count of the sampled field's interior PL minima
 //   and maxima (lower/upper links, written here) equals the complex's interior extrema;
 // - the same report with one thread and several;
+// - saddles on their nodes: on weak noise (monkey saddles, saddles a vertex apart), every
+//   interior saddle of the complex has one of the sampling's within one edge and the other way
+//   round (PL multiplicities and one-to-one pairings written here);
 // - an image of spacing 0.01 x 3 is reconstructed and verified (in the complex's frame), its
 //   outputs in the image's coordinates.
 //
@@ -22,6 +25,9 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
+#include <functional>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -366,6 +372,164 @@ TEST_CASE(SpuriousPointsAreCountedNearAndFarFromTheOneCells)
   CHECK_EQ(far, 4);  // 2.5, 5, 3 (beyond the end) and far outside
   CountByDistanceToOneCells({}, smoothed, 2.0, near, far);
   CHECK(near == 0 && far == 0);
+}
+
+namespace
+{
+// Uniform noise in [0, 1) on an n x n grid, from splitmix64 (the same on every platform).
+GridField UniformNoise(int n, std::uint64_t seed)
+{
+  GridField grid;
+  grid.Dimensions[0] = grid.Dimensions[1] = n;
+  std::uint64_t state = seed;
+  for (int v = 0; v < n * n; ++v)
+  {
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    grid.Values.push_back(static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53);
+  }
+  return grid;
+}
+
+// The PL saddle multiplicity of every interior vertex of a grid field triangulated along the
+// (i+1,j)-(i,j+1) diagonals, ties by vertex id: half the number of changes between lower and
+// upper neighbours around the link, less one.
+std::vector<int> InteriorSaddleMultiplicity(const std::vector<double>& f, int nx, int ny)
+{
+  // The six neighbours in turning order: E, N, NW, W, S, SE.
+  const int di[6] = { 1, 0, -1, -1, 0, 1 }, dj[6] = { 0, 1, 1, 0, -1, -1 };
+  std::vector<int> multiplicity(f.size(), 0);
+  for (int j = 1; j + 1 < ny; ++j)
+  {
+    for (int i = 1; i + 1 < nx; ++i)
+    {
+      const int v = j * nx + i;
+      bool below[6];
+      for (int k = 0; k < 6; ++k)
+      {
+        const int w = (j + dj[k]) * nx + i + di[k];
+        below[k] = f[w] < f[v] || (f[w] == f[v] && w < v);
+      }
+      int changes = 0;
+      for (int k = 0; k < 6; ++k)
+      {
+        changes += below[k] != below[(k + 1) % 6] ? 1 : 0;
+      }
+      multiplicity[v] = std::max(0, changes / 2 - 1);
+    }
+  }
+  return multiplicity;
+}
+
+// Pairs saddles (one entry per unit of multiplicity, by vertex) of `a` with those of `b` on the
+// same vertex or one of the 8 around it, within the longest edge (Kuhn's augmenting paths);
+// returns, per entry of a, its partner in b or -1.
+std::vector<int> PairNeighbouringSaddles(const std::vector<int>& a, const std::vector<int>& b, int nx)
+{
+  auto near = [nx](int v, int w) {
+    const int di = w % nx - v % nx, dj = w / nx - v / nx;
+    return std::abs(di) <= 1 && std::abs(dj) <= 1; // within one edge's length (the verdict's tolerance)
+  };
+  std::vector<int> partnerOfA(a.size(), -1), partnerOfB(b.size(), -1);
+  for (std::size_t start = 0; start < a.size(); ++start)
+  {
+    std::vector<char> visited(b.size(), 0);
+    std::function<bool(std::size_t)> augment = [&](std::size_t x) {
+      for (std::size_t y = 0; y < b.size(); ++y)
+      {
+        if (!visited[y] && near(a[x], b[y]))
+        {
+          visited[y] = 1;
+          if (partnerOfB[y] < 0 || augment(static_cast<std::size_t>(partnerOfB[y])))
+          {
+            partnerOfA[x] = static_cast<int>(y);
+            partnerOfB[y] = static_cast<int>(x);
+            return true;
+          }
+        }
+      }
+      return false;
+    };
+    augment(start);
+  }
+  return partnerOfA;
+}
+} // namespace
+
+TEST_CASE(SaddlesStayOnTheirNodesOnWeakNoise)
+{
+  // Uniform noise simplified at 0.5 and 1 %: hundreds of saddles, among them monkey saddles
+  // (two saddles of the complex on one vertex) and saddles a vertex apart. The sampled
+  // reconstruction must have each interior saddle of the complex on its vertex or one of the 8
+  // around it (the verdict's tolerance, the longest edge), and no other: checked here with the PL
+  // multiplicity of every vertex and one-to-one pairings, away from the boundary rows (saddles
+  // there trade places with the complex's boundary rule, not counted here). Before the carving
+  // of a missing saddle went on to the saddles each carve takes away, and a monkey saddle's
+  // 1-cells shared a link vertex per sector, 18 of these 24 fields passed (verdict 1 on 16).
+  int cases = 0, kept = 0, monkeys = 0;
+  for (int n : { 24, 32 })
+  {
+    for (double percent : { 0.5, 1.0 })
+    {
+      for (std::uint64_t seed : { 1, 2, 3, 4, 5, 6 })
+      {
+        Pipeline p;
+        std::string error;
+        CHECK(RunStages1To3(UniformNoise(n, seed), percent, 4, p, error));
+        FieldReconstruction reconstruction;
+        FieldReconstructionReport report;
+        CHECK(reconstruction.Run(p.Field, p.Simplified.Complex, p.Smoothed, report, error));
+        auto awayFromBoundary = [n](int v) { return v % n >= 4 && v % n < n - 4 && v / n >= 4 && v / n < n - 4; };
+        std::vector<int> wanted, found;
+        for (const CriticalPoint& cp : p.Simplified.Complex.CriticalPoints)
+        {
+          if (cp.MorseIndex == 1 && !cp.OnBoundary)
+          {
+            wanted.push_back(static_cast<int>(cp.Vertex));
+          }
+        }
+        const std::vector<int> multiplicity = InteriorSaddleMultiplicity(report.Values, n, n);
+        for (int v = 0; v < n * n; ++v)
+        {
+          found.insert(found.end(), multiplicity[v], v);
+          monkeys += multiplicity[v] > 1 ? 1 : 0;
+        }
+        // Each side's saddles away from the boundary rows, paired with all of the other side's
+        // (saddles near the boundary trade places with the boundary rule's).
+        int unpaired = 0;
+        for (const auto* side : { &wanted, &found })
+        {
+          const std::vector<int>& other = side == &wanted ? found : wanted;
+          std::vector<int> inside;
+          std::copy_if(side->begin(), side->end(), std::back_inserter(inside), awayFromBoundary);
+          const std::vector<int> partner = PairNeighbouringSaddles(inside, other, n);
+          for (std::size_t i = 0; i < inside.size(); ++i)
+          {
+            if (partner[i] < 0)
+            {
+              std::printf("    %s saddle at (%d, %d) with none of the %s within one edge\n",
+                side == &wanted ? "complex" : "sampled", inside[i] % n, inside[i] / n,
+                side == &wanted ? "sampling's" : "complex's");
+              ++unpaired;
+            }
+          }
+        }
+        ++cases;
+        kept += unpaired == 0 ? 1 : 0;
+        if (unpaired > 0 || !report.Verified)
+        {
+          std::printf("  noise %d x %d seed %d at %g %%: %d saddles off their nodes, verdict %d\n", n, n,
+            static_cast<int>(seed), percent, unpaired, report.Verified ? 1 : 0);
+        }
+        CHECK_EQ(unpaired, 0);
+        CHECK(report.Verified);
+      }
+    }
+  }
+  std::printf("  %d of %d noise fields with every interior saddle on its node; %d monkey saddles sampled\n", kept,
+    cases, monkeys);
+  CHECK(monkeys > 0); // the case exercises what it tests
 }
 
 int main()

@@ -1,8 +1,10 @@
 // A minimal test harness: CHECK records failures and the run ends with the plain closing line
-// "N passed, N failed" that CI reads.
+// "N passed, N failed" that CI reads. TOPOSPLINE_TEST_CASE=<name> runs only the test cases whose
+// names contain <name> (to look at one while working on it).
 #pragma once
 
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <string>
 #include <vector>
@@ -24,8 +26,13 @@ inline int RunAll()
 {
   Registry& r = Registry::Get();
   int passed = 0, failed = 0;
+  const char* only = std::getenv("TOPOSPLINE_TEST_CASE");
   for (auto& test : r.Tests)
   {
+    if (only && test.first.find(only) == std::string::npos)
+    {
+      continue;
+    }
     r.CurrentFailures = 0;
     test.second();
     if (r.CurrentFailures == 0)
