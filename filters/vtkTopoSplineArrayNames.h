@@ -106,6 +106,7 @@ constexpr const char* PersistenceCurveCriticalPoints = "PersistenceCurveCritical
 constexpr const char* CurveSegments = "CurveSegments";
 constexpr const char* NumberOfPieces = "NumberOfPieces";
 constexpr const char* ShortPieces = "ShortPieces";
+constexpr const char* SampledSamplesPerSegment = "SampledSamplesPerSegment";
 constexpr const char* ErasedLoops = "ErasedLoops";
 constexpr const char* DroppedCuts = "DroppedCuts";
 constexpr const char* AdaptedPieces = "AdaptedPieces";

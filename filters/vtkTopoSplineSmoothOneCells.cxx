@@ -27,6 +27,7 @@
 
 #include <algorithm>
 #include <map>
+#include <string>
 
 namespace names = vtkTopoSplineArrayNames;
 using topospline::Index;
@@ -127,11 +128,38 @@ int vtkTopoSplineSmoothOneCells::RequestData(
   // The input's blocks pass through; the smoothed 1-cells are added.
   output->SetNumberOfBlocks(names::SampledOneCellsIndex + 1);
   vtkTopoSplineWireFormat::PassBlocks(input, names::SmoothedOneCellsIndex, output);
-  vtkTopoSplineWireFormat::WriteSmoothedOneCells(complex, result, this->SamplesPerSegment, output);
+  const int samples = this->SamplesWithinBudget(complex, result);
+  vtkTopoSplineWireFormat::WriteSmoothedOneCells(complex, result, samples, output);
 
   WriteSmoothingReport(result, this->CurveSegments, output->GetFieldData());
+  vtkTopoSplineDomainConversion::AddFieldNumbers(
+    output->GetFieldData(), names::SampledSamplesPerSegment, { static_cast<double>(samples) });
   this->UpdateProgress(1.0);
   return 1;
+}
+
+// SamplesPerSegment, or fewer where the display block would exceed its point budget (0: the
+// block is left empty), with a warning.
+int vtkTopoSplineSmoothOneCells::SamplesWithinBudget(
+  const topospline::MorseSmaleComplex& complex, const topospline::OneCellSmoothingResult& result)
+{
+  const vtkIdType wanted = vtkTopoSplineWireFormat::SampledOneCellPoints(complex, result, this->SamplesPerSegment);
+  if (wanted <= this->MaximumSampledPoints)
+  {
+    return this->SamplesPerSegment;
+  }
+  int samples = static_cast<int>(static_cast<double>(this->SamplesPerSegment) * this->MaximumSampledPoints / wanted);
+  if (samples < 1 || vtkTopoSplineWireFormat::SampledOneCellPoints(complex, result, samples) > this->MaximumSampledPoints)
+  {
+    samples = 0;
+  }
+  vtkWarningMacro("Smooth 1-Cells: the SampledOneCells display block would hold "
+    << wanted << " points at " << this->SamplesPerSegment << " per segment (merged 1-cells share pieces), more than "
+    << this->MaximumSampledPoints << "; "
+    << (samples > 0 ? "sampled at " + std::to_string(samples) + " per segment instead"
+                    : std::string("left empty (the Bezier block has every curve)"))
+    << ".");
+  return samples;
 }
 
 // Not errors, but changes a user should know of: critical values spread apart, crossings left.
@@ -163,5 +191,6 @@ void vtkTopoSplineSmoothOneCells::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "CurveSegments: " << this->CurveSegments << "\n"
-     << indent << "SamplesPerSegment: " << this->SamplesPerSegment << "\n";
+     << indent << "SamplesPerSegment: " << this->SamplesPerSegment << "\n"
+     << indent << "MaximumSampledPoints: " << this->MaximumSampledPoints << "\n";
 }

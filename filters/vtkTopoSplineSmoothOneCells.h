@@ -44,9 +44,18 @@ public:
   //@}
 
   //@{
-  /** Points per Bezier segment of the "SampledOneCells" polylines. */
+  /** Points per Bezier segment of the "SampledOneCells" polylines (fewer, with a warning, where
+   * they would exceed MaximumSampledPoints; field data SampledSamplesPerSegment says how many). */
   vtkSetClampMacro(SamplesPerSegment, int, 1, 1000);
   vtkGetMacro(SamplesPerSegment, int);
+  //@}
+
+  //@{
+  /** The "SampledOneCells" display block's point budget (default 2^23): on a large noisy
+   * complex merged 1-cells run through thousands of pieces each, and sampling every one at 16
+   * points per segment took more than 13 GB (1000 x 1000 noise at 25 %, k = 29). */
+  vtkSetClampMacro(MaximumSampledPoints, vtkIdType, 1, VTK_ID_MAX);
+  vtkGetMacro(MaximumSampledPoints, vtkIdType);
   //@}
 
 protected:
@@ -58,9 +67,12 @@ protected:
 
   int CurveSegments = 4;
   int SamplesPerSegment = 16;
+  vtkIdType MaximumSampledPoints = vtkIdType(1) << 23;
 
 private:
   void ReportAdjustments(
+    const topospline::MorseSmaleComplex& complex, const topospline::OneCellSmoothingResult& result);
+  int SamplesWithinBudget(
     const topospline::MorseSmaleComplex& complex, const topospline::OneCellSmoothingResult& result);
 
   vtkTopoSplineSmoothOneCells(const vtkTopoSplineSmoothOneCells&) = delete;

@@ -593,6 +593,10 @@ vtkSmartPointer<vtkPolyData> SampledOneCellsBlock(const topospline::MorseSmaleCo
   const topospline::OneCellSmoothingResult& smoothed, int samplesPerSegment, const conversion::DomainPlane& plane)
 {
   auto sampled = vtkSmartPointer<vtkPolyData>::New();
+  if (samplesPerSegment <= 0)
+  {
+    return sampled;
+  }
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   vtkNew<vtkCellArray> lines;
@@ -654,6 +658,22 @@ void WriteSmoothedOneCells(const topospline::MorseSmaleComplex& complex,
   output->SetBlock(names::SampledOneCellsIndex, SampledOneCellsBlock(complex, smoothed, samplesPerSegment, plane));
   output->GetMetaData(static_cast<unsigned int>(names::SampledOneCellsIndex))
     ->Set(vtkCompositeDataSet::NAME(), names::SampledOneCellsBlock);
+}
+
+vtkIdType SampledOneCellPoints(
+  const topospline::MorseSmaleComplex& complex, const topospline::OneCellSmoothingResult& smoothed, int samplesPerSegment)
+{
+  vtkIdType points = 0;
+  for (std::size_t a = 0; a < complex.OneCells.size() && a < smoothed.PiecesOfOneCell.size(); ++a)
+  {
+    vtkIdType segments = 0;
+    for (Index p : smoothed.PiecesOfOneCell[a])
+    {
+      segments += smoothed.Pieces[p].Curve.Segments;
+    }
+    points += 1 + segments * samplesPerSegment;
+  }
+  return points;
 }
 
 bool ReadSmoothedOneCells(vtkMultiBlockDataSet* input, const topospline::MorseSmaleComplex& complex,

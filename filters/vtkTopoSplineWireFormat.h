@@ -11,6 +11,8 @@
 #include "MorseSmaleComplex.h" // core
 #include "OneCellSmoothing.h"  // core
 
+#include <vtkType.h>
+
 #include <string>
 #include <vector>
 
@@ -41,9 +43,13 @@ void WriteJunctionPoints(const topospline::MorseSmaleComplex& complex,
 
 // Blocks 5 and 6: every piece as VTK_BEZIER_CURVE cells of degree 3 with their heights, the
 // pieces of every 1-cell, and (block 6) every 1-cell sampled at `samplesPerSegment` points per
-// Bezier segment.
+// Bezier segment (0: block 6 left empty).
 void WriteSmoothedOneCells(const topospline::MorseSmaleComplex& complex,
   const topospline::OneCellSmoothingResult& smoothed, int samplesPerSegment, vtkMultiBlockDataSet* output);
+// The points block 6 takes at `samplesPerSegment` per Bezier segment: a piece is sampled once
+// for every 1-cell that runs through it (merged 1-cells share pieces).
+vtkIdType SampledOneCellPoints(
+  const topospline::MorseSmaleComplex& complex, const topospline::OneCellSmoothingResult& smoothed, int samplesPerSegment);
 // Returns false with a message when block 5 is absent or does not match `complex`.
 bool ReadSmoothedOneCells(vtkMultiBlockDataSet* input, const topospline::MorseSmaleComplex& complex,
   topospline::OneCellSmoothingResult& smoothed, std::string& error);

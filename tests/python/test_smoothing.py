@@ -1,7 +1,8 @@
 """Stage 3 through ParaView: strictly increasing heights checked on their Bezier ordinates,
 exact end values and zero end slopes, one value per junction point shared by all 1-cells
 through it, L1 errors, no crossings, on the synthetic fields and every catalog data set at
-2, 5 and 25 % with k = 4 and 7."""
+2, 5 and 25 % with k = 4 and 7; the display block's point budget (coarser samples, or an empty
+block, with stage 4 unaffected)."""
 import numpy as np
 from paraview.simple import *
 from paraview import servermanager as sm
@@ -93,4 +94,33 @@ for name, source in inputs:
             checks.equal(crossings, 0, "%s: smoothed 1-cells do not cross" % label)
             print("%s: adapted %d pieces, L1 %.6g (unconstrained %.6g)" % (label, adapted, l1, free), flush=True)
             Delete(smooth)
+
+# The display block's point budget: sampled more coarsely above it, left empty when even one
+# point per segment is too many; stage 4 reads the Bezier block and does not notice.
+shepard = ShepardField()
+simplified = SimplifyMorseSmaleComplex(Input=MorseSmaleComplex(Input=shepard), PersistenceThreshold=5)
+full = Smooth1Cells(Input=simplified, CurveSegments=4)
+full_data = sm.Fetch(full)
+full_points = full_data.GetBlock(6).GetNumberOfPoints()
+lines = full_data.GetBlock(6).GetNumberOfCells()
+checks.equal(int(full_data.GetFieldData().GetArray("SampledSamplesPerSegment").GetValue(0)), 16,
+             "budget: 16 samples per segment within the default budget")
+for budget, expect_empty in ((full_points // 3, False), (10, True)):
+    small = Smooth1Cells(Input=simplified, CurveSegments=4, MaximumSampledPoints=budget)
+    data = sm.Fetch(small)
+    used = int(data.GetFieldData().GetArray("SampledSamplesPerSegment").GetValue(0))
+    block = data.GetBlock(6)
+    if expect_empty:
+        checks.check(used == 0 and block.GetNumberOfPoints() == 0, "budget %d: block left empty" % budget)
+    else:
+        checks.check(0 < used < 16 and block.GetNumberOfPoints() <= budget and block.GetNumberOfCells() == lines,
+                     "budget %d: %d samples per segment, %d points, a line per 1-cell" % (budget, used, block.GetNumberOfPoints()))
+        c = tt.fetch_complex(small)
+        check_smoothing(c, data, "budget %d" % budget, 4)
+    recon = Reconstruct2Cells(Input=small)
+    recon.UpdatePipeline()
+    verdict = sm.Fetch(recon).GetFieldData().GetArray("TopologyVerified").GetValue(0)
+    checks.equal(int(verdict), 1, "budget %d: stage 4 verifies on the coarser display block" % budget)
+    Delete(recon)
+    Delete(small)
 checks.finish()
