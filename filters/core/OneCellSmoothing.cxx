@@ -657,6 +657,7 @@ public:
     this->Flat.resize(2 * this->Offset[count]);
     this->Moved.assign(count, 0);
     this->Resampled.clear();
+    this->Extra.clear();
     this->Parallel(0, count, [this](Index begin, Index end) {
       for (Index p = begin; p < end; ++p)
       {

@@ -778,6 +778,14 @@ bool CheckBorderParameters(CellBoundary& cell, std::string& error)
   return true;
 }
 
+// A walk of boundary samples, read (ReadBoundarySamples) and its (u, v) checked
+// (CheckBorderParameters): the given one, and each walk rebuilt from it.
+bool ReadBoundaryWalk(const std::vector<double>& boundaryPoints, const std::vector<double>& boundaryParameters,
+  CellBoundary& cell, std::string& error)
+{
+  return ReadBoundarySamples(boundaryPoints, boundaryParameters, cell, error) && CheckBorderParameters(cell, error);
+}
+
 // The outer loop must be a simple polygon (exact predicates: touching or crossing edges and
 // collinear, zero-area loops are all "not simple"; repeated points were refused already unless
 // they are on slits). Sets its orientation and area.
@@ -1229,7 +1237,7 @@ bool TwoCellParameterization::Parameterize(
     if (SampleOverlapsAlike(cell, alikePoints, alikeParameters))
     {
       CellBoundary alike;
-      if (!ReadBoundarySamples(alikePoints, alikeParameters, alike, ignored) || !CheckBorderParameters(alike, ignored))
+      if (!ReadBoundaryWalk(alikePoints, alikeParameters, alike, ignored))
       {
         return false;
       }
@@ -1269,17 +1277,16 @@ bool TwoCellParameterization::Parameterize(
       return true;
     }
     CellBoundary without;
-    if (!ReadBoundarySamples(withoutPoints, withoutParameters, without, error) ||
-      !CheckBorderParameters(without, error) || !AnalyzeBoundary(without.XY, without.Count, without.Graph, error) ||
-      !CheckOuterLoop(without, error))
+    if (!ReadBoundaryWalk(withoutPoints, withoutParameters, without, error) ||
+      !AnalyzeBoundary(without.XY, without.Count, without.Graph, error) || !CheckOuterLoop(without, error))
     {
       return false;
     }
     cell = without;
     return true;
   };
-  if (!ReadBoundarySamples(boundaryPoints, boundaryParameters, cell, error) || !CheckBorderParameters(cell, error) ||
-    !analyze() || !CheckOuterLoop(cell, error) || !dropOutsideSlits() ||
+  if (!ReadBoundaryWalk(boundaryPoints, boundaryParameters, cell, error) || !analyze() ||
+    !CheckOuterLoop(cell, error) || !dropOutsideSlits() ||
     !TriangulateCell(cell, InteriorEdgeLength(cell, this->TargetEdgeLength, this->MaximumVertices), this->ShapeBound,
       this->MaximumFixRounds, mesh, error))
   {

@@ -35,28 +35,35 @@ using namespace topospline;
 
 namespace
 {
-// Interior PL minima and maxima of a grid field triangulated along the (i+1,j)-(i,j+1)
-// diagonals, ties broken by vertex id (as the simulation of simplicity of stage 1).
+// Which of the six neighbours of interior vertex (i, j), in turning order (E, N, NW, W, S, SE),
+// lie below it, for a grid field triangulated along the (i+1,j)-(i,j+1) diagonals, ties broken
+// by vertex id (as the simulation of simplicity of stage 1).
+std::array<bool, 6> LowerLink(const std::vector<double>& f, int nx, int i, int j)
+{
+  const int di[6] = { 1, 0, -1, -1, 0, 1 }, dj[6] = { 0, 1, 1, 0, -1, -1 };
+  const int v = j * nx + i;
+  std::array<bool, 6> below;
+  for (int k = 0; k < 6; ++k)
+  {
+    const int w = (j + dj[k]) * nx + i + di[k];
+    below[k] = f[w] < f[v] || (f[w] == f[v] && w < v);
+  }
+  return below;
+}
+
+// Interior PL minima and maxima of a grid field (LowerLink).
 std::array<int, 2> InteriorExtrema(const PlanarScalarField& field)
 {
   const int nx = field.GridDimensions[0], ny = field.GridDimensions[1];
-  const auto& f = field.Values;
-  const auto lower = [&](int a, int b) { return f[a] < f[b] || (f[a] == f[b] && a < b); };
-  // The six neighbours of (i, j) in that triangulation.
-  const int di[6] = { 1, -1, 0, 0, 1, -1 }, dj[6] = { 0, 0, 1, -1, -1, 1 };
   std::array<int, 2> counts{ 0, 0 };
   for (int j = 1; j + 1 < ny; ++j)
   {
     for (int i = 1; i + 1 < nx; ++i)
     {
-      const int v = j * nx + i;
-      int below = 0;
-      for (int k = 0; k < 6; ++k)
-      {
-        below += lower((j + dj[k]) * nx + i + di[k], v) ? 1 : 0;
-      }
-      counts[0] += below == 0 ? 1 : 0;
-      counts[1] += below == 6 ? 1 : 0;
+      const std::array<bool, 6> below = LowerLink(field.Values, nx, i, j);
+      const auto lower = std::count(below.begin(), below.end(), true);
+      counts[0] += lower == 0 ? 1 : 0;
+      counts[1] += lower == 6 ? 1 : 0;
     }
   }
   return counts;
@@ -392,31 +399,22 @@ GridField UniformNoise(int n, std::uint64_t seed)
   return grid;
 }
 
-// The PL saddle multiplicity of every interior vertex of a grid field triangulated along the
-// (i+1,j)-(i,j+1) diagonals, ties by vertex id: half the number of changes between lower and
-// upper neighbours around the link, less one.
+// The PL saddle multiplicity of every interior vertex: half the number of changes between lower
+// and upper neighbours around its link (LowerLink), less one.
 std::vector<int> InteriorSaddleMultiplicity(const std::vector<double>& f, int nx, int ny)
 {
-  // The six neighbours in turning order: E, N, NW, W, S, SE.
-  const int di[6] = { 1, 0, -1, -1, 0, 1 }, dj[6] = { 0, 1, 1, 0, -1, -1 };
   std::vector<int> multiplicity(f.size(), 0);
   for (int j = 1; j + 1 < ny; ++j)
   {
     for (int i = 1; i + 1 < nx; ++i)
     {
-      const int v = j * nx + i;
-      bool below[6];
-      for (int k = 0; k < 6; ++k)
-      {
-        const int w = (j + dj[k]) * nx + i + di[k];
-        below[k] = f[w] < f[v] || (f[w] == f[v] && w < v);
-      }
+      const std::array<bool, 6> below = LowerLink(f, nx, i, j);
       int changes = 0;
       for (int k = 0; k < 6; ++k)
       {
         changes += below[k] != below[(k + 1) % 6] ? 1 : 0;
       }
-      multiplicity[v] = std::max(0, changes / 2 - 1);
+      multiplicity[j * nx + i] = std::max(0, changes / 2 - 1);
     }
   }
   return multiplicity;
