@@ -5,7 +5,8 @@
 //
 // Solver: the alternating direction method of multipliers in the splitting of OSQP (Stellato et
 // al., Math. Prog. Comp. 12, 2020): one sparse LDLT factorization of H + sigma I + rho C^T C
-// (Eigen's SimplicialLDLT), then cheap iterations, rho rebalanced (and refactored) a few times.
+// (Eigen's SimplicialLDLT), then cheap iterations from x_f, rho rebalanced (and refactored) a few
+// times.
 // ADMM satisfies the rows only up to a tolerance, so the answer is then pulled towards x_f:
 // x = x_f + t (x_admm - x_f) with the largest t in [0, 1] that keeps every row at or above its
 // bound. The rows are linear, so t is a minimum over rows in closed form, and the result is
@@ -29,13 +30,18 @@ struct ConstrainedLeastSquaresOptions
   // scaled to unit norm) and the dual residual is small.
   double PrimalTolerance = 1e-5;
   double DualTolerance = 1e-5;
+
+  // Iterations at which rho is rebalanced (when the residuals are out of balance by more than
+  // 5x): the first, then every interval after it. Multiples of 10, when the residuals are read.
+  int FirstRhoUpdate = 10;
+  int RhoUpdateInterval = 30;
 };
 
 struct ConstrainedLeastSquaresReport
 {
   int Iterations = 0;
   bool Converged = false;       // the ADMM tolerances were met
-  bool UnconstrainedFeasible = false; // the unconstrained minimizer already met every row
+  bool UnconstrainedFeasible = false; // the unconstrained minimizer met every row: it is the answer
   double PulledBack = 0;        // 1 - t: how far the answer was pulled towards x_f
   double Objective = 0;         // at the returned x
   double FeasibleObjective = 0; // at x_f

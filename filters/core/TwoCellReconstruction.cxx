@@ -7,11 +7,14 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <numeric>
 #include <sstream>
+#include <unordered_map>
 
 namespace topospline
 {
@@ -1048,20 +1051,29 @@ std::vector<PlanarBezierTriangle> TwoCellReconstruction::PlanarBezierTriangles(I
   const auto& toControl = LatticeToControl();
   const std::vector<SurfaceBezierTriangle> patches = cell.Surface.GetBezierTriangles();
   result.resize(patches.size());
+  // The (u, v) of a polynomial triangle's control points are its lattice points: for the Sibson
+  // split of an N x N grid, points of the (6N + 1)^2 lattice, most of them shared by two to
+  // eight triangles. Each is mapped back to (x, y) once.
+  const double steps = 6.0 * cell.Surface.GetGridSize();
+  std::unordered_map<std::uint64_t, std::array<double, 2>> mapped;
+  mapped.reserve(5 * patches.size());
+  const auto inverse = [&](double u, double v) {
+    const auto key = (static_cast<std::uint64_t>(std::llround(std::clamp(u, 0.0, 1.0) * steps)) << 32) |
+      static_cast<std::uint64_t>(std::llround(std::clamp(v, 0.0, 1.0) * steps));
+    auto [it, added] = mapped.try_emplace(key, std::array<double, 2>{ 0, 0 });
+    if (added && !cell.Parameterization.InverseEvaluate(u, v, it->second.data()))
+    {
+      // Only rounding can put a lattice point outside the square's mesh; clamp it in.
+      cell.Parameterization.InverseEvaluate(std::clamp(u, 0.0, 1.0), std::clamp(v, 0.0, 1.0), it->second.data());
+    }
+    return it->second;
+  };
   Eigen::Matrix<double, 10, 2> lattice;
   for (std::size_t t = 0; t < patches.size(); ++t)
   {
-    // The (u, v) of a polynomial triangle's control points are its lattice points.
     for (int m = 0; m < 10; ++m)
     {
-      double xy[2] = { 0, 0 };
-      if (!cell.Parameterization.InverseEvaluate(patches[t].Points[m][0], patches[t].Points[m][1], xy))
-      {
-        // Only rounding can put a lattice point outside the square's mesh; clamp it in.
-        const double u = std::clamp(patches[t].Points[m][0], 0.0, 1.0);
-        const double v = std::clamp(patches[t].Points[m][1], 0.0, 1.0);
-        cell.Parameterization.InverseEvaluate(u, v, xy);
-      }
+      const std::array<double, 2> xy = inverse(patches[t].Points[m][0], patches[t].Points[m][1]);
       lattice(m, 0) = xy[0];
       lattice(m, 1) = xy[1];
     }
