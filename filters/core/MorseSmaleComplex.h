@@ -75,10 +75,12 @@ struct MorseSmaleComplex
   std::vector<Index> AscendingManifold;  // id of the minimum it flows down to
   std::vector<Index> DescendingManifold; // id of the maximum it flows up to
   std::vector<Index> TwoCellId;
-  // Vertices of boundary-curve minima that simplification cancelled with the interior saddle
-  // on their own vertex (a zero-persistence pair of stage 1's boundary rule): the boundary
-  // 1-cells turn inwards there. Stage 1 extracts that pair again from any field that falls
-  // into the domain at such a vertex, so a topology check expects it (TopologyVerification).
+  // Vertices of the boundary curve, on no critical point, where descending 1-cells come down
+  // the curve from both sides and turn inwards (set by simplification from the 1-cells'
+  // routes; boundary minima cancelled with the interior saddle on their own vertex start out
+  // as such). Every monotone reconstruction falls into the domain there, and stage 1 extracts a
+  // minimum and a saddle on such a vertex, so a topology check expects them
+  // (TopologyVerification).
   std::vector<Index> BoundaryJunctions;
   // The coordinates stages 3 and 4 work in (PlanarFrame): set by stage 1 from the domain's
   // edges, kept by simplification.

@@ -8,6 +8,7 @@
 #include <limits>
 #include <numeric>
 #include <queue>
+#include <unordered_map>
 
 namespace topospline
 {
@@ -298,6 +299,7 @@ bool MorseSmaleComplexSimplification::ComputeHierarchy(const MorseSmaleComplex& 
 
   this->IndexOneCellsBySaddle();
   this->FindBoundaryCurve();
+  this->IndexBoundaryCurveEdges();
   if (!this->FindSaddleCorners(error))
   {
     return false;
@@ -358,6 +360,31 @@ void MorseSmaleComplexSimplification::FindBoundaryCurve()
       this->OnBoundaryCurve[this->ArcExtremum[this->SaddleOneCells[s][1]]] = 1;
     }
   }
+}
+
+//------------------------------------------------------------------------------
+void MorseSmaleComplexSimplification::IndexBoundaryCurveEdges()
+{
+  const auto& cps = this->Input.CriticalPoints;
+  this->BoundaryCurveEdges.clear();
+  for (Index s = 0; s < static_cast<Index>(cps.size()); ++s)
+  {
+    if (cps[s].MorseIndex != 1 || !this->OnBoundaryCurve[s])
+    {
+      continue;
+    }
+    for (int k = 0; k < 2; ++k)
+    {
+      const std::vector<Index>& path = this->Input.OneCells[this->SaddleOneCells[s][k]].MeshCells;
+      for (std::size_t i = 1; i < path.size(); ++i)
+      {
+        this->BoundaryCurveEdges.push_back({ std::min(path[i - 1], path[i]), std::max(path[i - 1], path[i]) });
+      }
+    }
+  }
+  std::sort(this->BoundaryCurveEdges.begin(), this->BoundaryCurveEdges.end());
+  this->BoundaryCurveEdges.erase(
+    std::unique(this->BoundaryCurveEdges.begin(), this->BoundaryCurveEdges.end()), this->BoundaryCurveEdges.end());
 }
 
 //------------------------------------------------------------------------------
@@ -1086,8 +1113,81 @@ bool MorseSmaleComplexSimplification::Simplify(
   }
   this->BuildMergedTwoCells(replay, output.Complex);
   this->RelabelVertices(replay, output.Complex);
+  output.Complex.BoundaryJunctions = this->FindBoundaryJunctions(output.Complex);
   output.JunctionPoints = DetectJunctionPoints(output.Complex);
   return true;
+}
+
+//------------------------------------------------------------------------------
+// A boundary junction is a vertex of the boundary curve, on no critical point, where descending
+// 1-cells come down the curve from both of its neighbours and go on into the domain: every
+// monotone reconstruction has a minimum of the boundary curve there with a lower interior
+// neighbour, which stage 1's boundary rule extracts as a minimum and a saddle on that vertex.
+// Read from the simplified 1-cells' routes. The boundary minima cancelled with the interior
+// saddle on their own vertex (ComputeSequence) start out as such junctions, but later
+// cancellations can reroute a 1-cell straight along the curve through one (it then rises
+// through it: no minimum), and two merged 1-cells can meet at a vertex of the curve that was
+// no minimum of f (stress crops #109 and #176 had one of each).
+std::vector<Index> MorseSmaleComplexSimplification::FindBoundaryJunctions(const MorseSmaleComplex& out) const
+{
+  const auto onCurve = [this](Index a, Index b) {
+    return std::binary_search(this->BoundaryCurveEdges.begin(), this->BoundaryCurveEdges.end(),
+      std::array<Index, 2>{ std::min(a, b), std::max(a, b) });
+  };
+  std::vector<Index> critical;
+  for (const CriticalPoint& cp : out.CriticalPoints)
+  {
+    critical.push_back(cp.Vertex);
+  }
+  std::sort(critical.begin(), critical.end());
+  // Per vertex: the neighbours along the curve that a 1-cell comes down from (up to two), and
+  // whether a 1-cell comes into it along the curve (it then rises through the vertex).
+  struct Arrivals
+  {
+    std::array<Index, 2> From{ InvalidIndex, InvalidIndex };
+    bool AlongCurve = false;
+  };
+  std::unordered_map<Index, Arrivals> arrivals;
+  for (const OneCell& oneCell : out.OneCells)
+  {
+    if (oneCell.Type != OneCell::Descending)
+    {
+      continue;
+    }
+    // From the minimum up to the saddle: path[i + 1] lies above path[i].
+    const std::vector<Index>& path = oneCell.MeshCells;
+    for (std::size_t i = 1; i + 1 < path.size(); ++i)
+    {
+      const Index v = path[i];
+      const bool comesDown = onCurve(v, path[i + 1]);
+      const bool goesDown = onCurve(v, path[i - 1]);
+      if (!comesDown && !goesDown)
+      {
+        continue;
+      }
+      Arrivals& a = arrivals[v];
+      a.AlongCurve = a.AlongCurve || goesDown;
+      const Index above = path[i + 1];
+      if (comesDown && a.From[0] == InvalidIndex)
+      {
+        a.From[0] = above;
+      }
+      else if (comesDown && a.From[0] != above)
+      {
+        a.From[1] = above; // a vertex of the curve has two neighbours on it
+      }
+    }
+  }
+  std::vector<Index> junctions;
+  for (const auto& [v, a] : arrivals)
+  {
+    if (a.From[1] != InvalidIndex && !a.AlongCurve && !std::binary_search(critical.begin(), critical.end(), v))
+    {
+      junctions.push_back(v);
+    }
+  }
+  std::sort(junctions.begin(), junctions.end());
+  return junctions;
 }
 
 //------------------------------------------------------------------------------
@@ -1123,20 +1223,13 @@ MorseSmaleComplexSimplification::Replay MorseSmaleComplexSimplification::ReplayC
   replay.Alive.assign(nCP, 1);
   replay.Forward.resize(nCP);
   std::iota(replay.Forward.begin(), replay.Forward.end(), 0);
-  out.BoundaryJunctions = in.BoundaryJunctions;
   out.Frame = in.Frame;
   for (Index j = 0; j < performed; ++j)
   {
     const Step& step = this->Steps[j];
     replay.Alive[step.Saddle] = replay.Alive[step.Extremum] = 0;
     replay.Forward[step.Extremum] = step.Survivor;
-    // The only boundary-interior cancellations ComputeSequence performs are boundary junctions.
-    if (this->OnBoundaryCurve[step.Extremum] != this->OnBoundaryCurve[step.Saddle])
-    {
-      out.BoundaryJunctions.push_back(cps[step.Extremum].Vertex);
-    }
   }
-  std::sort(out.BoundaryJunctions.begin(), out.BoundaryJunctions.end());
   replay.Position.assign(nCP, InvalidIndex);
   for (Index i = 0; i < nCP; ++i)
   {

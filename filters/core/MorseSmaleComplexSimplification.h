@@ -147,6 +147,7 @@ private:
   // ComputeHierarchy, in order: index the input, then the elder rule and the greedy sequence.
   void IndexOneCellsBySaddle();
   void FindBoundaryCurve();
+  void IndexBoundaryCurveEdges();
   bool FindSaddleCorners(std::string& error);
   void BuildForests();
   void AddDescendingPath(Index oneCell, std::vector<Index>& nodeOfVertex);
@@ -170,6 +171,7 @@ private:
   void MergeTwoCells(Replay& replay) const;
   void BuildMergedTwoCells(Replay& replay, MorseSmaleComplex& out) const;
   void RelabelVertices(Replay& replay, MorseSmaleComplex& out) const;
+  std::vector<Index> FindBoundaryJunctions(const MorseSmaleComplex& out) const;
 
   bool Computed = false;
   MorseSmaleComplex Input;
@@ -188,6 +190,9 @@ private:
   std::vector<std::array<Index, 4>> SaddleOneCells;
   std::vector<Index> ArcExtremum; // per input 1-cell: its minimum or maximum (position)
   std::vector<unsigned char> OnBoundaryCurve; // per critical point: a cell of the boundary curve
+  // The edges of the boundary curve (vertex pairs, lower id first, sorted): the steps of the
+  // input's boundary 1-cells, which make up the whole curve.
+  std::vector<std::array<Index, 2>> BoundaryCurveEdges;
   // Per saddle, the input 2-cell at each corner: [2 d + a] for its descending 1-cell d and
   // ascending 1-cell a (0 or 1, in SaddleOneCells order); InvalidIndex if the input has none.
   std::vector<std::array<Index, 4>> SaddleCorners;
