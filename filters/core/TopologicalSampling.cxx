@@ -1662,12 +1662,16 @@ struct CarvingGround
     return nearest;
   }
 
-  // Whether v is left to the floods and to CarveSaddleOneCells: near the 1-cell's ends (from
-  // `start` to `end`), on the boundary, or a critical point.
-  bool LeftAlone(Index v, const double* start, const double* end) const
+  // Whether v is left to the floods and to CarveSaddleOneCells: near the 1-cell's saddle end
+  // (`start`), on the boundary, or a critical point. The extremum's end is carved too (the
+  // vertices beside a wanted extremum only as far as it, see CarveOneCells): left alone within
+  // a spacing (the grid's diagonal), a valley carved down to a vertex just outside that circle
+  // could find the uncarved vertex between it and its minimum higher, a pit whose fill then
+  // drained the whole valley the other way, into a boundary junction, and took the junction's
+  // saddle with it (stress case #232).
+  bool LeftAlone(Index v, const double* start) const
   {
-    return this->DistanceTo(v, start) <= this->Spacing || this->DistanceTo(v, end) <= this->Spacing ||
-      this->Mesh.IsBoundaryVertex(v) || this->Critical.count(v);
+    return this->DistanceTo(v, start) <= this->Spacing || this->Mesh.IsBoundaryVertex(v) || this->Critical.count(v);
   }
 };
 
@@ -1734,7 +1738,6 @@ void AskAlongOneCell(const CarvingGround& ground, const SaddleOneCell& cell, con
 {
   const std::vector<double>& q = cell.Points;
   const double* start = &q[0];
-  const double* end = &q[q.size() - 3];
   Index current = cell.Saddle;
   double previous = values[cell.Saddle];
   for (std::size_t i = 0; i + 2 < q.size(); i += 3)
@@ -1747,7 +1750,7 @@ void AskAlongOneCell(const CarvingGround& ground, const SaddleOneCell& cell, con
         break;
       }
       current = nearest;
-      if (!ground.LeftAlone(current, start, end))
+      if (!ground.LeftAlone(current, start))
       {
         previous = requests.Ask(current, q[i + 2], previous, cell.Ascending, values);
       }
