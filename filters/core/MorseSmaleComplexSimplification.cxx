@@ -385,6 +385,18 @@ void MorseSmaleComplexSimplification::IndexBoundaryCurveEdges()
   std::sort(this->BoundaryCurveEdges.begin(), this->BoundaryCurveEdges.end());
   this->BoundaryCurveEdges.erase(
     std::unique(this->BoundaryCurveEdges.begin(), this->BoundaryCurveEdges.end()), this->BoundaryCurveEdges.end());
+  this->OnBoundaryCurveVertex.clear();
+  for (const auto& edge : this->BoundaryCurveEdges)
+  {
+    for (const Index v : edge)
+    {
+      if (static_cast<std::size_t>(v) >= this->OnBoundaryCurveVertex.size())
+      {
+        this->OnBoundaryCurveVertex.resize(static_cast<std::size_t>(v) + 1, 0);
+      }
+      this->OnBoundaryCurveVertex[v] = 1;
+    }
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -1159,6 +1171,12 @@ std::vector<Index> MorseSmaleComplexSimplification::FindBoundaryJunctions(const 
     for (std::size_t i = 1; i + 1 < path.size(); ++i)
     {
       const Index v = path[i];
+      // Most of a complex's 1-cells run inside: one lookup spares them the edge searches (this
+      // runs at every threshold change).
+      if (static_cast<std::size_t>(v) >= this->OnBoundaryCurveVertex.size() || !this->OnBoundaryCurveVertex[v])
+      {
+        continue;
+      }
       const bool comesDown = onCurve(v, path[i + 1]);
       const bool goesDown = onCurve(v, path[i - 1]);
       if (!comesDown && !goesDown)

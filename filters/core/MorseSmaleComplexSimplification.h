@@ -193,6 +193,7 @@ private:
   // The edges of the boundary curve (vertex pairs, lower id first, sorted): the steps of the
   // input's boundary 1-cells, which make up the whole curve.
   std::vector<std::array<Index, 2>> BoundaryCurveEdges;
+  std::vector<unsigned char> OnBoundaryCurveVertex; // per vertex id up to the largest on the curve
   // Per saddle, the input 2-cell at each corner: [2 d + a] for its descending 1-cell d and
   // ascending 1-cell a (0 or 1, in SaddleOneCells order); InvalidIndex if the input has none.
   std::vector<std::array<Index, 4>> SaddleCorners;

@@ -8,9 +8,9 @@
 
 #include <algorithm>
 #include <array>
-#include <cstdint>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numeric>
 #include <sstream>

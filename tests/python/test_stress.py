@@ -20,8 +20,9 @@ For every case it records:
   junction pairs: within three).
 It also checks that the 1-cells lie within the input's bounds (images whose extent does not
 start at 0, or at z != 0). It fails on a crash or time-out, on 1-cells outside the input, on
-boundary junction lists that differ, and on a dishonest verdict (1 while the counter disagrees or 2-cells failed); the CI subset also
-fails when the counter's counts differ from the complex's.
+boundary junction lists that differ, and on a dishonest verdict (1 while the counter disagrees
+or 2-cells failed); the CI subset also fails when the counter's counts differ from the
+complex's.
 Errors and verdicts of 0 on valid input are printed with their totals: they are still open
 (docs/StressTest.md); TOPOSPLINE_STRESS_STRICT=1 fails on those too. A run the filters refuse
 because it would not fit in memory (their error gives the estimate) is counted apart from the
