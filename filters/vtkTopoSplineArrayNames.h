@@ -110,6 +110,7 @@ constexpr const char* SampledSamplesPerSegment = "SampledSamplesPerSegment";
 constexpr const char* ErasedLoops = "ErasedLoops";
 constexpr const char* DroppedCuts = "DroppedCuts";
 constexpr const char* AdaptedPieces = "AdaptedPieces";
+constexpr const char* RiseKnotPieces = "RiseKnotPieces";
 constexpr const char* PolylinePieces = "PolylinePieces";
 constexpr const char* RemainingCrossings = "RemainingCrossings";
 constexpr const char* PiecesOutsideDomain = "PiecesOutsideDomain";

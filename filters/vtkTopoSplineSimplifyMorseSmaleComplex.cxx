@@ -175,10 +175,20 @@ int vtkTopoSplineSimplifyMorseSmaleComplex::RequestData(
     ++this->HierarchyComputations;
   }
 
+  double percent = this->PersistenceThreshold;
+  if (cache.Simplification.NearConstant() && percent < 100)
+  {
+    vtkWarningMacro("Simplify Morse-Smale Complex: the field varies by less than "
+      << topospline::MorseSmaleComplexSimplification::NearConstantRange
+      << " of its magnitude, too little for strictly monotone 1-cells and 2-cells in double precision; "
+         "simplified completely (100 %) instead of "
+      << percent << " %.");
+    percent = 100;
+  }
   topospline::SimplificationOutput result;
   {
-    vtkLogScopeF(TRACE, "replay cancellations to %g%%", this->PersistenceThreshold);
-    if (!cache.Simplification.Simplify(this->PersistenceThreshold, result, error))
+    vtkLogScopeF(TRACE, "replay cancellations to %g%%", percent);
+    if (!cache.Simplification.Simplify(percent, result, error))
     {
       vtkErrorMacro("Simplify Morse-Smale Complex: " << error << ".");
       return 1;

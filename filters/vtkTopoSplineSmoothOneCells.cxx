@@ -57,6 +57,7 @@ void WriteSmoothingReport(const topospline::OneCellSmoothingResult& result, int 
   AddFieldNumbers(fd, names::ErasedLoops, { static_cast<double>(result.ErasedLoops) });
   AddFieldNumbers(fd, names::DroppedCuts, { static_cast<double>(result.DroppedCuts) });
   AddFieldNumbers(fd, names::AdaptedPieces, { static_cast<double>(result.AdaptedPieces) });
+  AddFieldNumbers(fd, names::RiseKnotPieces, { static_cast<double>(result.RiseKnotPieces) });
   AddFieldNumbers(fd, names::PolylinePieces, { static_cast<double>(result.PolylinePieces) });
   AddFieldNumbers(fd, names::RemainingCrossings, { static_cast<double>(result.RemainingCrossings) });
   AddFieldNumbers(fd, names::PiecesOutsideDomain, { static_cast<double>(result.PiecesOutsideDomain) });

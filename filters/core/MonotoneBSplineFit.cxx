@@ -613,6 +613,41 @@ std::vector<double> MonotoneBSplineFit::NormalizedArcLength(const std::vector<do
   return parameters;
 }
 
+std::vector<double> MonotoneBSplineFit::ArcLengthAndRise(const std::vector<double>& points,
+  const std::vector<double>& values, double startValue, double endValue, double maximumRiseRatio)
+{
+  std::vector<double> parameters = NormalizedArcLength(points);
+  const std::size_t count = parameters.size();
+  const double rise = endValue - startValue;
+  if (count < 3 || values.size() != count || !(rise > 0) || !std::isfinite(rise))
+  {
+    return parameters;
+  }
+  // Each step's rise counts at most maximumRiseRatio times its share of the length: the
+  // curve's speed then stays within a small factor of the path's, a jump of the values (noise
+  // past the end value) leaves no long parameter gap without samples, where the planar curve
+  // would be free to loop.
+  std::vector<double> combined(count, 0.0);
+  double highest = 0;
+  for (std::size_t i = 1; i < count; ++i)
+  {
+    const double next = std::max(highest, std::clamp((values[i] - startValue) / rise, 0.0, 1.0));
+    const double length = parameters[i] - parameters[i - 1];
+    combined[i] = combined[i - 1] + length + std::min(next - highest, maximumRiseRatio * length);
+    highest = next;
+  }
+  const double total = combined.back();
+  if (!(total > 0))
+  {
+    return parameters;
+  }
+  for (std::size_t i = 1; i + 1 < count; ++i)
+  {
+    parameters[i] = combined[i] / total;
+  }
+  return parameters;
+}
+
 //------------------------------------------------------------------------------
 bool MonotoneBSplineFit::CheckSamples(const std::vector<double>& parameters, std::size_t valuesPerSample,
   const std::vector<double>& values, std::string& error) const

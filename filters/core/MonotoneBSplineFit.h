@@ -94,6 +94,16 @@ public:
   // length gets uniform parameters i / n.
   static std::vector<double> NormalizedArcLength(const std::vector<double>& points);
 
+  // The parameters a height fit can follow: the normalized arc length plus the normalized
+  // rise, the running maximum of the values clamped to [startValue, endValue] (so noise that
+  // goes down and up again adds nothing), each step's rise at most `maximumRiseRatio` times
+  // its share of the length; normalized again. A profile that falls steeply and
+  // then flattens gets as many uniform knots on the fall as on the flat (uniform in arc
+  // length, k = 4 put one segment on a fall of 15 % of the range). Arc length alone when
+  // the values do not rise (endValue <= startValue, or a flat profile).
+  static std::vector<double> ArcLengthAndRise(const std::vector<double>& points, const std::vector<double>& values,
+    double startValue, double endValue, double maximumRiseRatio);
+
 private:
   bool CheckSamples(const std::vector<double>& parameters, std::size_t valuesPerSample,
     const std::vector<double>& values, std::string& error) const;

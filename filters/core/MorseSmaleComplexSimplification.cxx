@@ -1044,6 +1044,18 @@ void MorseSmaleComplexSimplification::Cancel(
 }
 
 //------------------------------------------------------------------------------
+bool MorseSmaleComplexSimplification::NearConstant() const
+{
+  double lowest = std::numeric_limits<double>::infinity(), highest = -lowest, magnitude = 0;
+  for (const CriticalPoint& point : this->Input.CriticalPoints)
+  {
+    lowest = std::min(lowest, point.Value);
+    highest = std::max(highest, point.Value);
+    magnitude = std::max(magnitude, std::abs(point.Value));
+  }
+  return highest > lowest && highest - lowest < NearConstantRange * magnitude;
+}
+
 Index MorseSmaleComplexSimplification::NumberOfCancellations(double percent) const
 {
   if (!this->Computed)

@@ -1070,26 +1070,225 @@ int SegmentsOfPiece(const SmoothedPiece& piece, int asked)
 }
 } // namespace
 
+namespace
+{
+// How far a planar curve strays from the path it was fitted to, at `perSegment` parameters
+// per segment: the largest distance to the path (to its edges whose parameters lie within a
+// segment's span), and the largest backtrack, how far the nearest path position falls behind
+// the farthest one reached before (a curve that overshoots along a straight path and comes
+// back touches itself, and its 2-cells are not simple).
+struct PathDeviation
+{
+  double Distance = 0;
+  double Backtrack = 0;
+};
+
+// How much farther from its path a curve with knots that follow the rise may run than with
+// knots uniform in arc length (crossings it causes are repaired: RepairCrossings first gives
+// the pieces involved uniform knots again).
+constexpr double RiseCurveSlack = 2.5;
+
+// Knots follow the rise only on pieces with this many samples per segment: with fewer the
+// least-squares curve nearly interpolates the samples, and uneven parameters make it hook.
+constexpr int RiseSamplesPerSegment = 3;
+
+// How much the rise may count per unit of length, tried in turn (see ArcLengthAndRise): the
+// fit with the best height (BetterHeight) is kept.
+constexpr double RiseRatios[] = { 3, 10 };
+
+// Whether a planar curve stays inside the domain by ClampCurveIntoDomain's margin: its
+// coefficients do (the Bezier control points are convex combinations of them). A curve that
+// had to be clamped runs along the boundary a hair's breadth from it and touches the
+// boundary 1-cells: the 2-cells between them are not simple.
+bool InsideDomain(const UniformQuadraticBSpline& curve, const std::vector<double>& points, const double bounds[4])
+{
+  const std::size_t samples = points.size() / 2;
+  double length = 0;
+  for (std::size_t i = 1; i < samples; ++i)
+  {
+    length += std::hypot(points[2 * i] - points[2 * i - 2], points[2 * i + 1] - points[2 * i - 1]);
+  }
+  const double margin = samples > 1 ? 0.01 * length / (samples - 1) : 0.0;
+  const auto& c = curve.Coefficients;
+  for (std::size_t j = 2; j + 2 < c.size(); j += 2)
+  {
+    if (!(c[j] >= bounds[0] + margin && c[j] <= bounds[1] - margin && c[j + 1] >= bounds[2] + margin &&
+          c[j + 1] <= bounds[3] - margin))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool BetterHeight(const HeightFit& candidate, const HeightFit& best)
+{
+  return candidate.MaximumError < best.MaximumError;
+}
+
+// All points on the line through the first and the last (to rounding).
+bool IsStraight(const std::vector<double>& points)
+{
+  const std::size_t count = points.size() / 2;
+  if (count < 3)
+  {
+    return true;
+  }
+  const double* a = &points[0];
+  const double* b = &points[2 * (count - 1)];
+  const double length = std::hypot(b[0] - a[0], b[1] - a[1]);
+  for (std::size_t i = 1; i + 1 < count; ++i)
+  {
+    if (std::abs(Orientation2D(a, b, &points[2 * i])) > 1e-12 * length * (length + 1))
+    {
+      return false;
+    }
+  }
+  return length > 0;
+}
+
+// The planar curve along a straight path (along the domain's boundary) for parameters that are
+// not its arc length: the least-squares curve, put exactly on the line, kept only when its
+// coefficients advance strictly along the chord, which makes the curve advance strictly too
+// (its derivative is a positive combination of their differences). A curve that overshoots
+// along the line and comes back touches itself, and one that stops closes a 2-cell with a
+// spike.
+bool FitStraightCurve(const MonotoneBSplineFit& fitter, const std::vector<double>& parameters,
+  const std::vector<double>& points, PlanarCurveFit& curve)
+{
+  std::string ignored;
+  if (!fitter.FitPlanarCurve(parameters, points, curve, ignored))
+  {
+    return false;
+  }
+  const double* a = &points[0];
+  const double* b = &points[points.size() - 2];
+  const double dx = b[0] - a[0], dy = b[1] - a[1];
+  const double length2 = dx * dx + dy * dy;
+  std::vector<double>& c = curve.Spline.Coefficients;
+  const std::size_t count = c.size() / 2;
+  double previous = 0;
+  for (std::size_t j = 1; j + 1 < count; ++j)
+  {
+    const double f = ((c[2 * j] - a[0]) * dx + (c[2 * j + 1] - a[1]) * dy) / length2;
+    if (!(f > previous && f < 1))
+    {
+      return false;
+    }
+    c[2 * j] = a[0] + f * dx;
+    c[2 * j + 1] = a[1] + f * dy;
+    previous = f;
+  }
+  return count >= 2 && length2 > 0;
+}
+
+PathDeviation DeviationFromPath(const UniformQuadraticBSpline& curve, const std::vector<double>& parameters,
+  const std::vector<double>& points, int perSegment)
+{
+  PathDeviation deviation;
+  const std::size_t count = parameters.size();
+  std::vector<double> along(count, 0.0);
+  for (std::size_t i = 1; i < count; ++i)
+  {
+    along[i] = along[i - 1] + std::hypot(points[2 * i] - points[2 * i - 2], points[2 * i + 1] - points[2 * i - 1]);
+  }
+  const int samples = std::max(1, curve.Segments * perSegment);
+  const double window = 1.0 / std::max(1, curve.Segments);
+  double reached = 0;
+  std::size_t first = 0;
+  for (int q = 0; q <= samples; ++q)
+  {
+    const double t = static_cast<double>(q) / samples;
+    double xy[2];
+    curve.Evaluate(t, xy);
+    while (first + 1 < count && parameters[first + 1] < t - window)
+    {
+      ++first;
+    }
+    double nearest = std::numeric_limits<double>::infinity(), position = reached;
+    for (std::size_t i = first; i + 1 < count && parameters[i] <= t + window; ++i)
+    {
+      double fraction;
+      const double d2 = SegmentDistance2(&points[2 * i], &points[2 * i + 2], xy[0], xy[1], fraction);
+      if (d2 < nearest)
+      {
+        nearest = d2;
+        position = along[i] + fraction * (along[i + 1] - along[i]);
+      }
+    }
+    if (std::isfinite(nearest))
+    {
+      deviation.Distance = std::max(deviation.Distance, std::sqrt(nearest));
+      deviation.Backtrack = std::max(deviation.Backtrack, reached - position);
+      reached = std::max(reached, position);
+    }
+  }
+  return deviation;
+}
+} // namespace
+
 // Paper, section 4, steps 2 and 3 for one piece: a strictly increasing height (and the
 // unconstrained one, for comparison) and a planar curve, both as k cubic Beziers.
 bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments,
   const double bounds[4], std::string& error) const
 {
-  if (piece.Parameters.size() != piece.Values.size())
-  {
-    piece.Parameters = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
-  }
+  const double a = nodes[piece.StartNode].Value, b = nodes[piece.EndNode].Value;
   MonotoneBSplineFit fitter;
   fitter.Segments = segments;
+  PlanarCurveFit curve;
   HeightFit height, free;
-  const double a = nodes[piece.StartNode].Value, b = nodes[piece.EndNode].Value;
-  if (!fitter.FitHeight(piece.Parameters, piece.Values, a, b, true, height, error) ||
-    !fitter.FitHeight(piece.Parameters, piece.Values, a, b, false, free, error))
+  const bool firstFit = piece.Parameters.size() != piece.Values.size();
+  if (firstFit)
+  {
+    piece.Parameters = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
+    piece.RiseKnots = false;
+  }
+  if (!fitter.FitPlanarCurve(piece.Parameters, piece.Points, curve, error) ||
+    !fitter.FitHeight(piece.Parameters, piece.Values, a, b, true, height, error))
   {
     return false;
   }
-  PlanarCurveFit curve;
-  if (!fitter.FitPlanarCurve(piece.Parameters, piece.Points, curve, error))
+  if (firstFit && piece.Values.size() >= static_cast<std::size_t>(RiseSamplesPerSegment * segments + 1))
+  {
+    // Knots that follow the rise as well as the length (for each of RiseRatios), kept where
+    // the height then misses the samples by less (a valley that falls steeply and flattens:
+    // uniform knots put one of k = 4 segments on the fall) and the planar curve still follows
+    // the path: within RiseCurveTolerance or RiseCurveSlack times as far as with arc length,
+    // backtracking no more, and inside the domain by the clamping margin where the arc-length
+    // curve is (a curve whose speed follows the heights bulges on long flat stretches, and
+    // bulges cross: see RepairCrossings). On a straight path the curve runs along the line
+    // (FitStraightCurve).
+    const bool straight = IsStraight(piece.Points);
+    const int perSegment = this->SamplesPerSegment;
+    const PathDeviation even =
+      straight ? PathDeviation() : DeviationFromPath(curve.Spline, piece.Parameters, piece.Points, perSegment);
+    const bool evenInside = straight || InsideDomain(curve.Spline, piece.Points, bounds);
+    for (const double ratio : RiseRatios)
+    {
+      std::vector<double> rise = MonotoneBSplineFit::ArcLengthAndRise(piece.Points, piece.Values, a, b, ratio);
+      PlanarCurveFit riseCurve;
+      HeightFit riseHeight;
+      std::string ignored;
+      const auto followsPath = [&]() {
+        const PathDeviation risen = DeviationFromPath(riseCurve.Spline, rise, piece.Points, perSegment);
+        return risen.Distance <= std::max(RiseCurveSlack * even.Distance, this->RiseCurveTolerance) &&
+          risen.Backtrack <= std::max(even.Backtrack, this->RiseCurveTolerance) &&
+          (InsideDomain(riseCurve.Spline, piece.Points, bounds) || !evenInside);
+      };
+      if (rise != piece.Parameters &&
+        (straight ? FitStraightCurve(fitter, rise, piece.Points, riseCurve)
+                  : fitter.FitPlanarCurve(rise, piece.Points, riseCurve, ignored) && followsPath()) &&
+        fitter.FitHeight(rise, piece.Values, a, b, true, riseHeight, ignored) &&
+        BetterHeight(riseHeight, height))
+      {
+        piece.Parameters = std::move(rise);
+        piece.RiseKnots = true;
+        curve = std::move(riseCurve);
+        height = std::move(riseHeight);
+      }
+    }
+  }
+  if (!fitter.FitHeight(piece.Parameters, piece.Values, a, b, false, free, error))
   {
     return false;
   }
@@ -1211,6 +1410,30 @@ bool OneCellSmoothing::RepairCrossings(
     // Up to MaximumSegments, or to the piece's number of samples for long pieces: with about
     // one segment per sample the least-squares curve follows the jagged 1-cell, which does
     // not cross the others.
+    // A crossing piece whose knots follow its rise first gets knots uniform in arc length at
+    // the same k: its curve then runs as evenly as the path.
+    std::vector<Index> even;
+    for (Index p : crossing)
+    {
+      SmoothedPiece& piece = result.Pieces[p];
+      if (piece.RiseKnots)
+      {
+        piece.RiseKnots = false;
+        piece.Parameters = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
+        even.push_back(p);
+      }
+    }
+    if (!even.empty())
+    {
+      if (!this->FitInParallel(
+            result, even, [](const SmoothedPiece& piece) { return piece.Segments; }, domainBounds, error))
+      {
+        return false;
+      }
+      crossing.clear();
+      pairs = detector.UpdateCrossings(even, crossing);
+      continue;
+    }
     // k doubles, and only doubles (a cap between would leave counts like 25 and 37, whose
     // common multiples exceed stage 4's grid limit): stage 4 subdivides each piece of the
     // four sides of a cell by a whole factor to one common count.
@@ -1252,6 +1475,8 @@ bool OneCellSmoothing::RepairCrossings(
     pairs = detector.UpdateCrossings(changed, crossing);
   }
   result.AdaptedPieces = static_cast<int>(adapted.size());
+  result.RiseKnotPieces = static_cast<int>(std::count_if(result.Pieces.begin(), result.Pieces.end(),
+    [](const SmoothedPiece& piece) { return piece.RiseKnots; }));
   result.RemainingCrossings = pairs;
   return true;
 }

@@ -40,8 +40,9 @@ struct SmoothedPiece
   std::vector<Index> OneCells; // 1-cells that run through it
   std::vector<double> Points;      // the jagged samples (x, y), start to end
   std::vector<double> Values;      // the field along them
-  std::vector<double> Parameters;  // normalized arc length
+  std::vector<double> Parameters;  // arc length and rise (MonotoneBSplineFit::ArcLengthAndRise)
   int Segments = 0;                // k used (more than asked where crossings forced it)
+  bool RiseKnots = false;          // Parameters follow the rise too (else arc length only)
   CubicBezierSpline Curve;         // Dimension 2
   CubicBezierSpline Height;        // Dimension 1, strictly increasing
   double L1Error = 0;              // monotone fit, over the interior samples
@@ -56,6 +57,7 @@ struct OneCellSmoothingResult
   std::vector<std::vector<Index>> PiecesOfOneCell; // per 1-cell, its pieces in order
   int ShortPieces = 0;         // pieces of fewer edges than k, fitted with fewer segments (a divisor of k)
   int AdaptedPieces = 0;       // pieces whose k was raised to remove crossings
+  int RiseKnotPieces = 0;      // pieces whose knots follow their rise (MonotoneBSplineFit::ArcLengthAndRise)
   int PolylinePieces = 0;      // of them, pieces that still crossed at their largest k and follow
                                // their jagged 1-cell in straight segments instead
   int RemainingCrossings = 0;  // pairs of pieces that still cross (0 is the goal)
@@ -82,6 +84,11 @@ public:
   int MaximumSegments = 32;
   // Points per Bezier segment used to check crossings.
   int SamplesPerSegment = 8;
+  // A piece's knots follow its rise as well as its length (MonotoneBSplineFit::ArcLengthAndRise)
+  // where its height then fits better and its planar curve stays this close to the path
+  // (working-frame units, about grid spacings) or not much farther than with knots uniform in
+  // arc length (see FitPiece).
+  double RiseCurveTolerance = 0.25;
 
   // domainBounds: xmin, xmax, ymin, ymax of the domain (its corners become nodes when 1-cells
   // run through them, so that the boundary keeps its corners). Works in complex.Frame; the
@@ -111,7 +118,7 @@ private:
     std::string& error) const;
   // Steps 2 and 3 on every piece with k = Segments (fewer on pieces of fewer edges).
   bool FitAllPieces(OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const;
-  // Raises k on crossing pieces and fits them again (sets AdaptedPieces, RemainingCrossings).
+  // Raises k on crossing pieces and fits them again (sets AdaptedPieces, RiseKnotPieces, RemainingCrossings).
   bool RepairCrossings(OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const;
   // Fits the listed pieces in parallel, each with segmentsOf(piece) segments; false with the
   // first failing piece in list order named in `error`.

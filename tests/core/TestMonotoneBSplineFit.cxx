@@ -363,6 +363,82 @@ TEST_CASE(MonotoneFitsOnSyntheticData)
 }
 
 //------------------------------------------------------------------------------
+// Parameters that follow the rise: 0 and 1 at the ends, non-decreasing, each step between
+// half and (1 + the ratio) times its share of the arc length (so no long gap without
+// samples), on seeded random paths and values; arc length when the values do not rise. A
+// profile that rises steeply and then flattens is fitted closer with them.
+TEST_CASE(ArcLengthAndRiseParameters)
+{
+  std::mt19937 random(17);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int badSteps = 0, badEnds = 0;
+  for (int trial = 0; trial < 200; ++trial)
+  {
+    const int n = 3 + static_cast<int>(unit(random) * 300);
+    std::vector<double> points(2 * n), values(n);
+    double x = 0, y = 0;
+    for (int i = 0; i < n; ++i)
+    {
+      x += 0.1 + unit(random);
+      y += unit(random) - 0.5;
+      points[2 * i] = x;
+      points[2 * i + 1] = y;
+      // noisy rise, sometimes past the end value, sometimes below the start
+      values[i] = std::pow(static_cast<double>(i) / (n - 1), 1 + 6 * unit(random)) + 0.3 * (unit(random) - 0.5);
+    }
+    const double start = values.front(), end = values.back();
+    const std::vector<double> arc = MonotoneBSplineFit::NormalizedArcLength(points);
+    const double ratio = 1 + 9 * unit(random);
+    const std::vector<double> t = MonotoneBSplineFit::ArcLengthAndRise(points, values, start, end, ratio);
+    badEnds += t.front() != 0.0 || t.back() != 1.0 || t.size() != arc.size();
+    for (int i = 1; i < n; ++i)
+    {
+      const double share = arc[i] - arc[i - 1];
+      const double step = t[i] - t[i - 1];
+      badSteps += !(step >= 0.5 * share * (1 - 1e-9) &&
+        step <= (1 + ratio) * share * (1 + 1e-9) + 1e-15);
+    }
+    if (!(end > start))
+    {
+      badEnds += t != arc;
+    }
+  }
+  CHECK(badSteps == 0);
+  CHECK(badEnds == 0);
+  // Falling values: arc length.
+  const std::vector<double> line = { 0, 0, 1, 0, 3, 0, 4, 0 };
+  CHECK((MonotoneBSplineFit::ArcLengthAndRise(line, { 1, 0.5, 0.2, 0 }, 1, 0, 3) ==
+    MonotoneBSplineFit::NormalizedArcLength(line)));
+
+  // Steep, then flat: v = 1 - (1 - s)^12 along a straight path of 200 samples, k = 4.
+  const int n = 200;
+  std::vector<double> points(2 * n), values(n);
+  for (int i = 0; i < n; ++i)
+  {
+    const double s = static_cast<double>(i) / (n - 1);
+    points[2 * i] = s;
+    values[i] = 1 - std::pow(1 - s, 12);
+  }
+  MonotoneBSplineFit fitter;
+  fitter.Segments = 4;
+  const auto largestMiss = [&](const std::vector<double>& t) {
+    HeightFit fit;
+    std::string error;
+    CHECK(fitter.FitHeight(t, values, 0.0, 1.0, true, fit, error));
+    double miss = 0;
+    for (int i = 0; i < n; ++i)
+    {
+      miss = std::max(miss, std::abs(fit.Spline.Value(t[i]) - values[i]));
+    }
+    return miss;
+  };
+  const double even = largestMiss(MonotoneBSplineFit::NormalizedArcLength(points));
+  const double risen = largestMiss(MonotoneBSplineFit::ArcLengthAndRise(points, values, 0.0, 1.0, 3));
+  std::printf("  steep-then-flat profile, k = 4: largest miss %.4f (arc length), %.4f (arc length and rise)\n",
+    even, risen);
+  CHECK(risen < 0.75 * even);
+}
+
 TEST_CASE(DegenerateHeightFits)
 {
   MonotoneBSplineFit fitter;

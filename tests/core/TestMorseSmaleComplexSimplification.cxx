@@ -687,6 +687,32 @@ TEST_CASE(BadInput)
   CHECK(simplification.Simplify(100, output, error));
 }
 
+// A field that varies by less than NearConstantRange of its magnitude is near-constant, one
+// that varies more or not at all is not (the filter then simplifies it completely).
+TEST_CASE(NearConstantFields)
+{
+  const GridField shepard = ShepardField(50, 2, 40, 4); // values in [0, 1]
+  const auto isNearConstant = [&](double offset, double scale) {
+    GridField grid = shepard;
+    for (double& v : grid.Values)
+    {
+      v = offset + scale * v;
+    }
+    MorseSmaleComplexExtraction extraction;
+    MorseSmaleComplex input;
+    MorseSmaleComplexSimplification simplification;
+    std::string error;
+    CHECK(extraction.Extract(MeshFieldOnGrid(grid), input, error));
+    CHECK(simplification.ComputeHierarchy(input, error));
+    return simplification.NearConstant();
+  };
+  CHECK(isNearConstant(1.0, 1e-13));
+  CHECK(isNearConstant(-7.25e6, 1e-4));
+  CHECK(!isNearConstant(1.0, 1e-8));
+  CHECK(!isNearConstant(0.0, 1e-300)); // tiny, but no offset: all of it is resolved
+  CHECK(!isNearConstant(1.0, 0.0));    // constant: nothing to resolve
+}
+
 // A simplified complex is again a valid input (two simplification filters in a row).
 TEST_CASE(ChainedSimplification)
 {
