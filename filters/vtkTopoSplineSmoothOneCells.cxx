@@ -58,6 +58,7 @@ void WriteSmoothingReport(const topospline::OneCellSmoothingResult& result, int 
   AddFieldNumbers(fd, names::DroppedCuts, { static_cast<double>(result.DroppedCuts) });
   AddFieldNumbers(fd, names::AdaptedPieces, { static_cast<double>(result.AdaptedPieces) });
   AddFieldNumbers(fd, names::RiseKnotPieces, { static_cast<double>(result.RiseKnotPieces) });
+  AddFieldNumbers(fd, names::RefinedPieces, { static_cast<double>(result.RefinedPieces) });
   AddFieldNumbers(fd, names::PolylinePieces, { static_cast<double>(result.PolylinePieces) });
   AddFieldNumbers(fd, names::RemainingCrossings, { static_cast<double>(result.RemainingCrossings) });
   AddFieldNumbers(fd, names::PiecesOutsideDomain, { static_cast<double>(result.PiecesOutsideDomain) });
@@ -109,6 +110,10 @@ int vtkTopoSplineSmoothOneCells::RequestData(
   vtkTopoSplineDomainConversion::PlanarBounds(domain, bounds);
   topospline::OneCellSmoothing smoothing;
   smoothing.Segments = this->CurveSegments;
+  if (vtkDataArray* threshold = input->GetFieldData()->GetArray(names::AbsolutePersistenceThreshold))
+  {
+    smoothing.HeightTolerance = threshold->GetNumberOfTuples() > 0 ? threshold->GetComponent(0, 0) : 0.0;
+  }
   smoothing.Parallel = vtkTopoSplineDomainConversion::SMPParallelFor();
   smoothing.Hooks.Progress = [this](double f) { this->UpdateProgress(0.9 * f); };
   smoothing.Hooks.AbortRequested = [this]() { return this->GetAbortExecute() != 0; };

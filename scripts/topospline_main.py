@@ -114,7 +114,7 @@ if smoothed_data is None or smoothed_data.GetNumberOfBlocks() < 7:
     sys.exit("the 1-cell smoothing failed (see the error above)")
 sfd = smoothed_data.GetFieldData()
 summary["smoothed_1_cells"] = {name: sfd.GetArray(name).GetValue(0) for name in (
-    "CurveSegments", "NumberOfPieces", "AdaptedPieces", "RiseKnotPieces", "RemainingCrossings",
+    "CurveSegments", "NumberOfPieces", "AdaptedPieces", "RiseKnotPieces", "RefinedPieces", "RemainingCrossings",
     "PiecesOutsideDomain", "L1Error", "UnconstrainedL1Error")}
 summary["smoothed_1_cells"]["bezier_segments"] = smoothed_data.GetBlock(5).GetNumberOfCells()
 

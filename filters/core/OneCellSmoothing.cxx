@@ -1243,7 +1243,19 @@ bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<Smoothin
     piece.Parameters = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
     piece.RiseKnots = false;
   }
-  if (!fitter.FitPlanarCurve(piece.Parameters, piece.Points, curve, error) ||
+  // A refit (more segments) of a straight piece with rise knots keeps its curve on the line,
+  // or goes back to arc length (see FitStraightCurve).
+  bool curveFitted = false;
+  if (!firstFit && piece.RiseKnots && IsStraight(piece.Points))
+  {
+    curveFitted = FitStraightCurve(fitter, piece.Parameters, piece.Points, curve);
+    if (!curveFitted)
+    {
+      piece.Parameters = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
+      piece.RiseKnots = false;
+    }
+  }
+  if ((!curveFitted && !fitter.FitPlanarCurve(piece.Parameters, piece.Points, curve, error)) ||
     !fitter.FitHeight(piece.Parameters, piece.Values, a, b, true, height, error))
   {
     return false;
@@ -1297,6 +1309,7 @@ bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<Smoothin
   piece.Curve = curve.Spline.ToCubicBezier();
   ClampCurveIntoDomain(piece, bounds);
   piece.L1Error = height.L1Error;
+  piece.LargestMiss = height.MaximumError;
   piece.UnconstrainedL1Error = free.L1Error;
   return true;
 }
@@ -1370,6 +1383,36 @@ bool OneCellSmoothing::FitAllPieces(
       return false;
     }
   }
+  // Pieces whose height misses a sample by more than the simplification's threshold get twice
+  // their segments (twice at most): the user simplifies to remove features smaller than that,
+  // not to move the 1-cells off the data by more (a long valley of the Shepard field that falls
+  // steeply then flattens still missed its samples by 10 % of the range with knots that follow
+  // the rise).
+  std::set<Index> refined;
+  for (int round = 0; round < 2 && this->HeightTolerance > 0; ++round)
+  {
+    std::vector<Index> missing;
+    for (Index p = 0; p < count; ++p)
+    {
+      const SmoothedPiece& piece = result.Pieces[p];
+      if (piece.LargestMiss > this->HeightTolerance && 2 * piece.Segments <= this->MaximumHeightSegments &&
+        static_cast<int>(piece.Values.size()) > 3 * 2 * piece.Segments)
+      {
+        missing.push_back(p);
+      }
+    }
+    if (missing.empty())
+    {
+      break;
+    }
+    if (!this->FitInParallel(
+          result, missing, [](const SmoothedPiece& piece) { return 2 * piece.Segments; }, domainBounds, error))
+    {
+      return false;
+    }
+    refined.insert(missing.begin(), missing.end());
+  }
+  result.RefinedPieces = static_cast<int>(refined.size());
   return true;
 }
 

@@ -46,6 +46,7 @@ struct SmoothedPiece
   CubicBezierSpline Curve;         // Dimension 2
   CubicBezierSpline Height;        // Dimension 1, strictly increasing
   double L1Error = 0;              // monotone fit, over the interior samples
+  double LargestMiss = 0;          // monotone fit, the largest |height - sample|
   double UnconstrainedL1Error = 0; // the same fit without monotonicity, for comparison
   bool Clamped = false;            // control points were clamped into the domain's box
 };
@@ -58,6 +59,7 @@ struct OneCellSmoothingResult
   int ShortPieces = 0;         // pieces of fewer edges than k, fitted with fewer segments (a divisor of k)
   int AdaptedPieces = 0;       // pieces whose k was raised to remove crossings
   int RiseKnotPieces = 0;      // pieces whose knots follow their rise (MonotoneBSplineFit::ArcLengthAndRise)
+  int RefinedPieces = 0;       // pieces whose k was doubled because the height missed (HeightTolerance)
   int PolylinePieces = 0;      // of them, pieces that still crossed at their largest k and follow
                                // their jagged 1-cell in straight segments instead
   int RemainingCrossings = 0;  // pairs of pieces that still cross (0 is the goal)
@@ -84,6 +86,17 @@ public:
   int MaximumSegments = 32;
   // Points per Bezier segment used to check crossings.
   int SamplesPerSegment = 8;
+  // A piece whose height misses a sample by more than this (in the field's units; 0: never;
+  // the filter passes the simplification's absolute persistence threshold) gets twice its
+  // segments, twice at most, up to MaximumHeightSegments and while it keeps 3 samples per
+  // segment.
+  double HeightTolerance = 0;
+  // A quarter of stage 4's fitted-grid limit (TwoCellReconstruction::MaximumFittedGridSize):
+  // a cell's grid is a common count of its sides, each the sum of its pieces' counts, and
+  // cells beyond that limit keep the paper's interior (on the Rainier crop at k = 7, pieces
+  // doubled to 14 made grids of 84 and a cell 24 % of the range off; fitting those instead
+  // took the crop from 0.87 to 1.44 s).
+  int MaximumHeightSegments = 12;
   // A piece's knots follow its rise as well as its length (MonotoneBSplineFit::ArcLengthAndRise)
   // where its height then fits better and its planar curve stays this close to the path
   // (working-frame units, about grid spacings) or not much farther than with knots uniform in

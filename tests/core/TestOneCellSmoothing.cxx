@@ -267,6 +267,54 @@ TEST_CASE(ShortPiecesGetNoMoreSegmentsThanEdges)
 // cuts would order nodes in a cycle loses cuts (DroppedCuts), and only there may pieces
 // overlap. Before, one cycle anywhere left every 1-cell that ran down through a junction
 // uncut: 100^2 noise at 25 % had 910 pairs of pieces crossing to the end.
+// With a height tolerance (the filter passes the simplification's threshold), every piece whose
+// height misses a sample by more gets twice its segments where it has the samples for them (3
+// per segment) and stays within MaximumHeightSegments; fewer pieces miss by more than the
+// tolerance. The misses are measured here from the Bezier heights at the pieces' parameters.
+TEST_CASE(PiecesThatMissTheDataGetMoreSegments)
+{
+  int before = 0, after = 0, unrefined = 0;
+  for (std::uint64_t seed : { 0, 2, 3 })
+  {
+    Stage3Input input;
+    std::string error;
+    CHECK(RunStages1And2(ShepardField(50, 2.0, 250, seed), 5.0, input, error));
+    const double tolerance = 0.05 * input.Range;
+    const auto misses = [&](const OneCellSmoothingResult& result, bool refined) {
+      int count = 0;
+      for (const SmoothedPiece& piece : result.Pieces)
+      {
+        double miss = 0;
+        for (std::size_t i = 1; i + 1 < piece.Values.size(); ++i)
+        {
+          double h = 0;
+          piece.Height.Evaluate(piece.Parameters[i], &h);
+          miss = std::max(miss, std::abs(h - piece.Values[i]));
+        }
+        count += miss > tolerance ? 1 : 0;
+        const bool room = static_cast<int>(piece.Values.size()) > 3 * 8;
+        unrefined += refined && miss > tolerance && room && piece.Segments < 8 ? 1 : 0;
+        CHECK(piece.Segments <= 12 || !refined);
+      }
+      return count;
+    };
+    OneCellSmoothing plain;
+    OneCellSmoothingResult a, b;
+    CHECK(plain.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, a, error));
+    OneCellSmoothing refining;
+    refining.HeightTolerance = tolerance;
+    CHECK(refining.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, b, error));
+    CheckSmoothedOneCells(input, b, 4);
+    CHECK(a.RefinedPieces == 0 && b.RefinedPieces > 0);
+    before += misses(a, false);
+    after += misses(b, true);
+  }
+  std::printf("  Shepard 5 %%, k = 4, seeds 0, 2, 3: pieces missing by more than 5 %% of the range %d -> %d\n",
+    before, after);
+  CHECK(after < before);
+  CHECK(unrefined == 0);
+}
+
 TEST_CASE(MergedOneCellsShareTheirPiecesOnNoise)
 {
   for (const double percent : { 10.0, 25.0, 50.0 })
