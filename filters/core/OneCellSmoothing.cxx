@@ -576,6 +576,19 @@ bool SolveJunctionValues(std::vector<SmoothingNode>& nodes, OneCellSmoothingResu
   return true;
 }
 
+// A hundredth of a piece's mean sample spacing: how far inside the domain's box its curve is
+// kept (ClampCurveIntoDomain).
+double ClampingMargin(const std::vector<double>& points)
+{
+  const std::size_t samples = points.size() / 2;
+  double length = 0;
+  for (std::size_t i = 1; i < samples; ++i)
+  {
+    length += std::hypot(points[2 * i] - points[2 * i - 2], points[2 * i + 1] - points[2 * i - 1]);
+  }
+  return samples > 1 ? 0.01 * length / (samples - 1) : 0.0;
+}
+
 // A least-squares curve fitted to a 1-cell that runs along the boundary and then turns
 // inwards can overshoot the boundary slightly. A Bezier curve lies in the convex hull of its
 // control points: clamping them keeps it inside (the ends, data points, never move). Only a
@@ -586,12 +599,7 @@ bool SolveJunctionValues(std::vector<SmoothingNode>& nodes, OneCellSmoothingResu
 void ClampCurveIntoDomain(SmoothedPiece& piece, const double bounds[4])
 {
   const std::size_t samples = piece.Points.size() / 2;
-  double length = 0;
-  for (std::size_t i = 1; i < samples; ++i)
-  {
-    length += std::hypot(piece.Points[2 * i] - piece.Points[2 * i - 2], piece.Points[2 * i + 1] - piece.Points[2 * i - 1]);
-  }
-  const double margin = samples > 1 ? 0.01 * length / (samples - 1) : 0.0;
+  const double margin = ClampingMargin(piece.Points);
   double box[4];
   for (int side = 0; side < 4; ++side)
   {
@@ -1072,17 +1080,6 @@ int SegmentsOfPiece(const SmoothedPiece& piece, int asked)
 
 namespace
 {
-// How far a planar curve strays from the path it was fitted to, at `perSegment` parameters
-// per segment: the largest distance to the path (to its edges whose parameters lie within a
-// segment's span), and the largest backtrack, how far the nearest path position falls behind
-// the farthest one reached before (a curve that overshoots along a straight path and comes
-// back touches itself, and its 2-cells are not simple).
-struct PathDeviation
-{
-  double Distance = 0;
-  double Backtrack = 0;
-};
-
 // How much farther from its path a curve with knots that follow the rise may run than with
 // knots uniform in arc length (crossings it causes are repaired: RepairCrossings first gives
 // the pieces involved uniform knots again).
@@ -1102,13 +1099,7 @@ constexpr double RiseRatios[] = { 3, 10 };
 // boundary 1-cells: the 2-cells between them are not simple.
 bool InsideDomain(const UniformQuadraticBSpline& curve, const std::vector<double>& points, const double bounds[4])
 {
-  const std::size_t samples = points.size() / 2;
-  double length = 0;
-  for (std::size_t i = 1; i < samples; ++i)
-  {
-    length += std::hypot(points[2 * i] - points[2 * i - 2], points[2 * i + 1] - points[2 * i - 1]);
-  }
-  const double margin = samples > 1 ? 0.01 * length / (samples - 1) : 0.0;
+  const double margin = ClampingMargin(points);
   const auto& c = curve.Coefficients;
   for (std::size_t j = 2; j + 2 < c.size(); j += 2)
   {
@@ -1121,6 +1112,8 @@ bool InsideDomain(const UniformQuadraticBSpline& curve, const std::vector<double
   return true;
 }
 
+// The largest miss decides: it is what the carving copies onto the vertices (the L1 error
+// chose about the same).
 bool BetterHeight(const HeightFit& candidate, const HeightFit& best)
 {
   return candidate.MaximumError < best.MaximumError;
@@ -1181,6 +1174,17 @@ bool FitStraightCurve(const MonotoneBSplineFit& fitter, const std::vector<double
   }
   return count >= 2 && length2 > 0;
 }
+
+// How far a planar curve strays from the path it was fitted to, at `perSegment` parameters
+// per segment: the largest distance to the path (to its edges whose parameters lie within a
+// segment's span), and the largest backtrack, how far the nearest path position falls behind
+// the farthest one reached before (a curve that overshoots along a straight path and comes
+// back touches itself, and its 2-cells are not simple).
+struct PathDeviation
+{
+  double Distance = 0;
+  double Backtrack = 0;
+};
 
 PathDeviation DeviationFromPath(const UniformQuadraticBSpline& curve, const std::vector<double>& parameters,
   const std::vector<double>& points, int perSegment)
