@@ -158,8 +158,9 @@ bool AllowedBoundaryMismatch(const MonotoneSurfaceBoundary& boundary, const Mono
   // Relative to the cell's range, but never below rounding: a nearly flat cell far from 0
   // (a constant field at 7.25 spread by 1e-11) has a range of a few thousand ulps only.
   const double magnitude = std::max(std::abs(lowest), std::abs(highest));
-  allowedMismatch = std::max(options.ConsistencyTolerance * (range > 0 ? range : 1.0),
-    64 * std::numeric_limits<double>::epsilon() * magnitude);
+  allowedMismatch = std::max({ options.ConsistencyTolerance * (range > 0 ? range : 1.0),
+    64 * std::numeric_limits<double>::epsilon() * magnitude,
+    std::min(options.RoundingTolerance * magnitude, options.RoundingShareOfRange * range) });
   return true;
 }
 } // namespace

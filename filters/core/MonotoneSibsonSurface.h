@@ -51,6 +51,12 @@ struct MonotoneSurfaceOptions
   // Mismatches between the sides at shared points (values and scaled derivatives) up to this
   // fraction of the value range are averaged away; larger ones are an error.
   double ConsistencyTolerance = 1e-9;
+  // ... and up to this fraction of the largest |value| on the boundary (rounding, which a
+  // nearly flat cell's own range does not bound), as long as that stays within
+  // RoundingShareOfRange of the range: in a field that varies by 1e-13 of its magnitude the
+  // sides differ by real values, not rounding. 64 ulps are always allowed.
+  double RoundingTolerance = 0;
+  double RoundingShareOfRange = 0.1;
   // Lower bound sigma of p + q at interior nodes (and at boundary nodes whose tangential
   // derivative is below sigma), as this fraction of the smallest per-cell spare rise.
   double MinimumSlopeFraction = 0.1;

@@ -82,14 +82,22 @@ SamplingConstraints ComplexConstraints(const MorseSmaleComplex& complex, const T
 // ridge and a valley both claim, and boundary vertices the 1-cell does not run through.
 // Critical vertices keep their values (the nodes' critical values, as Apply sets them), and
 // no vertex next to a wanted maximum (minimum) is raised (lowered) past it.
+// With `onlyWhereNeeded`, a vertex the walk reaches already past the value before it keeps
+// its value (the walk goes on rising, or falling, through it), and a ridge is not carved beside
+// a boundary row that stands as high: far fewer vertices change, but on noise a saddle ends
+// off its node more often (Apply tries this first).
 // Returns the number of changed vertices.
 Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
-  const SamplingConstraints& constraints, double spacing, std::vector<double>& values);
+  const SamplingConstraints& constraints, double spacing, std::vector<double>& values,
+  bool onlyWhereNeeded = false);
 
 // The whole topological sampling of a reconstruction: the complex's critical points as
 // constraints, its smoothed 1-cells carved in (CarveOneCells), the floods
 // (EnforceCriticalVertices) and the saddles moved back onto their nodes (within Spacing,
-// looked for within 8 spacings). The complex side is fixed at construction; Apply samples one
+// looked for within 8 spacings). The 1-cells are carved only where needed first; if saddles
+// are then left off their nodes, the whole sequence runs again with every walked vertex carved
+// (on samplings of at most MaximumVerticesForSecondPass vertices), and the sampling with fewer
+// displaced saddles is kept. The complex side is fixed at construction; Apply samples one
 // sampling of the reconstruction (the input vertices, a finer grid).
 // `complexPoints` (x, y per vertex of `complexMesh`) tells where the nodes are: on a sampling
 // whose vertices do not include them (an image resampled over a triangle mesh), the vertex
@@ -115,6 +123,9 @@ public:
   double Spacing = 1;
   // Runs the extractions of the sampled critical points (the floods are sequential).
   ParallelFor Parallel = SequentialFor;
+  // Samplings with more vertices keep the first pass (carved only where needed) even with
+  // saddles off their nodes (see Apply).
+  Index MaximumVerticesForSecondPass = Index(1) << 20;
 
   // `values` (one per vertex of `mesh`, at sampling.Points) is modified in place; `vertexAt`
   // gives the sampling's vertex for a vertex of the complex's mesh (InvalidIndex: none). The
@@ -123,6 +134,12 @@ public:
     const std::function<Index(Index)>& vertexAt, std::vector<double>& values) const;
 
 private:
+  // How far from its node a saddle is looked for and carved back.
+  double SaddleReach() const { return 8 * this->Spacing; }
+  TopologicalSamplingReport Settle(const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
+    const std::function<Index(Index)>& vertexAt, const SamplingConstraints& wanted, bool onlyWhereNeeded,
+    std::vector<double>& values) const;
+
   const MorseSmaleComplex& Complex;
   const TriangleMeshTopology& ComplexMesh;
   const std::vector<double>& ComplexPoints;

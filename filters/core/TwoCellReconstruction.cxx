@@ -401,7 +401,7 @@ int ChooseGridLayout(const std::array<SideSegments, 4>& sides, int maximum, std:
 }
 
 std::array<SideSegments, 4> TwoCellSideSegments(
-  const TwoCellSides& sides, const OneCellSmoothingResult& smoothed, bool exactHalves)
+  const TwoCellSides& sides, const OneCellSmoothingResult& smoothed, bool exactHalves, int cutOffset)
 {
   std::array<SideSegments, 4> result;
   for (int s = 0; s < 4; ++s)
@@ -454,7 +454,9 @@ std::array<SideSegments, 4> TwoCellSideSegments(
       }
       whole = std::move(halved);
     }
-    const std::size_t half = whole.Curve.size() / 2;
+    const int count = static_cast<int>(whole.Curve.size());
+    const std::size_t half =
+      static_cast<std::size_t>(count < 2 ? count / 2 : std::clamp(count / 2 + cutOffset, 1, count - 1));
     SideSegments lower, upper;
     lower.Curve.assign(whole.Curve.begin(), whole.Curve.begin() + half);
     lower.Height.assign(whole.Height.begin(), whole.Height.begin() + half);
@@ -657,7 +659,8 @@ void TwoCellReconstruction::ParameterizeCell(const TwoCell& twoCell, const OneCe
     if (!BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed, false), this->BoundarySamples,
           this->MaximumGridSize, walk, parameters, boundary) &&
       !BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed, true), this->BoundarySamples,
-        this->MaximumGridSize, walk, parameters, boundary))
+        this->MaximumGridSize, walk, parameters, boundary) &&
+      !this->BuildBoundaryWalkCutOffMiddle(cell.Sides, smoothed, walk, parameters, boundary))
     {
       message = "its sides need more than " + std::to_string(this->MaximumGridSize) + " segments each (pieces";
       for (const SideSegments& side : TwoCellSideSegments(cell.Sides, smoothed))
@@ -746,6 +749,42 @@ void TwoCellReconstruction::LocateSamples(const PlanarScalarField& data, const s
     }
   });
   GroupByIndex(cellOf, this->NumberOfCells(), firstVertex, vertices);
+}
+
+// A side split at the segment boundary nearest its middle can leave counts whose grid layout
+// exceeds MaximumGridSize: a side of pieces 128 + 2 splits into 65 and 63 + 2, which with sides
+// of 4 and 32 need a grid of 2080, where a cut at 64 needs 128. The corner made up there can be
+// anywhere along the split side, so cuts ever farther from the middle (up to a quarter of the
+// side's segments either way) are tried, the nearest one whose layout fits is taken.
+bool TwoCellReconstruction::BuildBoundaryWalkCutOffMiddle(const TwoCellSides& sides,
+  const OneCellSmoothingResult& smoothed, std::vector<double>& walk, std::vector<double>& parameters,
+  MonotoneSurfaceBoundary& boundary) const
+{
+  int longest = 0;
+  for (int split : sides.SplitSides)
+  {
+    if (split >= 0)
+    {
+      int count = 0;
+      for (Index p : sides.Pieces[split])
+      {
+        count += smoothed.Pieces[p].Curve.Segments;
+      }
+      longest = std::max(longest, count);
+    }
+  }
+  for (int distance = 1; distance <= longest / 4; ++distance)
+  {
+    for (int offset : { -distance, distance })
+    {
+      if (BuildBoundaryWalk(TwoCellSideSegments(sides, smoothed, false, offset), this->BoundarySamples,
+            this->MaximumGridSize, walk, parameters, boundary))
+      {
+        return true;
+      }
+    }
+  }
+  return false;
 }
 
 bool TwoCellReconstruction::FitSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided,
@@ -852,8 +891,12 @@ void TwoCellReconstruction::BuildSurface(ReconstructedTwoCell& cell, const Monot
   std::string message;
   MonotoneSurfaceOptions options;
   // Subdivision and the B-spline conversion round the segment joins by ~1e-12 relative to the
-  // values, which can exceed 1e-9 of a small cell's own range.
+  // values, which can exceed 1e-9 of a small cell's own range; at piece joins the heights'
+  // zero end slopes hold to the linear program's rounding, ~1e-11 of the values: a cell of a
+  // Delaunay mesh at 0.5 % whose values all lie within 2.3e-11 (of magnitude 0.12) failed on a
+  // mismatch of 1.2e-12.
   options.ConsistencyTolerance = 1e-7;
+  options.RoundingTolerance = 1e-10;
   // A flat valley floor or ridge top along the 1-cells (see MonotoneSurfaceOptions).
   options.FlatAcrossBoundary = true;
   // False also when the conditions are infeasible somewhere: the surface is then built anyway

@@ -81,11 +81,11 @@ struct SideSegments
 int ChooseGridLayout(const std::array<SideSegments, 4>& sides, int maximum, std::array<std::vector<int>, 4>& multipliers);
 
 // The segments of the four sides (Bottom, Right, Top, Left), with an empty side made up from
-// half of its partner (TwoCellSides::SplitSides), cut at the segment boundary nearest the middle,
-// or with `exactHalves` at the exact middle of a partner of an odd count (every segment then
-// cut in two).
-std::array<SideSegments, 4> TwoCellSideSegments(
-  const TwoCellSides& sides, const OneCellSmoothingResult& smoothed, bool exactHalves = false);
+// half of its partner (TwoCellSides::SplitSides), cut at the segment boundary nearest the middle
+// (`cutOffset` segments past it, within the side), or with `exactHalves` at the exact middle of a
+// partner of an odd count (every segment then cut in two).
+std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed,
+  bool exactHalves = false, int cutOffset = 0);
 
 // One reconstructed 2-cell.
 struct ReconstructedTwoCell
@@ -226,6 +226,10 @@ private:
   // its (u, v) there; the vertices of cell c are vertices[firstVertex[c] .. firstVertex[c + 1]).
   void LocateSamples(const PlanarScalarField& data, const std::vector<Index>& hints, std::vector<Index>& firstVertex,
     std::vector<Index>& vertices, std::vector<double>& parameters) const;
+  // The boundary walk with the split sides cut off their middle, where the cut at the middle
+  // leaves no grid layout within MaximumGridSize; false if no cut does better.
+  bool BuildBoundaryWalkCutOffMiddle(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed,
+    std::vector<double>& walk, std::vector<double>& parameters, MonotoneSurfaceBoundary& boundary) const;
   // Fits the cell's interior, refining its grid (see SurfaceTolerance); returns whether refined.
   bool FitSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided,
     const std::vector<SurfaceSample>& samples) const;

@@ -325,6 +325,53 @@ TEST_CASE(SubdivisionKeepsTheCurve)
   CHECK(worst < 1e-13);
 }
 
+TEST_CASE(RoundingOfANearlyFlatCellIsAveragedAway)
+{
+  // A cell whose values all lie within 2e-11 at 0.12, as the value spreading of stage 3 leaves
+  // them on noise: a join off by 3e-13 (its end slope then by 9e-13: under 1e-11 of the values,
+  // but 4.5 % of the cell's own range) is rounding of the 1-cell fits. Refused by default; averaged away with a rounding
+  // tolerance of 1e-10 of the values. A join off by half the range is refused either way: the
+  // tolerance stays within RoundingShareOfRange of the range.
+  Random random(31);
+  MonotoneSurfaceBoundary b = MakeBoundary(random, 3, BoundaryFlavour::Regular);
+  double lowest = 1e300, highest = -1e300;
+  for (const auto* side : { &b.Bottom, &b.Right, &b.Top, &b.Left })
+  {
+    for (const auto& segment : *side)
+    {
+      lowest = std::min(lowest, *std::min_element(segment.begin(), segment.end()));
+      highest = std::max(highest, *std::max_element(segment.begin(), segment.end()));
+    }
+  }
+  const double range = 2e-11;
+  for (auto* side : { &b.Bottom, &b.Right, &b.Top, &b.Left })
+  {
+    for (auto& segment : *side)
+    {
+      for (double& c : segment)
+      {
+        c = 0.12 + range * (c - lowest) / (highest - lowest);
+      }
+    }
+  }
+  MonotoneSurfaceBoundary rounded = b;
+  rounded.Bottom[1][0] += 3e-13;
+  MonotoneSurfaceBoundary real = b;
+  real.Bottom[1][0] += 0.5 * range;
+  MonotoneSibsonSurface surface;
+  std::string error;
+  CHECK(!surface.Build(rounded, error));
+  CHECK(error.find("join") != std::string::npos);
+  MonotoneSurfaceOptions options;
+  options.RoundingTolerance = 1e-10;
+  error.clear();
+  surface.Build(rounded, error, options);
+  CHECK(error.find("join") == std::string::npos);
+  CHECK_EQ(surface.GetGridSize(), 3);
+  CHECK(!surface.Build(real, error, options));
+  CHECK(error.find("join") != std::string::npos);
+}
+
 TEST_CASE(SurfaceOfLinearDataIsLinear)
 {
   // Boundary of F = x + y: the Laplace values and difference derivatives are exact, nothing

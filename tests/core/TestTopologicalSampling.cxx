@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
@@ -34,6 +35,23 @@ struct SamplingCase
   TriangleMeshTopology Mesh;
   SamplingConstraints Constraints;
 };
+
+// An nx x ny grid of unit spacing with value(i, j) at vertex (i, j).
+PlanarScalarField UnitGrid(int nx, int ny, const std::function<double(int, int)>& value)
+{
+  PlanarScalarField field;
+  field.GridDimensions[0] = nx;
+  field.GridDimensions[1] = ny;
+  for (int j = 0; j < ny; ++j)
+  {
+    for (int i = 0; i < nx; ++i)
+    {
+      field.Points.insert(field.Points.end(), { double(i), double(j) });
+      field.Values.push_back(value(i, j));
+    }
+  }
+  return field;
+}
 
 SamplingCase TrigonometricSamplingCase()
 {
@@ -268,17 +286,7 @@ TEST_CASE(NarrowRidgeBetweenRowsIsCarvedIn)
   const double startX = 5, endX = 50;
   auto crest = [](double x) { return 5 + 0.45 * std::sin(0.7 * x); };
   auto height = [&](double x) { return 0.01 * std::min(x, endX) - 0.05 * std::max(0.0, x - endX); };
-  PlanarScalarField field;
-  field.GridDimensions[0] = nx;
-  field.GridDimensions[1] = ny;
-  for (int j = 0; j < ny; ++j)
-  {
-    for (int i = 0; i < nx; ++i)
-    {
-      field.Points.insert(field.Points.end(), { double(i), double(j) });
-      field.Values.push_back(height(i) - 10 * std::abs(j - crest(i)));
-    }
-  }
+  PlanarScalarField field = UnitGrid(nx, ny, [&](int i, int j) { return height(i) - 10 * std::abs(j - crest(i)); });
   TriangleMeshTopology mesh;
   mesh.BuildGrid(nx, ny, SequentialFor);
   auto vertexNear = [&](double x, double y) { return static_cast<Index>(std::lround(y)) * nx + std::lround(x); };
@@ -321,6 +329,13 @@ TEST_CASE(NarrowRidgeBetweenRowsIsCarvedIn)
   const int before = maximaOnTheWay(carved);
   const Index changed = CarveOneCells(field, mesh, constraints, 1.0, carved);
   const int after = maximaOnTheWay(carved);
+  // Carved only where the walk turns back: no maximum left either, and no more vertices changed.
+  std::vector<double> gently = field.Values;
+  const Index gentlyChanged = CarveOneCells(field, mesh, constraints, 1.0, gently, true);
+  std::printf("  carved only where the walk turns back: %d maxima along the ridge, %d vertices raised\n",
+    maximaOnTheWay(gently), gentlyChanged);
+  CHECK_EQ(maximaOnTheWay(gently), 0);
+  CHECK(gentlyChanged <= changed);
   double largestChange = 0;
   for (std::size_t v = 0; v < carved.size(); ++v)
   {
@@ -332,6 +347,57 @@ TEST_CASE(NarrowRidgeBetweenRowsIsCarvedIn)
   CHECK_EQ(after, 0);
   CHECK(largestChange <= 10 * 0.5 + 1e-9); // at most the fall from the crest to a vertex half a row away
   CHECK_EQ(carved[ridge.Saddle], field.Values[ridge.Saddle]);
+}
+
+TEST_CASE(RidgeOnTheBoundaryRowIsNotCarvedBesideIt)
+{
+  // An ascending 1-cell a third of a row inside the top boundary, rising along x; the first row
+  // inside dips at every other vertex, so that a walk along it turns back down there. Where the
+  // boundary row is the crest (as high as the 1-cell), carving only where needed leaves the
+  // first row inside as it is: raising it would only put a second ridge beside the boundary
+  // one. Where the crest lies inside and the boundary row runs lower, the dips of that row are
+  // raised to the 1-cell.
+  const int nx = 40, ny = 8;
+  const double crestY = ny - 1 - 1.0 / 3;
+  auto height = [](double x) { return 0.01 * x; };
+  for (const bool onBoundary : { true, false })
+  {
+    const PlanarScalarField field = UnitGrid(nx, ny, [&](int i, int j) {
+      return height(i) - 10 * std::abs(j - (onBoundary ? ny - 1 : crestY)) - (j == ny - 2 && i % 2 == 1 ? 0.03 : 0.0);
+    });
+    TriangleMeshTopology mesh;
+    mesh.BuildGrid(nx, ny, SequentialFor);
+    SamplingConstraints constraints;
+    SaddleOneCell ridge;
+    ridge.Saddle = static_cast<Index>(ny - 2) * nx + 2;
+    ridge.Ascending = true;
+    for (double x = 2; x <= nx - 3 + 1e-9; x += 0.125)
+    {
+      ridge.Points.insert(ridge.Points.end(), { x, crestY, height(x) });
+    }
+    constraints.OneCells.push_back(ridge);
+    constraints.Saddles.push_back(ridge.Saddle);
+    std::vector<double> carved = field.Values;
+    CarveOneCells(field, mesh, constraints, 1.0, carved, true);
+    std::vector<double> carvedEverywhere = field.Values;
+    CarveOneCells(field, mesh, constraints, 1.0, carvedEverywhere, false);
+    int raisedInside = 0, changedOnBoundary = 0, raisedInsideEverywhere = 0;
+    for (int i = 0; i < nx; ++i)
+    {
+      raisedInside += carved[static_cast<Index>(ny - 2) * nx + i] > field.Values[static_cast<Index>(ny - 2) * nx + i];
+      raisedInsideEverywhere +=
+        carvedEverywhere[static_cast<Index>(ny - 2) * nx + i] > field.Values[static_cast<Index>(ny - 2) * nx + i];
+      changedOnBoundary += carved[static_cast<Index>(ny - 1) * nx + i] != field.Values[static_cast<Index>(ny - 1) * nx + i];
+    }
+    std::printf("  crest %s: %d vertices of the first row inside raised (carving every walked vertex: %d), %d "
+                "boundary vertices changed\n",
+      onBoundary ? "on the boundary row" : "a third of a row inside", raisedInside, raisedInsideEverywhere,
+      changedOnBoundary);
+    CHECK_EQ(changedOnBoundary, 0);
+    CHECK(onBoundary ? raisedInside == 0 : raisedInside > nx / 4);
+    // Apply's fallback carves every walked vertex, as before.
+    CHECK(raisedInsideEverywhere > nx / 2);
+  }
 }
 
 TEST_CASE(WantedExtremaSurviveTheOtherKindsFloods)

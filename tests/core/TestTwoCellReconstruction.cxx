@@ -351,6 +351,49 @@ TEST_CASE(GridLayoutOfOddSplitSides)
   CHECK_EQ(ChooseGridLayout({ side({ 19, 19 }), side({ 19 }), side({ 38 }), side({ 38 }) }, 512, multipliers), 38);
 }
 
+TEST_CASE(SplitSidesAreCutWhereAGridLayoutFits)
+{
+  // The right side holds pieces of 128 and 2 segments and the bottom side is empty: cut at the
+  // segment boundary nearest the middle, the halves are 65 and 63 + 2, which with sides of 4 and
+  // 32 need a grid of 2080 (none up to 512; exact halves give the same counts). One segment
+  // lower, 64 and 64 + 2 need 128. The cut stays on a segment boundary of the piece.
+  OneCellSmoothingResult smoothed;
+  smoothed.Pieces.resize(4);
+  const int counts[4] = { 128, 2, 4, 32 };
+  for (int p = 0; p < 4; ++p)
+  {
+    auto& piece = smoothed.Pieces[p];
+    piece.Curve.Segments = piece.Height.Segments = counts[p];
+    piece.Curve.Dimension = 2;
+    for (int j = 0; j < counts[p]; ++j)
+    {
+      const double x = j, y = p;
+      piece.Curve.ControlPoints.insert(piece.Curve.ControlPoints.end(), { x, y, x + 0.3, y, x + 0.6, y, x + 1, y });
+      piece.Height.ControlPoints.insert(piece.Height.ControlPoints.end(), { x, x + 0.3, x + 0.6, x + 1 });
+    }
+  }
+  TwoCellSides sides;
+  sides.Pieces[TwoCellSides::Right] = { 0, 1 };
+  sides.Pieces[TwoCellSides::Top] = { 2 };
+  sides.Pieces[TwoCellSides::Left] = { 3 };
+  sides.SplitSides = { { int(TwoCellSides::Right), -1 } };
+  std::array<std::vector<int>, 4> multipliers;
+  const auto middle = TwoCellSideSegments(sides, smoothed);
+  CHECK(middle[TwoCellSides::Bottom].Pieces == std::vector<int>({ 65 }));
+  CHECK(middle[TwoCellSides::Right].Pieces == std::vector<int>({ 63, 2 }));
+  CHECK_EQ(ChooseGridLayout(middle, 512, multipliers), 0);
+  CHECK_EQ(ChooseGridLayout(TwoCellSideSegments(sides, smoothed, true), 512, multipliers), 0);
+  const auto lower = TwoCellSideSegments(sides, smoothed, false, -1);
+  CHECK(lower[TwoCellSides::Bottom].Pieces == std::vector<int>({ 64 }));
+  CHECK(lower[TwoCellSides::Right].Pieces == std::vector<int>({ 64, 2 }));
+  CHECK_EQ(ChooseGridLayout(lower, 512, multipliers), 128);
+  CHECK(lower[TwoCellSides::Bottom].Curve.back()[6] == 64 && lower[TwoCellSides::Right].Curve.front()[0] == 64);
+  CHECK(lower[TwoCellSides::Bottom].Height.back()[3] == 64 && lower[TwoCellSides::Right].Height.front()[0] == 64);
+  // Offsets beyond the side are clamped: at least one segment stays on each half.
+  const auto far = TwoCellSideSegments(sides, smoothed, false, -1000);
+  CHECK(far[TwoCellSides::Bottom].Pieces == std::vector<int>({ 1 }));
+}
+
 TEST_CASE(DegenerateInputsNeverCrash)
 {
   // Tiny grids, a ramp (one cell), noise with many tiny and pouch cells, a plateau.
