@@ -1001,23 +1001,28 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
       }
     }
   }
-  // Carved only where needed first (few vertices change); where saddles are then left off their
-  // nodes (uniform noise), once more with every walked vertex carved, from the same start, and
-  // the sampling with fewer displaced saddles is kept. On the stress set's noise the gentle
-  // carving alone lost 11 verdicts and gained 5 (docs/Reconstruction.md). Not on samplings
-  // beyond MaximumVerticesForSecondPass: there the second pass costs seconds (2 s of the 2000 x
-  // 2000 terrain's 14, for one saddle that it left off all the same).
+  // The gentlest carving first (fewest vertices change); while saddles are then left off their
+  // nodes (uniform noise), once more with the next carving, from the same start, and the
+  // sampling with the fewest displaced saddles is kept (the gentler of equals). On the stress
+  // set's noise a gentle carving alone lost verdicts that the full one keeps (and gained
+  // others; docs/Reconstruction.md, "1-cells carved in"). Not on samplings beyond
+  // MaximumVerticesForMorePasses: there a pass costs seconds (2 s of the 2000 x 2000 terrain's
+  // 14, for one saddle that it left off all the same).
   const SamplingConstraints wanted = constraints;
   const std::vector<double> prepared = values;
-  TopologicalSamplingReport report = this->Settle(sampling, mesh, vertexAt, wanted, true, values);
-  if (report.DisplacedSaddles > 0 && mesh.NumberOfVertices() <= this->MaximumVerticesForSecondPass)
+  TopologicalSamplingReport report = this->Settle(sampling, mesh, vertexAt, wanted, OneCellCarving::JustPastTheWalk, values);
+  for (const OneCellCarving carving : { OneCellCarving::WhereNeeded, OneCellCarving::Everywhere })
   {
-    std::vector<double> carvedEverywhere = prepared;
-    const TopologicalSamplingReport second = this->Settle(sampling, mesh, vertexAt, wanted, false, carvedEverywhere);
-    if (second.DisplacedSaddles < report.DisplacedSaddles)
+    if (report.DisplacedSaddles == 0 || mesh.NumberOfVertices() > this->MaximumVerticesForMorePasses)
     {
-      values = std::move(carvedEverywhere);
-      report = second;
+      break;
+    }
+    std::vector<double> carved = prepared;
+    const TopologicalSamplingReport next = this->Settle(sampling, mesh, vertexAt, wanted, carving, carved);
+    if (next.DisplacedSaddles < report.DisplacedSaddles)
+    {
+      values = std::move(carved);
+      report = next;
     }
   }
   report.ChangedVertices = 0;
@@ -1029,12 +1034,12 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
 // The steps of Apply after the nodes' values: the 1-cells carved in, the boundary junctions
 // placed, the floods, and the saddles moved back onto their nodes.
 TopologicalSamplingReport TopologicalSampling::Settle(const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
-  const std::function<Index(Index)>& vertexAt, const SamplingConstraints& wanted, bool onlyWhereNeeded,
+  const std::function<Index(Index)>& vertexAt, const SamplingConstraints& wanted, OneCellCarving carving,
   std::vector<double>& values) const
 {
   const double reach = this->SaddleReach();
   SamplingConstraints constraints = wanted;
-  CarveOneCells(sampling, mesh, constraints, this->Spacing, values, onlyWhereNeeded);
+  CarveOneCells(sampling, mesh, constraints, this->Spacing, values, carving);
   const double junctionReach = BoundaryJunctionReach * this->Spacing;
   for (Index v : PlaceBoundaryJunctions(this->Complex, sampling, mesh, vertexAt, junctionReach, values))
   {
@@ -1725,25 +1730,28 @@ struct CarvingGround
 struct CarvingRequests
 {
   std::unordered_map<Index, double> RaiseTo, LowerTo;
-  bool OnlyWhereNeeded = false;
+  OneCellCarving Carving = OneCellCarving::Everywhere;
 
   // Asks for v the height of a 1-cell there, strictly past `previous` (the value before v along
-  // the walk); with OnlyWhereNeeded, not if v already lies past `previous`: the walk
-  // then goes on rising (falling) through v as it is, and no island can form there. Carving
-  // every vertex walked onto up to the 1-cell's height changed 2-3 % of the vertices of a
-  // reconstruction, most of them by more than 0.1 % of the range (a vertex beside a ridge lies
-  // on its flank); carving only where the walk would turn back halves that, with the same
-  // verdicts on the catalog and the synthetic fields, but not on noise (docs/Reconstruction.md,
-  // "1-cells carved in"). Returns v's value along the walk once carved.
+  // the walk). Gentler carvings (OneCellCarving) leave v alone if it already lies past
+  // `previous`: the walk then goes on rising (falling) through v as it is, and no island can
+  // form there; JustPastTheWalk asks only just past `previous`. Carving every vertex walked onto
+  // up to the 1-cell's height changed 2-3 % of the vertices of a reconstruction, most of them by
+  // more than 0.1 % of the range (a vertex beside a ridge lies on its flank), and raising a
+  // vertex beside a one-pixel peak to the 1-cell's height there took it 20 % of the range above
+  // the data (docs/Reconstruction.md, "1-cells carved in"). Returns v's value along the walk
+  // once carved.
   double Ask(Index v, double height, double previous, bool up, const std::vector<double>& values)
   {
     const double infinity = std::numeric_limits<double>::infinity();
-    if (this->OnlyWhereNeeded && (up ? values[v] > previous : values[v] < previous))
+    if (this->Carving != OneCellCarving::Everywhere && (up ? values[v] > previous : values[v] < previous))
     {
       return values[v];
     }
-    const double wanted =
-      up ? std::max(height, std::nextafter(previous, infinity)) : std::min(height, std::nextafter(previous, -infinity));
+    const double pastPrevious = std::nextafter(previous, up ? infinity : -infinity);
+    const double wanted = this->Carving == OneCellCarving::JustPastTheWalk ? pastPrevious
+      : up                                                                ? std::max(height, pastPrevious)
+                                                                          : std::min(height, pastPrevious);
     auto& asked = up ? this->RaiseTo : this->LowerTo;
     auto found = asked.find(v);
     if (found == asked.end())
@@ -1808,7 +1816,8 @@ void AskAlongOneCell(const CarvingGround& ground, const SaddleOneCell& cell, con
       }
       current = nearest;
       if (!ground.LeftAlone(current, start) &&
-        !(requests.OnlyWhereNeeded && cell.Ascending && ground.BoundaryCarries(current, q[i + 2], values)))
+        !(requests.Carving != OneCellCarving::Everywhere && cell.Ascending &&
+          ground.BoundaryCarries(current, q[i + 2], values)))
       {
         previous = requests.Ask(current, q[i + 2], previous, cell.Ascending, values);
       }
@@ -1818,11 +1827,11 @@ void AskAlongOneCell(const CarvingGround& ground, const SaddleOneCell& cell, con
 } // namespace
 
 Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
-  const SamplingConstraints& constraints, double spacing, std::vector<double>& values, bool onlyWhereNeeded)
+  const SamplingConstraints& constraints, double spacing, std::vector<double>& values, OneCellCarving carving)
 {
   const CarvingGround ground{ field.Points, mesh, spacing, CriticalVertices(constraints) };
   CarvingRequests requests;
-  requests.OnlyWhereNeeded = onlyWhereNeeded;
+  requests.Carving = carving;
   for (const SaddleOneCell& cell : constraints.OneCells)
   {
     AskAlongOneCell(ground, cell, values, requests);

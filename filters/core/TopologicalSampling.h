@@ -70,6 +70,21 @@ SamplingConstraints ComplexConstraints(const MorseSmaleComplex& complex, const T
 
 
 
+// How CarveOneCells changes the vertices it walks along a 1-cell. The gentler, the fewer
+// vertices change and the less, but on noise a saddle ends off its node more often:
+// TopologicalSampling::Apply tries them in this order.
+enum class OneCellCarving : int
+{
+  // Only where the walk would turn back (a vertex it reaches already past the value before it
+  // keeps its value), and then just past that value; a ridge is not carved beside a boundary
+  // row that stands as high.
+  JustPastTheWalk = 0,
+  // As JustPastTheWalk, but raised (lowered) to the 1-cell's height.
+  WhereNeeded = 1,
+  // Every vertex walked onto, to the 1-cell's height.
+  Everywhere = 2
+};
+
 // Embeds the complex's 1-cells (constraints.OneCells) in the sampling before the floods. A
 // 1-cell is a crease of F o Phi (a ridge for an ascending one, a valley for a descending one)
 // that can run between two rows of vertices, where no vertex sees it: along a narrow ridge
@@ -82,22 +97,18 @@ SamplingConstraints ComplexConstraints(const MorseSmaleComplex& complex, const T
 // ridge and a valley both claim, and boundary vertices the 1-cell does not run through.
 // Critical vertices keep their values (the nodes' critical values, as Apply sets them), and
 // no vertex next to a wanted maximum (minimum) is raised (lowered) past it.
-// With `onlyWhereNeeded`, a vertex the walk reaches already past the value before it keeps
-// its value (the walk goes on rising, or falling, through it), and a ridge is not carved beside
-// a boundary row that stands as high: far fewer vertices change, but on noise a saddle ends
-// off its node more often (Apply tries this first).
-// Returns the number of changed vertices.
+// `carving` says how far (OneCellCarving). Returns the number of changed vertices.
 Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, double spacing, std::vector<double>& values,
-  bool onlyWhereNeeded = false);
+  OneCellCarving carving = OneCellCarving::Everywhere);
 
 // The whole topological sampling of a reconstruction: the complex's critical points as
 // constraints, its smoothed 1-cells carved in (CarveOneCells), the floods
 // (EnforceCriticalVertices) and the saddles moved back onto their nodes (within Spacing,
-// looked for within 8 spacings). The 1-cells are carved only where needed first; if saddles
-// are then left off their nodes, the whole sequence runs again with every walked vertex carved
-// (on samplings of at most MaximumVerticesForSecondPass vertices), and the sampling with fewer
-// displaced saddles is kept. The complex side is fixed at construction; Apply samples one
+// looked for within 8 spacings). The 1-cells are carved gently first (OneCellCarving); while
+// saddles are left off their nodes, the whole sequence runs again with the next carving (on
+// samplings of at most MaximumVerticesForMorePasses vertices), and the sampling with the fewest
+// displaced saddles is kept, the gentler one of equals. The complex side is fixed at construction; Apply samples one
 // sampling of the reconstruction (the input vertices, a finer grid).
 // `complexPoints` (x, y per vertex of `complexMesh`) tells where the nodes are: on a sampling
 // whose vertices do not include them (an image resampled over a triangle mesh), the vertex
@@ -123,9 +134,9 @@ public:
   double Spacing = 1;
   // Runs the extractions of the sampled critical points (the floods are sequential).
   ParallelFor Parallel = SequentialFor;
-  // Samplings with more vertices keep the first pass (carved only where needed) even with
-  // saddles off their nodes (see Apply).
-  Index MaximumVerticesForSecondPass = Index(1) << 20;
+  // Samplings with more vertices keep the first pass (the gentlest carving) even with saddles
+  // off their nodes (see Apply).
+  Index MaximumVerticesForMorePasses = Index(1) << 20;
 
   // `values` (one per vertex of `mesh`, at sampling.Points) is modified in place; `vertexAt`
   // gives the sampling's vertex for a vertex of the complex's mesh (InvalidIndex: none). The
@@ -137,7 +148,7 @@ private:
   // How far from its node a saddle is looked for and carved back.
   double SaddleReach() const { return 8 * this->Spacing; }
   TopologicalSamplingReport Settle(const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
-    const std::function<Index(Index)>& vertexAt, const SamplingConstraints& wanted, bool onlyWhereNeeded,
+    const std::function<Index(Index)>& vertexAt, const SamplingConstraints& wanted, OneCellCarving carving,
     std::vector<double>& values) const;
 
   const MorseSmaleComplex& Complex;

@@ -331,7 +331,7 @@ TEST_CASE(NarrowRidgeBetweenRowsIsCarvedIn)
   const int after = maximaOnTheWay(carved);
   // Carved only where the walk turns back: no maximum left either, and no more vertices changed.
   std::vector<double> gently = field.Values;
-  const Index gentlyChanged = CarveOneCells(field, mesh, constraints, 1.0, gently, true);
+  const Index gentlyChanged = CarveOneCells(field, mesh, constraints, 1.0, gently, OneCellCarving::JustPastTheWalk);
   std::printf("  carved only where the walk turns back: %d maxima along the ridge, %d vertices raised\n",
     maximaOnTheWay(gently), gentlyChanged);
   CHECK_EQ(maximaOnTheWay(gently), 0);
@@ -378,9 +378,9 @@ TEST_CASE(RidgeOnTheBoundaryRowIsNotCarvedBesideIt)
     constraints.OneCells.push_back(ridge);
     constraints.Saddles.push_back(ridge.Saddle);
     std::vector<double> carved = field.Values;
-    CarveOneCells(field, mesh, constraints, 1.0, carved, true);
+    CarveOneCells(field, mesh, constraints, 1.0, carved, OneCellCarving::WhereNeeded);
     std::vector<double> carvedEverywhere = field.Values;
-    CarveOneCells(field, mesh, constraints, 1.0, carvedEverywhere, false);
+    CarveOneCells(field, mesh, constraints, 1.0, carvedEverywhere, OneCellCarving::Everywhere);
     int raisedInside = 0, changedOnBoundary = 0, raisedInsideEverywhere = 0;
     for (int i = 0; i < nx; ++i)
     {
