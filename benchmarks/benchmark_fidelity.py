@@ -133,13 +133,13 @@ def run(make_source, percent, k, interior, name):
     exact = pd.GetArray("ReconstructedExact")
     difference = pd.GetArray("Difference")
     values = pd.GetArray("Reconstructed")
-    # L_inf of F o Phi: Reconstructed - Difference is the input.
+    points = out.GetNumberOfPoints()
+    # The input: Reconstructed - Difference.
+    data = [values.GetValue(i) - difference.GetValue(i) for i in range(points)]
+    # L_inf of F o Phi.
     exact_error = 0.0
     if exact is not None:
-        for i in range(out.GetNumberOfPoints()):
-            data = values.GetValue(i) - difference.GetValue(i)
-            exact_error = max(exact_error, abs(exact.GetValue(i) - data))
-    points = out.GetNumberOfPoints()
+        exact_error = max(abs(exact.GetValue(i) - data[i]) for i in range(points))
     result = {
         "linf_range": 100 * number(fd, "MaximumError") / span,
         "rms_range": 100 * number(fd, "RMSError") / span,
@@ -156,7 +156,6 @@ def run(make_source, percent, k, interior, name):
     }
     result["linf_eps"] = result["linf_range"] / percent if percent > 0 else float("nan")
     if (name, percent) not in REFERENCES:
-        data = [values.GetValue(i) - difference.GetValue(i) for i in range(points)]
         REFERENCES[(name, percent)] = flood_reference(simplified, data, span)
     result["flood_rms_range"], result["flood_linf_range"] = REFERENCES[(name, percent)]
     for proxy in (reconstruct, smooth, simplified, ms, source):

@@ -1005,20 +1005,21 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   // nodes (uniform noise), once more with the next carving, from the same start, and the
   // sampling with the fewest displaced saddles is kept (the gentler of equals). On the stress
   // set's noise a gentle carving alone lost verdicts that the full one keeps (and gained
-  // others; docs/Reconstruction.md, "1-cells carved in"). Not on samplings beyond
+  // others; docs/Reconstruction.md, "Gentle carving first"). Not on samplings beyond
   // MaximumVerticesForMorePasses: there a pass costs seconds (2 s of the 2000 x 2000 terrain's
-  // 14, for one saddle that it left off all the same).
-  const SamplingConstraints wanted = constraints;
-  const std::vector<double> prepared = values;
-  TopologicalSamplingReport report = this->Settle(sampling, mesh, vertexAt, wanted, OneCellCarving::JustPastTheWalk, values);
+  // 14, for one saddle that it left off all the same), and the start is not kept.
+  const bool morePasses = mesh.NumberOfVertices() <= this->MaximumVerticesForMorePasses;
+  const std::vector<double> prepared = morePasses ? values : std::vector<double>();
+  TopologicalSamplingReport report =
+    this->Settle(sampling, mesh, vertexAt, constraints, OneCellCarving::JustPastTheWalk, values);
   for (const OneCellCarving carving : { OneCellCarving::WhereNeeded, OneCellCarving::Everywhere })
   {
-    if (report.DisplacedSaddles == 0 || mesh.NumberOfVertices() > this->MaximumVerticesForMorePasses)
+    if (report.DisplacedSaddles == 0 || !morePasses)
     {
       break;
     }
     std::vector<double> carved = prepared;
-    const TopologicalSamplingReport next = this->Settle(sampling, mesh, vertexAt, wanted, carving, carved);
+    const TopologicalSamplingReport next = this->Settle(sampling, mesh, vertexAt, constraints, carving, carved);
     if (next.DisplacedSaddles < report.DisplacedSaddles)
     {
       values = std::move(carved);
@@ -1739,7 +1740,7 @@ struct CarvingRequests
   // up to the 1-cell's height changed 2-3 % of the vertices of a reconstruction, most of them by
   // more than 0.1 % of the range (a vertex beside a ridge lies on its flank), and raising a
   // vertex beside a one-pixel peak to the 1-cell's height there took it 20 % of the range above
-  // the data (docs/Reconstruction.md, "1-cells carved in"). Returns v's value along the walk
+  // the data (docs/Reconstruction.md, "Gentle carving first"). Returns v's value along the walk
   // once carved.
   double Ask(Index v, double height, double previous, bool up, const std::vector<double>& values)
   {

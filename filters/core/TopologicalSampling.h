@@ -108,8 +108,9 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
 // looked for within 8 spacings). The 1-cells are carved gently first (OneCellCarving); while
 // saddles are left off their nodes, the whole sequence runs again with the next carving (on
 // samplings of at most MaximumVerticesForMorePasses vertices), and the sampling with the fewest
-// displaced saddles is kept, the gentler one of equals. The complex side is fixed at construction; Apply samples one
-// sampling of the reconstruction (the input vertices, a finer grid).
+// displaced saddles is kept, the gentler one of equals. The complex side is fixed at
+// construction; Apply samples one sampling of the reconstruction (the input vertices, a finer
+// grid).
 // `complexPoints` (x, y per vertex of `complexMesh`) tells where the nodes are: on a sampling
 // whose vertices do not include them (an image resampled over a triangle mesh), the vertex
 // nearest each node first takes the node's critical value, so that the wanted extremum is
