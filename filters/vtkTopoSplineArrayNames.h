@@ -138,6 +138,7 @@ constexpr const char* OutsideSlitTwoCells = "OutsideSlitTwoCells";
 constexpr const char* MaximumGridSize = "MaximumGridSize";
 constexpr const char* FittedCells = "FittedCells";
 constexpr const char* RefinedCells = "RefinedCells";
+constexpr const char* StiffenedCells = "StiffenedCells";
 constexpr const char* SnappedPoints = "SnappedPoints";
 constexpr const char* PointsOnOneCells = "PointsOnOneCells";
 constexpr const char* UnreconstructedPoints = "UnreconstructedPoints";

@@ -280,6 +280,7 @@ void WriteReport(const topospline::FieldReconstructionReport& report, vtkFieldDa
   AddFieldNumbers(fd, names::MaximumGridSize, { static_cast<double>(cells.MaximumGridSize) });
   AddFieldNumbers(fd, names::FittedCells, { static_cast<double>(cells.FittedCells) });
   AddFieldNumbers(fd, names::RefinedCells, { static_cast<double>(cells.RefinedCells) });
+  AddFieldNumbers(fd, names::StiffenedCells, { static_cast<double>(cells.StiffenedCells) });
   AddFieldNumbers(fd, names::SnappedPoints, { static_cast<double>(report.SnappedPoints) });
   AddFieldNumbers(fd, names::PointsOnOneCells, { static_cast<double>(report.PointsOnOneCells) });
   AddFieldNumbers(fd, names::UnreconstructedPoints, { static_cast<double>(report.UnreconstructedPoints) });

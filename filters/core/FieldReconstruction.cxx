@@ -288,7 +288,14 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
   this->Cells.Parallel = this->Parallel;
   this->Cells.Hooks.Progress = [this](double f) { this->Hooks.Report(0.6 * f); };
   this->Cells.Hooks.AbortRequested = this->Hooks.AbortRequested;
-  if (!this->Cells.Reconstruct(complex, smoothed, error, &field))
+  TriangleMeshTopology mesh;
+  std::string ignored; // the input's mesh was checked by stage 1
+  BuildMesh(field, mesh, this->Parallel, ignored);
+  this->Cells.Mesh = &mesh; // for the stiffening rounds: which vertices are neighbours
+  this->Cells.StiffeningRounds = this->StiffeningRounds;
+  const bool reconstructed = this->Cells.Reconstruct(complex, smoothed, error, &field);
+  this->Cells.Mesh = nullptr; // a local
+  if (!reconstructed)
   {
     return false;
   }
@@ -302,9 +309,6 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
   }
 
   this->EvaluateAtVertices(field, complex, smoothed, report);
-  TriangleMeshTopology mesh;
-  std::string ignored; // the input's mesh was checked by stage 1
-  BuildMesh(field, mesh, this->Parallel, ignored);
   if (this->TopologicalSampling)
   {
     this->SampleTopologicallyAtVertices(field, mesh, complex, smoothed, report);

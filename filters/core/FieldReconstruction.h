@@ -89,6 +89,9 @@ public:
   // Fitted interiors: a cell's grid is refined while its largest residual exceeds this fraction
   // of the input's value range (<= 0: no refinement).
   double SurfaceTolerance = 0.01;
+  // Fitted interiors: rounds of stiffening where a fit, sampled at the input's vertices, has
+  // critical points deep inside its cell (TwoCellReconstruction::StiffeningRounds; 0: none).
+  int StiffeningRounds = 5;
   bool TopologicalSampling = true;
   bool VerifyTopology = true;
   double MemoryBudget = 0; // bytes for the 2-cells' surfaces (TwoCellReconstruction::MemoryBudget)

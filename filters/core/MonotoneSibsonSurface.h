@@ -114,6 +114,21 @@ struct MonotoneSurfaceFitOptions
   // Also aim at p >= 0 and q >= 0 (F increasing along u and v, as its sides are), not enforced
   // exactly (see FitToSamples).
   bool IncreasingAlongAxes = true;
+  // Spots of the square where an earlier fit, sampled at the input vertices, had a critical
+  // point that no node of the complex explains (TwoCellReconstruction's stiffening): the
+  // thin-plate weight of every grid cell within StiffRadius grid steps of a spot is multiplied
+  // by the spot's factor (the largest one, where spots overlap).
+  struct StiffSpot
+  {
+    double U = 0;
+    double V = 0;
+    double Factor = 1;
+  };
+  std::vector<StiffSpot> StiffSpots;
+  double StiffRadius = 1.5;
+  // The fit replaces the surface it starts from (the paper's, or an earlier fit) only if its
+  // RMS residual is at most this times the starting surface's.
+  double AcceptedResidualGrowth = 1;
   ConstrainedLeastSquaresOptions Solver;
 };
 

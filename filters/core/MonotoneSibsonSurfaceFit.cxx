@@ -231,6 +231,22 @@ void MonotoneSibsonSurface::AssembleFit(const FreeOrdinates& free, const std::ve
   // sample, so that the balance with the data does not depend on how many the cell has.
   const LocalMatrix& energy = ThinPlateEnergy();
   const double mu = options.Smoothness * static_cast<double>(samples.size()) * n * n;
+  std::vector<double> stiffness(static_cast<std::size_t>(n) * n, 1.0);
+  for (const MonotoneSurfaceFitOptions::StiffSpot& spot : options.StiffSpots)
+  {
+    const double r = options.StiffRadius;
+    const double x = spot.U * n, y = spot.V * n;
+    for (int j = std::max(0, static_cast<int>(std::floor(y - r))); j < std::min(n, static_cast<int>(std::ceil(y + r))); ++j)
+    {
+      for (int i = std::max(0, static_cast<int>(std::floor(x - r))); i < std::min(n, static_cast<int>(std::ceil(x + r))); ++i)
+      {
+        if (std::hypot(i + 0.5 - x, j + 0.5 - y) <= r)
+        {
+          stiffness[j * n + i] = std::max(stiffness[j * n + i], spot.Factor);
+        }
+      }
+    }
+  }
   const std::array<LocalVector, 3> conditions = CellConditionForms();
   const double rise = this->Z[this->Node(n, n)] - this->Z[this->Node(0, 0)];
   const double margin = options.MarginFraction * std::max(0.0, rise) / n;
@@ -264,7 +280,8 @@ void MonotoneSibsonSurface::AssembleFit(const FreeOrdinates& free, const std::ve
         }
       }
       // (E x + d0)^T (M + mu K) (E x + d0) - 2 b^T (E x + d0), M and b the normal equations.
-      const LocalMatrix cellMatrix = LocalMatrix(normal[j * n + i].selfadjointView<Eigen::Lower>()) + mu * energy;
+      const LocalMatrix cellMatrix =
+        LocalMatrix(normal[j * n + i].selfadjointView<Eigen::Lower>()) + mu * stiffness[j * n + i] * energy;
       const LocalVector cellGradient = moment[j * n + i] - cellMatrix * d0;
       for (int a = 0; a < LocalData; ++a)
       {
@@ -424,7 +441,7 @@ bool MonotoneSibsonSurface::FitToSamples(
   this->BuildPatches();
   double maximum, rms;
   this->MeasureResiduals(samples, maximum, rms);
-  if (this->CountViolatingCells() > 0 || !(rms <= this->Fit.PaperRMSResidual))
+  if (this->CountViolatingCells() > 0 || !(rms <= options.AcceptedResidualGrowth * this->Fit.PaperRMSResidual))
   {
     this->Z = paperZ;
     this->P = paperP;

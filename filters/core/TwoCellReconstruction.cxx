@@ -599,18 +599,21 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
     complex.TwoCellId.size() == data->Values.size() && data->Points.size() == 2 * data->Values.size();
   std::vector<Index> firstVertex, vertices; // vertices of cell c: [firstVertex[c], firstVertex[c + 1])
   std::vector<double> parameters;           // (u, v) per vertex in its cell
+  std::vector<Index> cellOf;                // the cell of every vertex (InvalidIndex: none)
   if (fit)
   {
     // Every vertex is data for the smoothed cell that contains it (near the 1-cells that is
     // often not the region stage 1 put it in).
     this->BuildCellLocator();
-    this->LocateSamples(*data, complex.TwoCellId, firstVertex, vertices, parameters);
+    this->LocateSamples(*data, complex.TwoCellId, firstVertex, vertices, parameters, cellOf);
   }
+  const bool stiffen = fit && this->Mesh != nullptr && this->StiffeningRounds > 0 &&
+    this->Mesh->NumberOfVertices() == static_cast<Index>(data->Values.size());
   if (!this->SurfacesFitInMemory(boundaries, firstVertex, error))
   {
     return false;
   }
-  std::vector<char> refined(n, 0);
+  std::vector<char> refined(n, 0), stiffened(n, 0);
   this->Parallel(0, n, [&](Index begin, Index end) {
     for (Index c = begin; c < end && !this->Hooks.Aborted(); ++c)
     {
@@ -625,6 +628,10 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
           samples.push_back({ parameters[2 * vertices[k]], parameters[2 * vertices[k] + 1], data->Values[vertices[k]] });
         }
         refined[c] = this->FitSurface(cell, boundaries[c], samples);
+        if (stiffen && cell.Surface.FitReport().Fitted)
+        {
+          stiffened[c] = this->StiffenWhereSamplingBreaks(c, cell, samples, vertices.data() + firstVertex[c], cellOf);
+        }
       }
     }
   });
@@ -634,6 +641,7 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
     return false;
   }
   this->Summary.RefinedCells = std::count(refined.begin(), refined.end(), 1);
+  this->Summary.StiffenedCells = std::count(stiffened.begin(), stiffened.end(), 1);
   this->Summary.SurfaceSeconds = Seconds(start);
   this->Summarize();
   this->BuildCellLocator();
@@ -730,10 +738,11 @@ void TwoCellReconstruction::ParameterizeCell(const TwoCell& twoCell, const OneCe
 }
 
 void TwoCellReconstruction::LocateSamples(const PlanarScalarField& data, const std::vector<Index>& hints,
-  std::vector<Index>& firstVertex, std::vector<Index>& vertices, std::vector<double>& parameters) const
+  std::vector<Index>& firstVertex, std::vector<Index>& vertices, std::vector<double>& parameters,
+  std::vector<Index>& cellOf) const
 {
   const Index count = static_cast<Index>(data.Values.size());
-  std::vector<Index> cellOf(count, InvalidIndex);
+  cellOf.assign(count, InvalidIndex);
   parameters.assign(2 * static_cast<std::size_t>(count), 0.0);
   this->Parallel(0, count, [&](Index begin, Index end) {
     for (Index v = begin; v < end; ++v)
@@ -831,6 +840,150 @@ bool TwoCellReconstruction::FitSurface(ReconstructedTwoCell& cell, const Monoton
     refined = true;
   }
   return refined;
+}
+
+namespace
+{
+// Whether vertex v (inside the mesh) is critical for the values `value(w)` (ties broken by
+// vertex id, stage 1's order): its link is a cycle, one edge per incident triangle, and a
+// regular vertex's link changes between lower and upper exactly twice.
+template <typename Values>
+bool IsCriticalVertex(const TriangleMeshTopology& mesh, Index v, const Values& value)
+{
+  const double fv = value(v);
+  const auto lower = [&](Index w) {
+    const double fw = value(w);
+    return fw < fv || (fw == fv && w < v);
+  };
+  int changes = 0;
+  for (Index i = mesh.VertexTriangleBegin(v); i < mesh.VertexTriangleEnd(v); ++i)
+  {
+    const auto& t = mesh.TriangleVertices[mesh.VertexTriangle(i)];
+    const int at = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+    changes += lower(t[(at + 1) % 3]) != lower(t[(at + 2) % 3]) ? 1 : 0;
+  }
+  return changes != 2;
+}
+
+// Vertices of cell c two rings of vertices or more inside it (every vertex within two edges
+// in c, none on the mesh boundary): no smoothed 1-cell passes next to them.
+std::vector<Index> DeepVertices(
+  const TriangleMeshTopology& mesh, Index c, const Index* vertices, Index count, const std::vector<Index>& cellOf)
+{
+  const auto ringInCell = [&](Index v) {
+    if (mesh.IsBoundaryVertex(v))
+    {
+      return false;
+    }
+    for (Index i = mesh.VertexTriangleBegin(v); i < mesh.VertexTriangleEnd(v); ++i)
+    {
+      for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
+      {
+        if (cellOf[w] != c)
+        {
+          return false;
+        }
+      }
+    }
+    return true;
+  };
+  std::vector<Index> deep;
+  for (Index k = 0; k < count; ++k)
+  {
+    const Index v = vertices[k];
+    bool all = ringInCell(v);
+    for (Index i = mesh.VertexTriangleBegin(v); all && i < mesh.VertexTriangleEnd(v); ++i)
+    {
+      for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
+      {
+        all = all && (w == v || ringInCell(w));
+      }
+    }
+    if (all)
+    {
+      deep.push_back(k);
+    }
+  }
+  return deep;
+}
+} // namespace
+
+// A monotone F has no critical point, but sampled at the vertices, a ridge or a trough that
+// rises slowly along its crest compared with its flanks breaks into pairs of critical points:
+// the fit makes such crests where the monotonicity rows bind against data that falls (a
+// cancelled pit filled, its rim kept). Stiffening the thin plate there widens them until the
+// vertices see the rise.
+bool TwoCellReconstruction::StiffenWhereSamplingBreaks(Index c, ReconstructedTwoCell& cell,
+  const std::vector<SurfaceSample>& samples, const Index* vertices,
+  const std::vector<Index>& cellOf) const
+{
+  const TriangleMeshTopology& mesh = *this->Mesh;
+  const Index count = static_cast<Index>(samples.size());
+  const std::vector<Index> deep = DeepVertices(mesh, c, vertices, count, cellOf);
+  if (deep.empty())
+  {
+    return false;
+  }
+  // The deep vertices critical for F sampled at the cell's vertices (the rings of deep
+  // vertices lie in the cell).
+  const auto criticalSpots = [&](const MonotoneSibsonSurface& surface) {
+    std::unordered_map<Index, double> sampled;
+    sampled.reserve(2 * count);
+    for (Index k = 0; k < count; ++k)
+    {
+      sampled[vertices[k]] = surface.Evaluate(samples[k].U, samples[k].V);
+    }
+    const auto value = [&sampled](Index w) { return sampled.at(w); };
+    std::vector<Index> critical;
+    for (Index k : deep)
+    {
+      if (IsCriticalVertex(mesh, vertices[k], value))
+      {
+        critical.push_back(k);
+      }
+    }
+    return critical;
+  };
+  std::vector<Index> critical = criticalSpots(cell.Surface);
+  std::size_t fewest = critical.size();
+  MonotoneSurfaceFitOptions options = this->Fit;
+  options.AcceptedResidualGrowth = this->StiffeningResidualGrowth;
+  const MonotoneSibsonSurface first = cell.Surface;
+  bool stiffened = false;
+  for (int round = 0, stale = 0; round < this->StiffeningRounds && !critical.empty(); ++round)
+  {
+    // Stiffer where it was stiffened before, and around the points the last fit left (a crest
+    // can move aside instead of widening).
+    for (MonotoneSurfaceFitOptions::StiffSpot& spot : options.StiffSpots)
+    {
+      spot.Factor *= this->StiffeningFactor;
+    }
+    for (Index k : critical)
+    {
+      options.StiffSpots.push_back({ samples[k].U, samples[k].V, this->StiffeningFactor });
+    }
+    // From the first fit (it meets every row), kept within the allowed growth of its residual:
+    // stiffer rounds only fit worse, so a refused one ends the rounds.
+    MonotoneSibsonSurface trial = first;
+    std::string message;
+    if (!trial.FitToSamples(samples, message, options) || !trial.FitReport().Fitted)
+    {
+      break;
+    }
+    critical = criticalSpots(trial);
+    if (critical.size() < fewest)
+    {
+      fewest = critical.size();
+      cell.Surface = std::move(trial);
+      stiffened = true;
+      stale = 0;
+    }
+    else if (++stale == 2)
+    {
+      break; // points that stiffening does not move (a kink of Phi, a crest the rows force)
+    }
+  }
+  return stiffened;
 }
 
 int TwoCellReconstruction::FinestRefinedGridSize(int gridSize, std::size_t samples) const

@@ -20,6 +20,7 @@
 #include "MonotoneSibsonSurface.h"
 #include "MorseSmaleComplex.h"
 #include "OneCellSmoothing.h"
+#include "TriangleMeshTopology.h"
 #include "TwoCellParameterization.h"
 
 #include <array>
@@ -114,6 +115,7 @@ struct TwoCellReconstructionReport
   Index AdjustedDiagonals = 0;   // diagonals whose values were moved to meet the conditions
   Index FittedCells = 0;       // interiors fitted to the input samples (Interior == Fitted)
   Index RefinedCells = 0;      // of them, cells whose grid was refined beyond the sides' need
+  Index StiffenedCells = 0;    // of them, cells whose fit was stiffened (StiffeningRounds)
   Index MeshTriangles = 0;     // triangles of all cell meshes
   Index CrowdedTriangles = 0;  // of them, flattened in (u, v) by rounding (TwoCellMesh::CrowdedTriangles)
   Index BezierTriangles = 0;   // 4 N^2 per cell
@@ -170,6 +172,17 @@ public:
   // fewer than 8 samples or than one per 16 grid cells.
   int MaximumFittedGridSize = 48;
   MonotoneSurfaceFitOptions Fit;
+  // Fitted interiors, given the input's mesh: a fit whose values at the cell's vertices have a
+  // critical point two rings of vertices or more inside the cell (where no 1-cell passes, so
+  // no node of the complex can explain it) is fitted again with the thin-plate weight around
+  // such points multiplied by StiffeningFactor (compounding round after round, around the
+  // points each round leaves, for up to StiffeningRounds rounds). The fit with the fewest such
+  // points is kept; none whose RMS residual exceeds StiffeningResidualGrowth times the first
+  // fit's.
+  const TriangleMeshTopology* Mesh = nullptr;
+  int StiffeningRounds = 5;
+  double StiffeningFactor = 10;
+  double StiffeningResidualGrowth = 1.25;
   // Bytes the Sibson surfaces and their Bezier patches may take (<= 0: no limit). Checked
   // after the parameterization, when every cell's grid size N is known and before any surface
   // is built: the patches grow with the square of a cell's busiest side (4 N^2 triangles),
@@ -225,7 +238,7 @@ private:
   // Where each input vertex lies: the cell containing it (hints: a likely cell per vertex) and
   // its (u, v) there; the vertices of cell c are vertices[firstVertex[c] .. firstVertex[c + 1]).
   void LocateSamples(const PlanarScalarField& data, const std::vector<Index>& hints, std::vector<Index>& firstVertex,
-    std::vector<Index>& vertices, std::vector<double>& parameters) const;
+    std::vector<Index>& vertices, std::vector<double>& parameters, std::vector<Index>& cellOf) const;
   // The boundary walk with the split sides cut off their middle, where the cut at the middle
   // leaves no grid layout within MaximumGridSize; false if no cut does better.
   bool BuildBoundaryWalkCutOffMiddle(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed,
@@ -233,6 +246,10 @@ private:
   // Fits the cell's interior, refining its grid (see SurfaceTolerance); returns whether refined.
   bool FitSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided,
     const std::vector<SurfaceSample>& samples) const;
+  // The stiffening rounds (see StiffeningRounds) of cell c, whose samples are those of
+  // `vertices` (cellOf: every input vertex's cell). Returns whether a stiffened fit was kept.
+  bool StiffenWhereSamplingBreaks(Index c, ReconstructedTwoCell& cell, const std::vector<SurfaceSample>& samples,
+    const Index* vertices, const std::vector<Index>& cellOf) const;
   void Summarize();
   void BuildCellLocator();
   // The cell containing (x, y) and the point's (u, v) in its square (Inside false: snapped to
