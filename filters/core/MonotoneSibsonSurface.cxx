@@ -235,7 +235,6 @@ bool MonotoneSibsonSurface::Build(
   error.clear();
   this->BuildReport = MonotoneSurfaceReport();
   this->Fit = MonotoneSurfaceFitReport();
-  this->Patches.clear();
   const int n = static_cast<int>(boundary.Bottom.size());
   this->N = 0;
   if (n == 0 || boundary.Right.size() != boundary.Bottom.size() || boundary.Top.size() != boundary.Bottom.size() ||
@@ -291,7 +290,6 @@ bool MonotoneSibsonSurface::Build(
       std::max(this->BuildReport.MaximumValueShift, std::abs(this->Z[k] - this->LaplaceZ[k]));
   }
 
-  this->BuildPatches();
   this->BuildReport.ViolatingCells = this->CountViolatingCells();
   if (!construction.Feasible || this->BuildReport.ViolatingCells > 0)
   {
@@ -753,17 +751,11 @@ void MonotoneSibsonSurface::AdjustDiagonalValues(Construction& construction)
   }
 }
 
-void MonotoneSibsonSurface::BuildPatches()
+MonotoneSibsonPatch MonotoneSibsonSurface::GetPatch(int i, int j) const
 {
-  const int n = this->N;
-  this->Patches.resize(static_cast<std::size_t>(n) * n);
-  for (int j = 0; j < n; ++j)
-  {
-    for (int i = 0; i < n; ++i)
-    {
-      this->Patches[j * n + i].SetData(this->GetCellData(i, j));
-    }
-  }
+  MonotoneSibsonPatch patch;
+  patch.SetData(this->GetCellData(i, j));
+  return patch;
 }
 
 double MonotoneSibsonSurface::CellRequirement(
@@ -860,7 +852,7 @@ void MonotoneSibsonSurface::EvaluateWithGradient(double u, double v, double& val
   int i, j;
   double X, Y;
   this->Locate(u, v, i, j, X, Y);
-  this->Patches[j * this->N + i].EvaluateWithGradient(X, Y, value, gradient);
+  this->GetPatch(i, j).EvaluateWithGradient(X, Y, value, gradient);
   gradient[0] *= this->N;
   gradient[1] *= this->N;
 }
@@ -874,7 +866,7 @@ std::vector<SurfaceBezierTriangle> MonotoneSibsonSurface::GetBezierTriangles() c
   {
     for (int i = 0; i < this->N; ++i)
     {
-      const MonotoneSibsonPatch& patch = this->Patches[j * this->N + i];
+      const MonotoneSibsonPatch patch = this->GetPatch(i, j);
       for (int t = 0; t < 4; ++t)
       {
         double vertices[3][2];

@@ -185,7 +185,9 @@ public:
   // The Laplace values before any correction (interior nodes), for diagnostics.
   double LaplaceValue(int i, int j) const { return this->LaplaceZ[this->Node(i, j)]; }
   SibsonCellData GetCellData(int i, int j) const;
-  const MonotoneSibsonPatch& GetPatch(int i, int j) const { return this->Patches[j * this->N + i]; }
+  // The element of grid cell (i, j), made from the node data when asked: storing all N^2 of
+  // them took 400 bytes per element, and a cell of a noisy field can need N in the hundreds.
+  MonotoneSibsonPatch GetPatch(int i, int j) const;
 
   // Checks (C0)-(C3) in every cell plus p + q > 0 at interior nodes; returns the number of
   // failing cells (an interior node with p + q <= 0 counts as a failure of its cells).
@@ -220,7 +222,6 @@ private:
   void LimitDerivativesPerCell(Construction& construction) const;
   void LimitDerivativesPerDiagonal(Construction& construction);
   void AdjustDiagonalValues(Construction& construction);
-  void BuildPatches();
 
   // max(LHS(C2), LHS(C3), 0) / 3 of cell (i, j) with derivatives p, q: the least rise
   // z11 - z00 the cell needs; and its sum over the cells of a diagonal.
@@ -249,7 +250,6 @@ private:
   int N = 0;
   std::vector<double> Z, P, Q, LaplaceZ;
   MonotoneSurfaceFitReport Fit;
-  std::vector<MonotoneSibsonPatch> Patches;
   MonotoneSurfaceReport BuildReport;
 };
 } // namespace topospline

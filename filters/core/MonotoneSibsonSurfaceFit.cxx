@@ -395,7 +395,7 @@ bool MonotoneSibsonSurface::FitToSamples(
   this->Fit = MonotoneSurfaceFitReport();
   this->Fit.Samples = static_cast<int>(samples.size());
   const int n = this->N;
-  if (n < 1 || this->Patches.size() != static_cast<std::size_t>(n) * n)
+  if (n < 1 || this->Z.size() != static_cast<std::size_t>(n + 1) * (n + 1))
   {
     error = "fit: the surface has not been built";
     return false;
@@ -438,7 +438,6 @@ bool MonotoneSibsonSurface::FitToSamples(
       }
     }
   }
-  this->BuildPatches();
   double maximum, rms;
   this->MeasureResiduals(samples, maximum, rms);
   if (this->CountViolatingCells() > 0 || !(rms <= options.AcceptedResidualGrowth * this->Fit.PaperRMSResidual))
@@ -446,7 +445,6 @@ bool MonotoneSibsonSurface::FitToSamples(
     this->Z = paperZ;
     this->P = paperP;
     this->Q = paperQ;
-    this->BuildPatches();
     return true;
   }
   this->Fit.Fitted = true;
