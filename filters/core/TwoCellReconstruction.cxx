@@ -950,25 +950,34 @@ bool TwoCellReconstruction::StiffenWhereSamplingBreaks(Index c, ReconstructedTwo
   options.AcceptedResidualGrowth = this->StiffeningResidualGrowth;
   const MonotoneSibsonSurface first = cell.Surface;
   bool stiffened = false;
+  double step = this->StiffeningFactor;
   for (int round = 0, stale = 0; round < this->StiffeningRounds && !critical.empty(); ++round)
   {
     // Stiffer where it was stiffened before, and around the points the last fit left (a crest
     // can move aside instead of widening).
+    const MonotoneSurfaceFitOptions before = options;
     for (MonotoneSurfaceFitOptions::StiffSpot& spot : options.StiffSpots)
     {
-      spot.Factor *= this->StiffeningFactor;
+      spot.Factor *= step;
     }
     for (Index k : critical)
     {
-      options.StiffSpots.push_back({ samples[k].U, samples[k].V, this->StiffeningFactor });
+      options.StiffSpots.push_back({ samples[k].U, samples[k].V, step });
     }
-    // From the first fit (it meets every row), kept within the allowed growth of its residual:
-    // stiffer rounds only fit worse, so a refused one ends the rounds.
+    // From the first fit (it meets every row), kept within the allowed growth of its residual.
+    // A refused round is tried again with the square root of its step (10, 3.2, 1.8), and the
+    // later rounds keep the smaller step; below 1.5 the rounds end.
     MonotoneSibsonSurface trial = first;
     std::string message;
     if (!trial.FitToSamples(samples, message, options) || !trial.FitReport().Fitted)
     {
-      break;
+      options = before;
+      step = std::sqrt(step);
+      if (step < 1.5)
+      {
+        break;
+      }
+      continue;
     }
     critical = criticalSpots(trial);
     if (critical.size() < fewest)

@@ -178,7 +178,7 @@ public:
   // such points multiplied by StiffeningFactor (compounding round after round, around the
   // points each round leaves, for up to StiffeningRounds rounds). The fit with the fewest such
   // points is kept; none whose RMS residual exceeds StiffeningResidualGrowth times the first
-  // fit's.
+  // fit's (such a round is tried again with the square root of its step, down to 1.5).
   const TriangleMeshTopology* Mesh = nullptr;
   int StiffeningRounds = 5;
   double StiffeningFactor = 10;
