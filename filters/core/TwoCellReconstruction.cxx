@@ -551,6 +551,75 @@ void GroupByIndex(const std::vector<Index>& ids, Index groups, std::vector<Index
     }
   }
 }
+
+// Whether vertex v (inside the mesh) is critical for the values `value(w)` (ties broken by
+// vertex id, stage 1's order): its link is a cycle, one edge per incident triangle, and a
+// regular vertex's link changes between lower and upper exactly twice.
+template <typename Values>
+bool IsCriticalVertex(const TriangleMeshTopology& mesh, Index v, const Values& value)
+{
+  const double fv = value(v);
+  const auto lower = [&](Index w) {
+    const double fw = value(w);
+    return fw < fv || (fw == fv && w < v);
+  };
+  int changes = 0;
+  for (Index i = mesh.VertexTriangleBegin(v); i < mesh.VertexTriangleEnd(v); ++i)
+  {
+    const auto& t = mesh.TriangleVertices[mesh.VertexTriangle(i)];
+    const int at = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+    changes += lower(t[(at + 1) % 3]) != lower(t[(at + 2) % 3]) ? 1 : 0;
+  }
+  return changes != 2;
+}
+
+// Per vertex: whether it is inside the mesh and its whole ring of neighbours lies in its own
+// cell (cellOf; InvalidIndex: in none).
+std::vector<char> RingsInTheirCells(
+  const TriangleMeshTopology& mesh, const std::vector<Index>& cellOf, const ParallelFor& parallel)
+{
+  std::vector<char> ringInCell(cellOf.size(), 0);
+  parallel(0, static_cast<Index>(cellOf.size()), [&](Index begin, Index end) {
+    for (Index v = begin; v < end; ++v)
+    {
+      bool inside = cellOf[v] != InvalidIndex && !mesh.IsBoundaryVertex(v);
+      for (Index i = mesh.VertexTriangleBegin(v); inside && i < mesh.VertexTriangleEnd(v); ++i)
+      {
+        for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
+        {
+          inside = inside && cellOf[w] == cellOf[v];
+        }
+      }
+      ringInCell[v] = inside ? 1 : 0;
+    }
+  });
+  return ringInCell;
+}
+
+// Of a cell's vertices, those two rings of vertices or more inside it (its ring and the rings
+// of its neighbours in the cell, RingsInTheirCells): no smoothed 1-cell passes next to them.
+std::vector<Index> DeepVertices(
+  const TriangleMeshTopology& mesh, const Index* vertices, Index count, const std::vector<char>& ringInCell)
+{
+  std::vector<Index> deep;
+  for (Index k = 0; k < count; ++k)
+  {
+    const Index v = vertices[k];
+    bool all = ringInCell[v] != 0;
+    for (Index i = mesh.VertexTriangleBegin(v); all && i < mesh.VertexTriangleEnd(v); ++i)
+    {
+      for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
+      {
+        all = all && ringInCell[w] != 0;
+      }
+    }
+    if (all)
+    {
+      deep.push_back(k);
+    }
+  }
+  return deep;
+}
 } // namespace
 
 bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
@@ -609,6 +678,7 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
   }
   const bool stiffen = fit && this->Mesh != nullptr && this->StiffeningRounds > 0 &&
     this->Mesh->NumberOfVertices() == static_cast<Index>(data->Values.size());
+  const std::vector<char> ringInCell = stiffen ? RingsInTheirCells(*this->Mesh, cellOf, this->Parallel) : std::vector<char>();
   if (!this->SurfacesFitInMemory(boundaries, firstVertex, error))
   {
     return false;
@@ -630,7 +700,7 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
         refined[c] = this->FitSurface(cell, boundaries[c], samples);
         if (stiffen && cell.Surface.FitReport().Fitted)
         {
-          stiffened[c] = this->StiffenWhereSamplingBreaks(c, cell, samples, vertices.data() + firstVertex[c], cellOf);
+          stiffened[c] = this->StiffenWhereSamplingBreaks(cell, samples, vertices.data() + firstVertex[c], ringInCell);
         }
       }
     }
@@ -842,84 +912,17 @@ bool TwoCellReconstruction::FitSurface(ReconstructedTwoCell& cell, const Monoton
   return refined;
 }
 
-namespace
-{
-// Whether vertex v (inside the mesh) is critical for the values `value(w)` (ties broken by
-// vertex id, stage 1's order): its link is a cycle, one edge per incident triangle, and a
-// regular vertex's link changes between lower and upper exactly twice.
-template <typename Values>
-bool IsCriticalVertex(const TriangleMeshTopology& mesh, Index v, const Values& value)
-{
-  const double fv = value(v);
-  const auto lower = [&](Index w) {
-    const double fw = value(w);
-    return fw < fv || (fw == fv && w < v);
-  };
-  int changes = 0;
-  for (Index i = mesh.VertexTriangleBegin(v); i < mesh.VertexTriangleEnd(v); ++i)
-  {
-    const auto& t = mesh.TriangleVertices[mesh.VertexTriangle(i)];
-    const int at = t[0] == v ? 0 : t[1] == v ? 1 : 2;
-    changes += lower(t[(at + 1) % 3]) != lower(t[(at + 2) % 3]) ? 1 : 0;
-  }
-  return changes != 2;
-}
-
-// Vertices of cell c two rings of vertices or more inside it (every vertex within two edges
-// in c, none on the mesh boundary): no smoothed 1-cell passes next to them.
-std::vector<Index> DeepVertices(
-  const TriangleMeshTopology& mesh, Index c, const Index* vertices, Index count, const std::vector<Index>& cellOf)
-{
-  const auto ringInCell = [&](Index v) {
-    if (mesh.IsBoundaryVertex(v))
-    {
-      return false;
-    }
-    for (Index i = mesh.VertexTriangleBegin(v); i < mesh.VertexTriangleEnd(v); ++i)
-    {
-      for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
-      {
-        if (cellOf[w] != c)
-        {
-          return false;
-        }
-      }
-    }
-    return true;
-  };
-  std::vector<Index> deep;
-  for (Index k = 0; k < count; ++k)
-  {
-    const Index v = vertices[k];
-    bool all = ringInCell(v);
-    for (Index i = mesh.VertexTriangleBegin(v); all && i < mesh.VertexTriangleEnd(v); ++i)
-    {
-      for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
-      {
-        all = all && (w == v || ringInCell(w));
-      }
-    }
-    if (all)
-    {
-      deep.push_back(k);
-    }
-  }
-  return deep;
-}
-} // namespace
-
 // A monotone F has no critical point, but sampled at the vertices, a ridge or a trough that
 // rises slowly along its crest compared with its flanks breaks into pairs of critical points:
 // the fit makes such crests where the monotonicity rows bind against data that falls (a
 // cancelled pit filled, its rim kept). Stiffening the thin plate there widens them until the
 // vertices see the rise.
-bool TwoCellReconstruction::StiffenWhereSamplingBreaks(Index c, ReconstructedTwoCell& cell,
-  const std::vector<SurfaceSample>& samples, const Index* vertices,
-  const std::vector<Index>& cellOf) const
+bool TwoCellReconstruction::StiffenWhereSamplingBreaks(ReconstructedTwoCell& cell,
+  const std::vector<SurfaceSample>& samples, const Index* vertices, const std::vector<char>& ringInCell) const
 {
   const TriangleMeshTopology& mesh = *this->Mesh;
   const Index count = static_cast<Index>(samples.size());
-  const std::vector<Index> deep = DeepVertices(mesh, c, vertices, count, cellOf);
+  const std::vector<Index> deep = DeepVertices(mesh, vertices, count, ringInCell);
   if (deep.empty())
   {
     return false;

@@ -250,10 +250,11 @@ private:
   // Fits the cell's interior, refining its grid (see SurfaceTolerance); returns whether refined.
   bool FitSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided,
     const std::vector<SurfaceSample>& samples) const;
-  // The stiffening rounds (see StiffeningRounds) of cell c, whose samples are those of
-  // `vertices` (cellOf: every input vertex's cell). Returns whether a stiffened fit was kept.
-  bool StiffenWhereSamplingBreaks(Index c, ReconstructedTwoCell& cell, const std::vector<SurfaceSample>& samples,
-    const Index* vertices, const std::vector<Index>& cellOf) const;
+  // The stiffening rounds (see StiffeningRounds) of a cell whose samples are those of
+  // `vertices` (ringInCell: per input vertex, whether it and its ring of neighbours lie inside
+  // its cell). Returns whether a stiffened fit was kept.
+  bool StiffenWhereSamplingBreaks(ReconstructedTwoCell& cell, const std::vector<SurfaceSample>& samples,
+    const Index* vertices, const std::vector<char>& ringInCell) const;
   void Summarize();
   void BuildCellLocator();
   // The cell containing (x, y) and the point's (u, v) in its square (Inside false: snapped to
