@@ -1,15 +1,16 @@
 """Uniform noise end to end: the input simplification exists for. Seeded uniform noise of
 n x n samples (default 1000) at a threshold (default 5 %) through the four filters, each in its
-own pvpython process so that the peak resident memory (ru_maxrss of the child) is that run's.
+own pvpython process so that the peak resident memory (ru_maxrss of that child, from wait4) is
+that run's.
 Prints, per size: time per stage, peak memory, the simplified counts, the topology verdict,
 failed 2-cells and unreconstructed vertices; errors are printed, not hidden.
 
 Usage: pvpython benchmarks/benchmark_noise.py [n ...] [--threshold P] [--k K]"""
 import json
 import os
-import resource
 import subprocess
 import sys
+import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -80,15 +81,22 @@ def main():
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for n in sizes:
         start = time.time()
-        child = subprocess.run(["pvpython", "-c", CHILD % {"here": HERE, "n": n, "percent": percent, "k": k}],
-                               capture_output=True, text=True)
+        with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
+            child = subprocess.Popen(["pvpython", "-c", CHILD % {"here": HERE, "n": n, "percent": percent, "k": k}],
+                                     stdout=out, stderr=err, text=True)
+            # This child's own peak (RUSAGE_CHILDREN would give the largest child so far).
+            _, status, usage = os.wait4(child.pid, 0)
+            child.returncode = os.waitstatus_to_exitcode(status)
+            out.seek(0)
+            err.seek(0)
+            stdout, stderr = out.read(), err.read()
         wall = time.time() - start
-        peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1e6  # the largest child so far, GB
-        result = next((json.loads(line[7:]) for line in child.stdout.splitlines() if line.startswith("RESULT ")), None)
-        errors = [line.strip()[-200:] for line in (child.stdout + child.stderr).splitlines() if "ERR" in line]
+        peak = usage.ru_maxrss / 1e6  # kB -> GB
+        result = next((json.loads(line[7:]) for line in stdout.splitlines() if line.startswith("RESULT ")), None)
+        errors = [line.strip()[-200:] for line in (stdout + stderr).splitlines() if "ERR" in line]
         if result is None:
             print("| %d | run failed (exit %d, %.1f s): %s |" % (n, child.returncode, wall,
-                                                                (errors or [child.stderr.strip()[-300:]])[0]))
+                                                                (errors or [stderr.strip()[-300:]])[0]))
             continue
         t = result["times"]
         print("| %d | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %s | %s | %s | %s |" % (

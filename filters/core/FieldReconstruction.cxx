@@ -105,7 +105,7 @@ bool BuildMesh(const PlanarScalarField& field, TriangleMeshTopology& mesh, const
 
 double FieldReconstruction::MemoryEstimate(double cells, double finerPoints)
 {
-  return 230e3 * cells + 260.0 * finerPoints;
+  return 30e3 * cells + 260.0 * finerPoints;
 }
 
 GridField FieldReconstruction::FinerGrid(const PlanarScalarField& field) const

@@ -103,9 +103,11 @@ public:
   ProgressHooks Hooks;
 
   // About how many bytes the reconstruction of `cells` 2-cells and a finer grid of
-  // `finerPoints` points take (measured on uniform noise, 5 000 to 45 000 cells: about 230 kB
-  // per cell for its triangulation, parameterization, Sibson grid and Bezier patches; about
-  // 260 bytes per finer point for its values, mask and critical point check).
+  // `finerPoints` points take (measured on uniform noise at 5 %, k = 4, 5 000 to 45 000 cells:
+  // 19-25 kB per cell for its triangulation, parameterization and Sibson node data, since the
+  // Bezier elements are made when evaluated; taken as 30 kB. The Bezier Patches output comes on
+  // top, at most MaximumPatchTriangles of about 600 bytes. About 260 bytes per finer point for
+  // its values, mask and critical point check).
   static double MemoryEstimate(double cells, double finerPoints);
 
   // Reconstructs `complex` (smoothed into `smoothed`) over `field` (the input). Works in
