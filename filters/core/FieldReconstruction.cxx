@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace topospline
 {
@@ -154,22 +155,80 @@ topospline::TopologicalSampling FieldReconstruction::SamplingOf(const MorseSmale
 // The smoothed curves, sampled finely enough that the nearest sample is within a few percent of
 // `side` of the nearest curve point, with their heights, in square buckets of side `side`: the
 // samples within `side` of a point lie in its bucket or the 8 around it.
-OneCellSamples::OneCellSamples(const OneCellSmoothingResult& smoothed, double side)
+OneCellSamples::OneCellSamples(const OneCellSmoothingResult& smoothed, double side, const std::vector<double>& around)
   : Side(side > 0 ? side : 1.0)
 {
+  // The buckets Nearest looks into for the points around: each one's and the 8 beside it.
+  std::unordered_set<long long> wanted;
+  for (std::size_t p = 0; p + 1 < around.size(); p += 2)
+  {
+    for (int dx = -1; dx <= 1; ++dx)
+    {
+      for (int dy = -1; dy <= 1; ++dy)
+      {
+        // As Nearest computes them (not floor(x / side) + dx, which may round differently).
+        wanted.insert(this->Key(around[p] + dx * this->Side, around[p + 1] + dy * this->Side));
+      }
+    }
+  }
+  if (wanted.empty())
+  {
+    return;
+  }
+  // A Bezier segment lies in its control points' bounding box (widened against rounding): it
+  // can have samples in a wanted bucket only if a bucket of that box is wanted.
+  const auto mayHoldWanted = [this, &wanted](const double* control) {
+    double low[2] = { control[0], control[1] }, high[2] = { control[0], control[1] };
+    for (int c = 1; c < 4; ++c)
+    {
+      for (int axis = 0; axis < 2; ++axis)
+      {
+        low[axis] = std::min(low[axis], control[2 * c + axis]);
+        high[axis] = std::max(high[axis], control[2 * c + axis]);
+      }
+    }
+    const double margin = 1e-6 * this->Side;
+    const long long i0 = static_cast<long long>(std::floor((low[0] - margin) / this->Side));
+    const long long i1 = static_cast<long long>(std::floor((high[0] + margin) / this->Side));
+    const long long j0 = static_cast<long long>(std::floor((low[1] - margin) / this->Side));
+    const long long j1 = static_cast<long long>(std::floor((high[1] + margin) / this->Side));
+    if ((i1 - i0 + 1) * (j1 - j0 + 1) > 64)
+    {
+      return true; // a long segment: sampled, its samples filtered one by one
+    }
+    for (long long i = i0; i <= i1; ++i)
+    {
+      for (long long j = j0; j <= j1; ++j)
+      {
+        if (wanted.count(this->KeyOf(i, j)))
+        {
+          return true;
+        }
+      }
+    }
+    return false;
+  };
   constexpr int perSegment = 16;
   for (const SmoothedPiece& piece : smoothed.Pieces)
   {
     const int segments = piece.Curve.Segments;
     for (int j = 0; j < segments; ++j)
     {
+      if (!mayHoldWanted(piece.Curve.Segment(j)))
+      {
+        continue;
+      }
       for (int m = 0; m <= perSegment; ++m)
       {
         Sample sample;
         const double s = static_cast<double>(m) / perSegment;
         CubicBezierSpline::EvaluateSegment(piece.Curve.Segment(j), 2, s, sample.XY);
-        sample.Height = piece.Height.Segments > 0 ? piece.Height.Value((j + s) / segments) : 0;
-        this->Buckets[this->Key(sample.XY[0], sample.XY[1])].push_back(sample);
+        const long long key = this->Key(sample.XY[0], sample.XY[1]);
+        if (wanted.count(key))
+        {
+          sample.Height = piece.Height.Segments > 0 ? piece.Height.Value((j + s) / segments) : 0;
+          this->Buckets[key].push_back(sample);
+        }
       }
     }
   }
@@ -177,8 +236,12 @@ OneCellSamples::OneCellSamples(const OneCellSmoothingResult& smoothed, double si
 
 long long OneCellSamples::Key(double x, double y) const
 {
-  return (static_cast<long long>(std::floor(x / this->Side)) << 32) ^
-    (static_cast<long long>(std::floor(y / this->Side)) & 0xffffffffLL);
+  return this->KeyOf(static_cast<long long>(std::floor(x / this->Side)), static_cast<long long>(std::floor(y / this->Side)));
+}
+
+long long OneCellSamples::KeyOf(long long i, long long j) const
+{
+  return (i << 32) ^ (j & 0xffffffffLL);
 }
 
 bool OneCellSamples::Nearest(double x, double y, double distance, double& height) const
@@ -372,7 +435,16 @@ void FieldReconstruction::EvaluateAtVertices(const PlanarScalarField& field, con
     // A cell too small to reconstruct (NegligibleArea) holds a vertex or two, all within a
     // spacing of its boundary: they take the height of the nearest smoothed 1-cell. So does
     // any vertex within a spacing of one; the rest keep their input value and are reported.
-    const OneCellSamples samples(smoothed, this->Spacing);
+    std::vector<double> missedPoints;
+    for (Index v = 0; v < n; ++v)
+    {
+      if (report.CellOfVertex[v] == InvalidIndex)
+      {
+        missedPoints.insert(missedPoints.end(), &field.Points[2 * static_cast<std::size_t>(v)],
+          &field.Points[2 * static_cast<std::size_t>(v)] + 2);
+      }
+    }
+    const OneCellSamples samples(smoothed, this->Spacing, missedPoints);
     for (Index v = 0; v < n; ++v)
     {
       double height;
@@ -493,7 +565,12 @@ void CountByDistanceToOneCells(const std::vector<CriticalPointLocation>& points,
   {
     return;
   }
-  const OneCellSamples samples(smoothed, distance > 0 ? distance : 1.0);
+  std::vector<double> around;
+  for (const CriticalPointLocation& point : points)
+  {
+    around.insert(around.end(), point.Position, point.Position + 2);
+  }
+  const OneCellSamples samples(smoothed, distance > 0 ? distance : 1.0, around);
   double height;
   for (const CriticalPointLocation& point : points)
   {

@@ -58,6 +58,7 @@ struct SamplingConstraints
   // (AddSaddleOneCells).
   std::vector<SaddleOneCell> SaddleOneCells;
   // Optional, for CarveOneCells: every smoothed 1-cell of the complex, whole (AddOneCells).
+  // TopologicalSampling::Settle copies every field but this one: a new field goes there too.
   std::vector<SaddleOneCell> OneCells;
 };
 

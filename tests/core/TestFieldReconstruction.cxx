@@ -30,6 +30,8 @@
 #include <cstdint>
 #include <functional>
 #include <iterator>
+#include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -463,6 +465,78 @@ TEST_CASE(SpuriousPointsAreCountedNearAndFarFromTheOneCells)
   CHECK_EQ(far, 4);  // 2.5, 5, 3 (beyond the end) and far outside
   CountByDistanceToOneCells({}, smoothed, 2.0, near, far);
   CHECK(near == 0 && far == 0);
+}
+
+TEST_CASE(CountsNearOneCellsMatchExactDistancesOnManySegments)
+{
+  // A random walk of 200 straight segments of length 1.6 (16 samples each: 0.1 apart) and one
+  // diagonal segment 18 x 18 (its bounding box spans more than 64 buckets of side 2; samples
+  // 1.6 apart, the nearest within 0.8 of the curve), against the exact distance to the
+  // segments computed here; points within 0.85 of the threshold 2 are left out.
+  std::mt19937 random(20261203);
+  std::uniform_real_distribution<double> angle(0, 2 * 3.14159265358979), coordinate(0, 1);
+  OneCellSmoothingResult smoothed;
+  std::vector<std::array<double, 4>> lines; // x0, y0, x1, y1
+  SmoothedPiece walk;
+  walk.Curve.Dimension = 2;
+  double x = 50, y = 0;
+  for (int j = 0; j < 200; ++j)
+  {
+    const double a = angle(random);
+    const double x1 = x + 1.6 * std::cos(a), y1 = y + 1.6 * std::sin(a);
+    lines.push_back({ x, y, x1, y1 });
+    for (int c = 0; c < 4; ++c)
+    {
+      walk.Curve.ControlPoints.push_back(x + (x1 - x) * c / 3.0);
+      walk.Curve.ControlPoints.push_back(y + (y1 - y) * c / 3.0);
+    }
+    x = x1;
+    y = y1;
+  }
+  walk.Curve.Segments = 200;
+  smoothed.Pieces.push_back(walk);
+  SmoothedPiece line;
+  line.Curve.Dimension = 2;
+  line.Curve.Segments = 1;
+  line.Curve.ControlPoints = { 100, -60, 106, -54, 112, -48, 118, -42 };
+  smoothed.Pieces.push_back(line);
+  lines.push_back({ 100, -60, 118, -42 });
+  const auto exactDistance = [&lines](double px, double py) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& l : lines)
+    {
+      const double dx = l[2] - l[0], dy = l[3] - l[1];
+      const double t = std::clamp(((px - l[0]) * dx + (py - l[1]) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
+      best = std::min(best, std::hypot(px - l[0] - t * dx, py - l[1] - t * dy));
+    }
+    return best;
+  };
+  std::vector<CriticalPointLocation> points;
+  Index expectedNear = 0;
+  while (points.size() < 2000)
+  {
+    CriticalPointLocation point;
+    point.Position[0] = 95 + 30 * coordinate(random); // around the diagonal segment
+    point.Position[1] = -65 + 30 * coordinate(random);
+    if (points.size() % 2 == 0)
+    {
+      // Half of them close to the walk, where most are near.
+      point.Position[0] = x - 40 + 80 * coordinate(random);
+      point.Position[1] = y - 40 + 80 * coordinate(random);
+    }
+    const double d = exactDistance(point.Position[0], point.Position[1]);
+    if (std::abs(d - 2) < 0.85)
+    {
+      continue;
+    }
+    expectedNear += d <= 2 ? 1 : 0;
+    points.push_back(point);
+  }
+  Index near = -1, far = -1;
+  CountByDistanceToOneCells(points, smoothed, 2.0, near, far);
+  CHECK(expectedNear > 50);
+  CHECK_EQ(near, expectedNear);
+  CHECK_EQ(far, static_cast<Index>(points.size()) - expectedNear);
 }
 
 namespace
