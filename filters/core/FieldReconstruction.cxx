@@ -435,21 +435,23 @@ void FieldReconstruction::EvaluateAtVertices(const PlanarScalarField& field, con
     // A cell too small to reconstruct (NegligibleArea) holds a vertex or two, all within a
     // spacing of its boundary: they take the height of the nearest smoothed 1-cell. So does
     // any vertex within a spacing of one; the rest keep their input value and are reported.
+    std::vector<Index> missed;
     std::vector<double> missedPoints;
     for (Index v = 0; v < n; ++v)
     {
       if (report.CellOfVertex[v] == InvalidIndex)
       {
+        missed.push_back(v);
         missedPoints.insert(missedPoints.end(), &field.Points[2 * static_cast<std::size_t>(v)],
           &field.Points[2 * static_cast<std::size_t>(v)] + 2);
       }
     }
     const OneCellSamples samples(smoothed, this->Spacing, missedPoints);
-    for (Index v = 0; v < n; ++v)
+    for (std::size_t m = 0; m < missed.size(); ++m)
     {
+      const Index v = missed[m];
       double height;
-      const double* xy = &field.Points[2 * static_cast<std::size_t>(v)];
-      if (report.CellOfVertex[v] == InvalidIndex && samples.Nearest(xy[0], xy[1], this->Spacing, height))
+      if (samples.Nearest(missedPoints[2 * m], missedPoints[2 * m + 1], this->Spacing, height))
       {
         report.Values[v] = height;
         report.Difference[v] = height - field.Values[v];

@@ -1097,21 +1097,16 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
 // The steps of Apply after the nodes' values: the 1-cells carved in, the boundary junctions
 // placed, the floods, and the saddles moved back onto their nodes.
 TopologicalSamplingReport TopologicalSampling::Settle(const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
-  const std::function<Index(Index)>& vertexAt, const SamplingConstraints& wanted, OneCellCarving carving,
+  const std::function<Index(Index)>& vertexAt, SamplingConstraints& constraints, OneCellCarving carving,
   std::vector<double>& values) const
 {
   const double reach = this->SaddleReach();
-  CarveOneCells(sampling, mesh, wanted, this->Spacing, values, carving);
-  // The whole 1-cells serve only the carving: the constraints the boundary junctions are added
-  // to are copied without them (a copy per carving pass of every 1-cell's samples made a tenth
-  // of topological sampling's time on 1000 x 1000 noise, most of it page faults).
-  SamplingConstraints constraints;
-  constraints.Minima = wanted.Minima;
-  constraints.Maxima = wanted.Maxima;
-  constraints.BoundaryMinima = wanted.BoundaryMinima;
-  constraints.BoundaryMaxima = wanted.BoundaryMaxima;
-  constraints.Saddles = wanted.Saddles;
-  constraints.SaddleOneCells = wanted.SaddleOneCells;
+  CarveOneCells(sampling, mesh, constraints, this->Spacing, values, carving);
+  // This pass's boundary junctions join the constraints until it ends, and are taken off
+  // again: a copy of the constraints per pass copied every 1-cell's samples (a tenth of
+  // topological sampling's time on 1000 x 1000 noise, most of it page faults).
+  const std::size_t boundaryMinimaBefore = constraints.BoundaryMinima.size();
+  const std::size_t saddlesBefore = constraints.Saddles.size();
   const double junctionReach = BoundaryJunctionReach * this->Spacing;
   for (Index v : PlaceBoundaryJunctions(this->Complex, sampling, mesh, vertexAt, junctionReach, values))
   {
@@ -1137,6 +1132,8 @@ TopologicalSamplingReport TopologicalSampling::Settle(const PlanarScalarField& s
     }
     EnforceCriticalVertices(mesh, constraints, values);
   }
+  constraints.BoundaryMinima.resize(boundaryMinimaBefore);
+  constraints.Saddles.resize(saddlesBefore);
   return report;
 }
 

@@ -58,7 +58,6 @@ struct SamplingConstraints
   // (AddSaddleOneCells).
   std::vector<SaddleOneCell> SaddleOneCells;
   // Optional, for CarveOneCells: every smoothed 1-cell of the complex, whole (AddOneCells).
-  // TopologicalSampling::Settle copies every field but this one: a new field goes there too.
   std::vector<SaddleOneCell> OneCells;
 };
 
@@ -149,8 +148,10 @@ public:
 private:
   // How far from its node a saddle is looked for and carved back.
   double SaddleReach() const { return 8 * this->Spacing; }
+  // One pass: carves the 1-cells, places the boundary junctions (added to `constraints` for the
+  // pass only), floods and relocates saddles.
   TopologicalSamplingReport Settle(const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
-    const std::function<Index(Index)>& vertexAt, const SamplingConstraints& wanted, OneCellCarving carving,
+    const std::function<Index(Index)>& vertexAt, SamplingConstraints& constraints, OneCellCarving carving,
     std::vector<double>& values) const;
 
   const MorseSmaleComplex& Complex;

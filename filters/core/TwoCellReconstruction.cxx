@@ -928,15 +928,20 @@ bool TwoCellReconstruction::StiffenWhereSamplingBreaks(ReconstructedTwoCell& cel
     return false;
   }
   // The deep vertices critical for F sampled at the cell's vertices (the rings of deep
-  // vertices lie in the cell).
+  // vertices lie in the cell); each vertex's slot among them is found once, for every round.
+  std::unordered_map<Index, Index> slotOf;
+  slotOf.reserve(2 * count);
+  for (Index k = 0; k < count; ++k)
+  {
+    slotOf[vertices[k]] = k;
+  }
+  std::vector<double> sampled(count);
   const auto criticalSpots = [&](const MonotoneSibsonSurface& surface) {
-    std::unordered_map<Index, double> sampled;
-    sampled.reserve(2 * count);
     for (Index k = 0; k < count; ++k)
     {
-      sampled[vertices[k]] = surface.Evaluate(samples[k].U, samples[k].V);
+      sampled[k] = surface.Evaluate(samples[k].U, samples[k].V);
     }
-    const auto value = [&sampled](Index w) { return sampled.at(w); };
+    const auto value = [&](Index w) { return sampled[slotOf.at(w)]; };
     std::vector<Index> critical;
     for (Index k : deep)
     {
