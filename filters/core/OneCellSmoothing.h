@@ -62,7 +62,8 @@ struct OneCellSmoothingResult
   int RefinedPieces = 0;       // pieces whose k was doubled because the height missed (HeightTolerance)
   int PolylinePieces = 0;      // of them, pieces that still crossed at their largest k and follow
                                // their jagged 1-cell in straight segments instead
-  int RemainingCrossings = 0;  // pairs of pieces that still cross (0 is the goal)
+  int RemainingCrossings = 0;  // pairs of pieces that still cross (0 is the goal); a piece that
+                               // passes a node not its own too closely counts as one
   int PiecesOutsideDomain = 0; // pieces whose curve leaves the domain's bounding box
   int ClampedPieces = 0;       // pieces kept inside it by clamping control points
   double JunctionMargin = 0;

@@ -409,6 +409,198 @@ TEST_CASE(MergedOneCellsShareTheirPiecesOnNoise)
 }
 
 //------------------------------------------------------------------------------
+// Stage 4 cuts each 2-cell's boundary out of these curves at its own sampling (5 points per
+// Bezier segment, finer after subdivision). Where stage 3 reports no crossing, no sampling may
+// find one: two pieces' polylines at 5, 8 and 32 points per segment neither cross nor touch
+// away from a shared end, and no piece's polyline passes through a node it does not end at.
+// The oracle is written here (orientation tests on the samples). On noise a smoothed curve
+// that cut the corner of its jagged 1-cell 0.005 spacings from a saddle crossed its four
+// 1-cells there, on one sampling and not on another.
+namespace
+{
+double Orientation(const double* a, const double* b, const double* c)
+{
+  return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+bool ClosedSegmentsMeet(const double* a, const double* b, const double* c, const double* d)
+{
+  const double o1 = Orientation(a, b, c), o2 = Orientation(a, b, d);
+  const double o3 = Orientation(c, d, a), o4 = Orientation(c, d, b);
+  if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0)))
+  {
+    return true;
+  }
+  auto onSegment = [](const double* p, const double* q, const double* r, double o) {
+    return o == 0 && std::min(p[0], q[0]) <= r[0] && r[0] <= std::max(p[0], q[0]) && std::min(p[1], q[1]) <= r[1] &&
+      r[1] <= std::max(p[1], q[1]);
+  };
+  return onSegment(a, b, c, o1) || onSegment(a, b, d, o2) || onSegment(c, d, a, o3) || onSegment(c, d, b, o4);
+}
+
+std::vector<double> SampledCurve(const CubicBezierSpline& curve, int perSegment)
+{
+  std::vector<double> samples;
+  for (int j = 0; j < curve.Segments; ++j)
+  {
+    for (int s = j == 0 ? 0 : 1; s <= perSegment; ++s)
+    {
+      double xy[2];
+      CubicBezierSpline::EvaluateSegment(curve.Segment(j), 2, static_cast<double>(s) / perSegment, xy);
+      samples.insert(samples.end(), { xy[0], xy[1] });
+    }
+  }
+  return samples;
+}
+
+// Contacts between the polylines of two pieces (or of one piece with itself), away from the
+// ends they share: points within `shared` of a common end node are their meeting.
+int ContactsAwayFromSharedEnds(const std::vector<double>& a, const std::vector<double>& b, bool same,
+  const std::vector<const double*>& sharedEnds, double shared)
+{
+  auto nearShared = [&](const double* p) {
+    for (const double* e : sharedEnds)
+    {
+      if (std::hypot(p[0] - e[0], p[1] - e[1]) <= shared)
+      {
+        return true;
+      }
+    }
+    return false;
+  };
+  int contacts = 0;
+  for (std::size_t i = 0; i + 3 < a.size(); i += 2)
+  {
+    for (std::size_t j = same ? i + 4 : 0; j + 3 < b.size(); j += 2)
+    {
+      if (ClosedSegmentsMeet(&a[i], &a[i + 2], &b[j], &b[j + 2]) &&
+        !(nearShared(&a[i]) || nearShared(&a[i + 2])) && !(nearShared(&b[j]) || nearShared(&b[j + 2])))
+      {
+        ++contacts;
+      }
+    }
+  }
+  return contacts;
+}
+} // namespace
+
+TEST_CASE(NoSamplingFindsCrossingsWhereNoneAreReported)
+{
+  int checkedResults = 0;
+  for (const double percent : { 5.0 })
+  {
+    for (std::uint64_t seed = 1; seed <= 4; ++seed)
+    {
+      GridField noise;
+      noise.Dimensions[0] = noise.Dimensions[1] = 40;
+      DeterministicRandom random(100 + seed);
+      for (int i = 0; i < 40 * 40; ++i)
+      {
+        noise.Values.push_back(random.Uniform());
+      }
+      Stage3Input input;
+      std::string error;
+      CHECK(RunStages1And2(noise, percent, input, error));
+      for (const int k : { 4, 15 })
+      {
+        if (k == 15 && seed > 1)
+        {
+          continue;
+        }
+        OneCellSmoothing smoothing;
+        smoothing.Segments = k;
+        OneCellSmoothingResult result;
+        CHECK(smoothing.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, result, error));
+        if (result.RemainingCrossings != 0)
+        {
+          continue;
+        }
+        ++checkedResults;
+        const Index count = static_cast<Index>(result.Pieces.size());
+        int contacts = 0, throughNodes = 0;
+        for (const int perSegment : { 5, 8, 32 })
+        {
+          std::vector<std::vector<double>> polylines(count);
+          std::vector<std::array<double, 4>> boxes(count);
+          for (Index p = 0; p < count; ++p)
+          {
+            polylines[p] = SampledCurve(result.Pieces[p].Curve, perSegment);
+            boxes[p] = { 1e300, -1e300, 1e300, -1e300 };
+            for (std::size_t i = 0; i + 1 < polylines[p].size(); i += 2)
+            {
+              boxes[p] = { std::min(boxes[p][0], polylines[p][i]), std::max(boxes[p][1], polylines[p][i]),
+                std::min(boxes[p][2], polylines[p][i + 1]), std::max(boxes[p][3], polylines[p][i + 1]) };
+            }
+          }
+          const double shared = 1e-9 * (input.Bounds[1] - input.Bounds[0]);
+          for (Index p = 0; p < count; ++p)
+          {
+            const SmoothedPiece& a = result.Pieces[p];
+            const double* aEnds[2] = { result.Nodes[a.StartNode].Position, result.Nodes[a.EndNode].Position };
+            for (Index q = p; q < count; ++q)
+            {
+              if (boxes[p][0] > boxes[q][1] || boxes[q][0] > boxes[p][1] || boxes[p][2] > boxes[q][3] ||
+                boxes[q][2] > boxes[p][3])
+              {
+                continue;
+              }
+              const SmoothedPiece& b = result.Pieces[q];
+              std::vector<const double*> sharedEnds;
+              for (const double* e : aEnds)
+              {
+                for (const Index n : { b.StartNode, b.EndNode })
+                {
+                  if (e[0] == result.Nodes[n].Position[0] && e[1] == result.Nodes[n].Position[1])
+                  {
+                    sharedEnds.push_back(e);
+                  }
+                }
+              }
+              // Two pieces that close a loop (start where the other ends, both ways) may
+              // retrace each other.
+              // A piece that starts where it ends (a boundary saddle and a maximum on one
+              // vertex) may retrace itself.
+              const bool loop = sharedEnds.size() >= 2 &&
+                result.Nodes[a.StartNode].Position[0] == result.Nodes[b.EndNode].Position[0] &&
+                result.Nodes[a.StartNode].Position[1] == result.Nodes[b.EndNode].Position[1];
+              if (!loop)
+              {
+                contacts += ContactsAwayFromSharedEnds(polylines[p], polylines[q], p == q, sharedEnds, shared);
+              }
+            }
+            for (std::size_t n = 0; n < result.Nodes.size(); ++n)
+            {
+              const double* x = result.Nodes[n].Position;
+              if ((x[0] == aEnds[0][0] && x[1] == aEnds[0][1]) || (x[0] == aEnds[1][0] && x[1] == aEnds[1][1]) ||
+                x[0] < boxes[p][0] || x[0] > boxes[p][1] || x[1] < boxes[p][2] || x[1] > boxes[p][3])
+              {
+                continue;
+              }
+              for (std::size_t i = 0; i + 3 < polylines[p].size(); i += 2)
+              {
+                const double* u = &polylines[p][i];
+                if (ClosedSegmentsMeet(u, u + 2, x, x))
+                {
+                  ++throughNodes;
+                  break;
+                }
+              }
+            }
+          }
+        }
+        std::printf("  40^2 noise seed %d at %g %%, k = %d: %zu pieces, %d adapted, contacts at 5/8/32 "
+                    "points per segment %d, through foreign nodes %d\n",
+          static_cast<int>(100 + seed), percent, k, result.Pieces.size(), result.AdaptedPieces, contacts,
+          throughNodes);
+        CHECK_EQ(contacts, 0);
+        CHECK_EQ(throughNodes, 0);
+      }
+    }
+  }
+  CHECK(checkedResults >= 4);
+}
+
+//------------------------------------------------------------------------------
 TEST_CASE(ProgressAbortAndBadInput)
 {
   Stage3Input input;
