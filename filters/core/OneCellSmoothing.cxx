@@ -868,30 +868,39 @@ private:
   {
     std::size_t count;
     const double* samples = this->Samples(p, count);
-    const double* bounds = this->Bounds;
-    auto column = [&](double x) {
-      return std::clamp(static_cast<long>((x - bounds[0]) / this->CellSize), 0L, this->Nx - 1);
-    };
-    auto row = [&](double y) {
-      return std::clamp(static_cast<long>((y - bounds[2]) / this->CellSize), 0L, this->Ny - 1);
-    };
     for (std::size_t s = 0; s + 1 < count; ++s)
     {
       // Boxes grown by how far the curve may stray (ChordSagitta): chords closer than that
       // share a cell and are tested (TestPair).
       const double* a = samples + 2 * s;
-      const double* b = a + 2;
-      const double stray = this->ChordSagitta(p, static_cast<int>(s));
-      const long i0 = column(std::min(a[0], b[0]) - stray), i1 = column(std::max(a[0], b[0]) + stray);
-      const long j0 = row(std::min(a[1], b[1]) - stray), j1 = row(std::max(a[1], b[1]) + stray);
-      for (long i = i0; i <= i1; ++i)
+      this->ForEachCellNear(a, a + 2, this->ChordSagitta(p, static_cast<int>(s)),
+        [&visit, s](std::size_t cell) { visit(static_cast<int>(s), cell); });
+    }
+  }
+
+  // Calls visit(grid cell) for every grid cell that the box of segment ab, grown by `grow`,
+  // overlaps.
+  template <typename Visit>
+  void ForEachCellNear(const double* a, const double* b, double grow, const Visit& visit) const
+  {
+    const long i0 = this->Column(std::min(a[0], b[0]) - grow), i1 = this->Column(std::max(a[0], b[0]) + grow);
+    const long j0 = this->Row(std::min(a[1], b[1]) - grow), j1 = this->Row(std::max(a[1], b[1]) + grow);
+    for (long i = i0; i <= i1; ++i)
+    {
+      for (long j = j0; j <= j1; ++j)
       {
-        for (long j = j0; j <= j1; ++j)
-        {
-          visit(static_cast<int>(s), static_cast<std::size_t>(i * this->Ny + j));
-        }
+        visit(static_cast<std::size_t>(i * this->Ny + j));
       }
     }
+  }
+
+  long Column(double x) const
+  {
+    return std::clamp(static_cast<long>((x - this->Bounds[0]) / this->CellSize), 0L, this->Nx - 1);
+  }
+  long Row(double y) const
+  {
+    return std::clamp(static_cast<long>((y - this->Bounds[2]) / this->CellSize), 0L, this->Ny - 1);
   }
 
   // The nodes at which pieces end, in the grid of the segments (after LayOutGrid).
@@ -925,9 +934,7 @@ private:
 
   std::size_t GridCell(const double* xy) const
   {
-    const long i = std::clamp(static_cast<long>((xy[0] - this->Bounds[0]) / this->CellSize), 0L, this->Nx - 1);
-    const long j = std::clamp(static_cast<long>((xy[1] - this->Bounds[2]) / this->CellSize), 0L, this->Ny - 1);
-    return static_cast<std::size_t>(i * this->Ny + j);
+    return static_cast<std::size_t>(this->Column(xy[0]) * this->Ny + this->Row(xy[1]));
   }
 
   // A piece that passes a node it does not end at closer than the polylines can resolve
@@ -972,32 +979,24 @@ private:
         polylineFactor * this->SegmentSagitta(p, static_cast<int>(s) / this->SamplesPerSegment) + this->MeetingTolerance;
       const double* a = samples + 2 * s;
       const double* b = a + 2;
-      const double low[2] = { std::min(a[0], b[0]) - clearance, std::min(a[1], b[1]) - clearance };
-      const double high[2] = { std::max(a[0], b[0]) + clearance, std::max(a[1], b[1]) + clearance };
-      const std::size_t first = this->GridCell(low), last = this->GridCell(high);
-      const long i0 = static_cast<long>(first / this->Ny), i1 = static_cast<long>(last / this->Ny);
-      const long j0 = static_cast<long>(first % this->Ny), j1 = static_cast<long>(last % this->Ny);
-      for (long i = i0; i <= i1; ++i)
-      {
-        for (long j = j0; j <= j1; ++j)
+      bool tooClose = false;
+      this->ForEachCellNear(a, b, clearance, [&](std::size_t cell) {
+        for (std::size_t e = this->NodeStart[cell]; e < this->NodeStart[cell + 1] && !tooClose; ++e)
         {
-          const std::size_t cell = static_cast<std::size_t>(i * this->Ny + j);
-          for (std::size_t e = this->NodeStart[cell]; e < this->NodeStart[cell + 1]; ++e)
+          const Index n = this->NodeEntries[e];
+          const double* q = this->Result.Nodes[n].Position;
+          if (n == piece.StartNode || n == piece.EndNode || (q[0] == ends[0][0] && q[1] == ends[0][1]) ||
+            (q[0] == ends[1][0] && q[1] == ends[1][1]))
           {
-            const Index n = this->NodeEntries[e];
-            const double* q = this->Result.Nodes[n].Position;
-            if (n == piece.StartNode || n == piece.EndNode || (q[0] == ends[0][0] && q[1] == ends[0][1]) ||
-              (q[0] == ends[1][0] && q[1] == ends[1][1]))
-            {
-              continue;
-            }
-            double fraction;
-            if (SegmentDistance2(a, b, q[0], q[1], fraction) <= clearance * clearance)
-            {
-              return true;
-            }
+            continue;
           }
+          double fraction;
+          tooClose = SegmentDistance2(a, b, q[0], q[1], fraction) <= clearance * clearance;
         }
+      });
+      if (tooClose)
+      {
+        return true;
       }
     }
     return false;
@@ -1013,7 +1012,7 @@ private:
   // on the curves themselves (RefinedCrossing): two curves can cross between the samples (two
   // 1-cells leaving one saddle almost tangentially crossed 0.14 spacings from it, unseen at 8
   // points per segment) where a finer sampling, such as stage 4's subdivided boundaries, sees
-  // it. Near a shared end, where the chords meet at the node, only the curves tell.
+  // it; so can two curves leaving one node, from their second chords on.
   void TestPair(const SegmentRef& s, const SegmentRef& t, std::vector<std::pair<Index, Index>>& found) const
   {
     if (s.Piece == t.Piece && std::abs(s.Segment - t.Segment) <= 1)
@@ -1023,8 +1022,16 @@ private:
     const double* sa = this->SegmentStart(s);
     const double* ta = this->SegmentStart(t);
     const bool chordsCross = SegmentsCrossProperly(sa, sa + 2, ta, ta + 2);
-    bool crossing = chordsCross && !this->MeetAtSharedEnd(s, t);
-    if (!crossing && !this->FirstChordsAtASharedEnd(s, t) && (chordsCross || this->CurvesMayMeet(s, sa, t, ta)))
+    // Within two chords of an end both pieces share, a contact through that point (to
+    // rounding) is their meeting.
+    bool crossing = chordsCross && !this->NearASharedEnd(s, t, 2, true);
+    // The two chords that start at one shared end are left to the chords alone. Two curves
+    // leaving a node may cross a hair from it (Shepard seed 4 at 5 %: 0.045 spacings from the
+    // node, a 250th of the segment): no 2-cell boundary of stage 4 sees that, since its polygons
+    // start at the node too and sample the curves only from a fifth of a segment on, and giving
+    // those pieces more segments only made their heights fit worse (the largest error 1.37 ->
+    // 2.08 eps).
+    if (!crossing && (chordsCross || this->CurvesMayMeet(s, sa, t, ta)) && !this->NearASharedEnd(s, t, 1, false))
     {
       crossing = this->RefinedCrossing(s, t);
     }
@@ -1034,45 +1041,26 @@ private:
     }
   }
 
-  // Whether s and t are the chords of their pieces that start at one shared end. Two curves
-  // leaving a node may cross a hair from it (Shepard seed 4 at 5 %: 0.045 spacings from the
-  // node, a 250th of the segment): no 2-cell boundary of stage 4 sees that, since its polygons
-  // start at the node too and sample the curves only from a fifth of a segment on, and giving
-  // those pieces more segments only made their heights fit worse (the largest error 1.37 ->
-  // 2.08 eps). Only the chords themselves decide there (MeetAtSharedEnd).
-  bool FirstChordsAtASharedEnd(const SegmentRef& s, const SegmentRef& t) const
-  {
-    const int sLast = static_cast<int>(this->SegmentCount(s.Piece)) - 1;
-    const int tLast = static_cast<int>(this->SegmentCount(t.Piece)) - 1;
-    for (const bool sAtEnd : { false, true })
-    {
-      for (const bool tAtEnd : { false, true })
-      {
-        const double* a = this->EndPosition(s.Piece, sAtEnd);
-        const double* b = this->EndPosition(t.Piece, tAtEnd);
-        if (s.Segment == (sAtEnd ? sLast : 0) && t.Segment == (tAtEnd ? tLast : 0) && a[0] == b[0] && a[1] == b[1])
-        {
-          return true;
-        }
-      }
-    }
-    return false;
-  }
-
   // Whether chords sa (of s) and ta (of t) pass closer than their curves may stray from them.
   bool CurvesMayMeet(const SegmentRef& s, const double* sa, const SegmentRef& t, const double* ta) const
   {
     const double reach =
       this->ChordSagitta(s.Piece, s.Segment) + this->ChordSagitta(t.Piece, t.Segment) + this->MeetingTolerance;
+    return !BoxesApart(sa, ta, reach) && ChordDistance(sa, ta) <= reach;
+  }
+
+  // Whether the boxes of segments a and b (two points each) lie more than `reach` apart.
+  static bool BoxesApart(const double* a, const double* b, double reach)
+  {
     for (int d = 0; d < 2; ++d)
     {
-      if (std::min(sa[d], sa[d + 2]) - reach > std::max(ta[d], ta[d + 2]) ||
-        std::min(ta[d], ta[d + 2]) - reach > std::max(sa[d], sa[d + 2]))
+      if (std::min(a[d], a[d + 2]) - reach > std::max(b[d], b[d + 2]) ||
+        std::min(b[d], b[d + 2]) - reach > std::max(a[d], a[d + 2]))
       {
-        return false;
+        return true;
       }
     }
-    return ChordDistance(sa, ta) <= reach;
+    return false;
   }
 
   static double ChordDistance(const double* a, const double* b)
@@ -1151,8 +1139,7 @@ private:
       {
         const double* u = fineA + 2 * i;
         const double* w = fineB + 2 * j;
-        if (std::max(u[0], u[2]) + reach < std::min(w[0], w[2]) || std::max(w[0], w[2]) + reach < std::min(u[0], u[2]) ||
-          std::max(u[1], u[3]) + reach < std::min(w[1], w[3]) || std::max(w[1], w[3]) + reach < std::min(u[1], u[3]))
+        if (BoxesApart(u, w, reach))
         {
           continue;
         }
@@ -1213,19 +1200,22 @@ private:
     return this->Result.Nodes[atEnd ? piece.EndNode : piece.StartNode].Position;
   }
 
-  bool MeetAtSharedEnd(const SegmentRef& s, const SegmentRef& t) const
+  // Whether s and t lie within `chords` chords of ends of their pieces at one point; with
+  // `throughIt`, both chords must also pass through that point (to rounding).
+  bool NearASharedEnd(const SegmentRef& s, const SegmentRef& t, int chords, bool throughIt) const
   {
     const int sCount = static_cast<int>(this->SegmentCount(s.Piece));
     const int tCount = static_cast<int>(this->SegmentCount(t.Piece));
     for (int es = 0; es < 2; ++es)
     {
-      const bool nearS = es == 0 ? s.Segment < 2 : s.Segment >= sCount - 2;
+      const bool nearS = es == 0 ? s.Segment < chords : s.Segment >= sCount - chords;
       for (int et = 0; et < 2 && nearS; ++et)
       {
-        const bool nearT = et == 0 ? t.Segment < 2 : t.Segment >= tCount - 2;
+        const bool nearT = et == 0 ? t.Segment < chords : t.Segment >= tCount - chords;
         const double* a = this->EndPosition(s.Piece, es == 1);
         const double* b = this->EndPosition(t.Piece, et == 1);
-        if (nearT && a[0] == b[0] && a[1] == b[1] && this->PassesThrough(s, a) && this->PassesThrough(t, a))
+        if (nearT && a[0] == b[0] && a[1] == b[1] &&
+          (!throughIt || (this->PassesThrough(s, a) && this->PassesThrough(t, a))))
         {
           return true;
         }
