@@ -822,6 +822,159 @@ Index RestoreWantedExtrema(const TriangleMeshTopology& mesh, const SamplingConst
   return changed;
 }
 
+namespace
+{
+// What an interior vertex u is in the piecewise-linear field `values` (ties by value, then id),
+// read from its lower link, with `lower(a)` telling whether link vertex a lies below u: -1 a
+// minimum (nothing below), -2 a maximum (everything below), else the number of pieces of the
+// lower link (1 regular, k a saddle of multiplicity k - 1). On a disk's interior vertex the link
+// is one cycle, each of whose edges lies in one triangle around u: the pieces of a lower link that
+// is not the whole cycle are its vertices less its edges. Stage 1's critical cells in u's lower
+// star are these (2D lower stars are processed perfectly), so equal kinds mean equal cells.
+template <typename Below>
+int LowerLinkKind(const TriangleMeshTopology& mesh, Index u, const Below& lower)
+{
+  int vertices = 0, below = 0, edges = 0;
+  for (Index w : VertexLink(mesh, u))
+  {
+    ++vertices;
+    below += lower(w) ? 1 : 0;
+  }
+  if (below == 0)
+  {
+    return -1;
+  }
+  if (below == vertices)
+  {
+    return -2;
+  }
+  for (Index i = mesh.VertexTriangleBegin(u); i < mesh.VertexTriangleEnd(u); ++i)
+  {
+    const auto& triangle = mesh.TriangleVertices[mesh.VertexTriangle(i)];
+    const int k = triangle[0] == u ? 0 : (triangle[1] == u ? 1 : 2);
+    edges += lower(triangle[(k + 1) % 3]) && lower(triangle[(k + 2) % 3]) ? 1 : 0;
+  }
+  return below - edges;
+}
+} // namespace
+
+Index RelaxTowardTargets(const TriangleMeshTopology& mesh, const std::vector<double>& targets,
+  std::vector<double>& values, int maximumSweeps)
+{
+  const double infinity = std::numeric_limits<double>::infinity();
+  auto offTarget = [&](Index v) { return std::isfinite(targets[v]) && std::isfinite(values[v]) && values[v] != targets[v]; };
+  auto below = [&values](Index a, Index b) { return Key{ values[a], a } < Key{ values[b], b }; };
+  // The kind of u with v at `value` instead of its own value.
+  auto kindWith = [&](Index u, Index v, double value) {
+    return LowerLinkKind(mesh, u, [&](Index w) {
+      const double a = w == v ? value : values[w], b = u == v ? value : values[u];
+      return a < b || (a == b && w < u);
+    });
+  };
+  std::vector<Index> away;
+  for (Index v = 0; v < mesh.NumberOfVertices(); ++v)
+  {
+    if (offTarget(v))
+    {
+      away.push_back(v);
+    }
+  }
+  Index moves = 0;
+  std::vector<double> candidates;
+  // The vertices a sweep moved and their neighbours: only those can move in the next one (a
+  // vertex that could not move stays where it is until a neighbour does).
+  std::vector<char> stirred(values.size(), 0);
+  std::vector<Index> stirredList;
+  for (int sweep = 0; sweep < maximumSweeps && !away.empty(); ++sweep)
+  {
+    // Down from the lowest, up from the highest: the neighbour a vertex must stay above (below)
+    // on its way has moved already.
+    const auto up = std::partition(away.begin(), away.end(), [&](Index v) { return targets[v] < values[v]; });
+    std::sort(away.begin(), up, below);
+    std::sort(up, away.end(), [&below](Index a, Index b) { return below(b, a); });
+    Index moved = 0;
+    for (Index v : away)
+    {
+      const double target = targets[v], current = values[v];
+      // Within its neighbours' values: no link changes.
+      double floor = -infinity, ceiling = infinity;
+      for (Index w : VertexLink(mesh, v))
+      {
+        (below(w, v) ? floor : ceiling) = below(w, v) ? std::max(floor, values[w]) : std::min(ceiling, values[w]);
+      }
+      const double low = std::nextafter(floor, infinity), high = std::nextafter(ceiling, -infinity);
+      double relaxed = low <= high ? std::clamp(target, low, high) : current;
+      // Past some of them, where neither v nor any of those changes kind (only their two links
+      // change), away from the boundary (whose vertices stage 1 also judges along the boundary
+      // curve): the target itself, or just short of or past a neighbour's value on the way.
+      if (!mesh.IsBoundaryVertex(v) && relaxed != target)
+      {
+        candidates.assign(1, target);
+        for (Index w : VertexLink(mesh, v))
+        {
+          if (std::min(relaxed, target) < values[w] && values[w] < std::max(relaxed, target))
+          {
+            candidates.push_back(std::nextafter(values[w], relaxed));
+            candidates.push_back(std::nextafter(values[w], target));
+          }
+        }
+        std::sort(candidates.begin(), candidates.end(),
+          [target](double a, double b) { return std::abs(a - target) < std::abs(b - target); });
+        const int ownKind = LowerLinkKind(mesh, v, [&](Index w) { return below(w, v); });
+        for (double x : candidates)
+        {
+          if (std::abs(x - target) >= std::abs(relaxed - target))
+          {
+            break;
+          }
+          bool allowed = kindWith(v, v, x) == ownKind;
+          for (Index w : VertexLink(mesh, v))
+          {
+            const bool nowBelow = x < values[w] || (x == values[w] && v < w);
+            if (allowed && nowBelow != below(v, w))
+            {
+              allowed = !mesh.IsBoundaryVertex(w) && kindWith(w, v, x) == kindWith(w, v, current);
+            }
+          }
+          if (allowed)
+          {
+            relaxed = x;
+            break;
+          }
+        }
+      }
+      if (std::abs(relaxed - target) < std::abs(current - target))
+      {
+        values[v] = relaxed;
+        ++moved;
+        const VertexLink link(mesh, v);
+        stirredList.push_back(v);
+        stirredList.insert(stirredList.end(), link.begin(), link.end());
+      }
+    }
+    moves += moved;
+    if (moved == 0)
+    {
+      break;
+    }
+    away.clear();
+    for (Index u : stirredList)
+    {
+      if (!stirred[u] && offTarget(u))
+      {
+        away.push_back(u);
+      }
+      stirred[u] = 1;
+    }
+    for (Index u : stirredList)
+    {
+      stirred[u] = 0;
+    }
+    stirredList.clear();
+  }
+  return moves;
+}
+
 SamplingConstraints ComplexConstraints(const MorseSmaleComplex& complex, const TriangleMeshTopology& complexMesh,
   const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt)
 {
@@ -1070,6 +1223,7 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   // others; docs/Reconstruction.md, "Gentle carving first"). Not on samplings beyond
   // MaximumVerticesForMorePasses: there a pass costs seconds (2 s of the 2000 x 2000 terrain's
   // 14, for one saddle that it left off all the same), and the start is not kept.
+  const std::vector<double> targets = values;
   const bool morePasses = mesh.NumberOfVertices() <= this->MaximumVerticesForMorePasses;
   const std::vector<double> prepared = morePasses ? values : std::vector<double>();
   TopologicalSamplingReport report =
@@ -1088,6 +1242,9 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
       report = next;
     }
   }
+  // What the carving, the floods and the relocations changed beyond what the critical points
+  // need goes back toward F o Phi (the nodes' vertices toward their critical values).
+  RelaxTowardTargets(mesh, targets, values);
   report.ChangedVertices = 0;
   report.MaximumChange = 0;
   CountChanges(before, values, report);

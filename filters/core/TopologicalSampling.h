@@ -15,7 +15,8 @@
 // Before the floods, the complex's smoothed 1-cells are carved into the sampling
 // (CarveOneCells), so that a ridge or valley running between two rows of vertices is not cut
 // into islands; after them, saddles left off their nodes are moved back (RelocateSaddles).
-// TopologicalSampling::Apply runs the whole sequence.
+// Last, every changed vertex moves back toward F o Phi as far as the critical points allow
+// (RelaxTowardTargets). TopologicalSampling::Apply runs the whole sequence.
 #pragma once
 
 #include "CoreTypes.h"
@@ -105,7 +106,8 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
 // The whole topological sampling of a reconstruction: the complex's critical points as
 // constraints, its smoothed 1-cells carved in (CarveOneCells), the floods
 // (EnforceCriticalVertices) and the saddles moved back onto their nodes (within Spacing,
-// looked for within 8 spacings). The 1-cells are carved gently first (OneCellCarving); while
+// looked for within 8 spacings), and the changed vertices relaxed back toward F o Phi
+// (RelaxTowardTargets). The 1-cells are carved gently first (OneCellCarving); while
 // saddles are left off their nodes, the whole sequence runs again with the next carving (on
 // samplings of at most MaximumVerticesForMorePasses vertices), and the sampling with the fewest
 // displaced saddles is kept, the gentler one of equals. The complex side is fixed at
@@ -177,5 +179,19 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
 // changed vertices.
 Index RestoreWantedExtrema(const TriangleMeshTopology& mesh, const SamplingConstraints& constraints,
   std::vector<double>& values);
+
+// Moves every vertex whose value differs from its target back toward it without changing any
+// critical point: as far as its order against each neighbour allows (strictly above every
+// neighbour below it, strictly below every neighbour above it; ties by value, then vertex id),
+// and, for a vertex off the boundary, past interior neighbours where neither it nor any of them
+// changes kind (minimum, maximum, regular, saddle of its multiplicity: only their links change).
+// The sampling keeps exactly its critical points (kinds, multiplicities, vertices), and every
+// vertex ends at least as close to its target, while what the steps before changed beyond what
+// the critical points need shrinks: a wanted minimum lifted with its pit sinks back to its
+// critical value, a vertex raised past a carved chain comes back down. Sweeps go in order of
+// value (those moving down from the lowest, those moving up from the highest), so that a run of
+// vertices follows the one before it; at most `maximumSweeps`. Returns the number of moves.
+Index RelaxTowardTargets(const TriangleMeshTopology& mesh, const std::vector<double>& targets,
+  std::vector<double>& values, int maximumSweeps = 8);
 
 } // namespace topospline

@@ -2,7 +2,8 @@
 // extrema noise adds and settle on plateaus, a dented boundary saddle gets a way up, a
 // ridge running between two rows of vertices is carved in, a cut leaves no pit on its plateau
 // of a triangle mesh, and wanted extrema taken away by
-// the floods of the other kind are restored. Each sampled result is checked by
+// the floods of the other kind are restored; relaxing toward the values before keeps every
+// link. Each sampled result is checked by
 // extracting its critical points again (stage 1) against the wanted complex. (The whole
 // sequence on real reconstructions is tested in TestFieldReconstruction.)
 //
@@ -15,6 +16,7 @@
 #include "TopologyVerification.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -498,6 +500,226 @@ TEST_CASE(WantedExtremaSurviveTheOtherKindsFloods)
     CHECK(maxima == interiorOnly(constraints.Maxima));
   }
   CHECK(lostByFloods > 0); // the case exercises what it tests
+}
+
+TEST_CASE(RelaxingTowardTargetsKeepsEveryCriticalPoint)
+{
+  // The steps around the floods move values past what the critical points need;
+  // RelaxTowardTargets moves them back toward the values before. Oracle, written here: every
+  // vertex keeps the shape of its lower link (counted from the triangle list), edges at the
+  // boundary keep their order, stage 1 finds the same critical cells, no vertex ends farther
+  // from its target, and
+  // wanted extrema that a step before lifted out of their pits (peaks) go back to their values.
+  // On the trigonometric field with noise, flooded to the smooth field's critical points, on its
+  // grid and on the same points with random diagonals, with values as they come and rounded to
+  // a few levels (ties everywhere, ordered by id).
+  const GridField smooth = TrigonometricField(10, 40, -20);
+  const int nx = smooth.Dimensions[0], ny = smooth.Dimensions[1];
+  MorseSmaleComplexExtraction extraction;
+  std::string error;
+  for (int seed : { 1, 2, 3 })
+  {
+    for (bool randomDiagonals : { false, true })
+    {
+      for (bool rounded : { false, true })
+      {
+        std::mt19937_64 random(seed);
+        PlanarScalarField field = FieldOnGrid(smooth);
+        TriangleMeshTopology mesh;
+        if (randomDiagonals)
+        {
+          std::bernoulli_distribution flip(0.5);
+          for (int j = 0; j + 1 < ny; ++j)
+          {
+            for (int i = 0; i + 1 < nx; ++i)
+            {
+              const Index a = j * nx + i, b = a + 1, c = a + nx, d = c + 1;
+              const std::vector<Index> quad = flip(random) ? std::vector<Index>{ a, b, d, a, d, c }
+                                                           : std::vector<Index>{ a, b, c, b, d, c };
+              field.Triangles.insert(field.Triangles.end(), quad.begin(), quad.end());
+            }
+          }
+          field.GridDimensions[0] = field.GridDimensions[1] = 0;
+          CHECK(mesh.Build(nx * ny, field.Triangles, SequentialFor, error));
+        }
+        else
+        {
+          mesh.BuildGrid(nx, ny, SequentialFor);
+        }
+        MorseSmaleComplex wanted;
+        CHECK(extraction.Extract(field, wanted, error));
+        const SamplingConstraints constraints = ComplexConstraints(wanted, mesh, mesh, [](Index v) { return v; });
+        std::uniform_real_distribution<double> noise(-0.3, 0.3);
+        PlanarScalarField noisy = field;
+        for (double& v : noisy.Values)
+        {
+          v += noise(random);
+          v = rounded ? std::round(4 * v) / 4 : v;
+        }
+        const std::vector<double> targets = noisy.Values;
+        EnforceCriticalVertices(mesh, constraints, noisy.Values);
+        // The floods alone change nothing they need not; the steps around them do (a carved
+        // chain lifts a wanted minimum, RestoreWantedExtrema puts it just below its lowest
+        // neighbour; a vertex beside a chain is raised past it). Such slack, made here without
+        // changing any order: every second interior wanted extremum goes just past its extreme
+        // neighbour, and a third of the other vertices to a random value between their
+        // neighbours below and above.
+        auto link = [&mesh](Index v) {
+          std::vector<Index> result;
+          for (Index i = mesh.VertexTriangleBegin(v); i < mesh.VertexTriangleEnd(v); ++i)
+          {
+            for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
+            {
+              if (w != v)
+              {
+                result.push_back(w);
+              }
+            }
+          }
+          return result;
+        };
+        auto below = [](const std::vector<double>& f, Index a, Index b) { return f[a] < f[b] || (f[a] == f[b] && a < b); };
+        const double infinity = std::numeric_limits<double>::infinity();
+        std::vector<std::pair<Index, double>> lifted; // vertex, value after the floods
+        std::vector<char> extremum(noisy.Values.size(), 0);
+        for (const auto* extrema : { &constraints.Minima, &constraints.Maxima })
+        {
+          const bool minima = extrema == &constraints.Minima;
+          for (std::size_t e = 0; e < extrema->size(); ++e)
+          {
+            const Index v = (*extrema)[e];
+            extremum[v] = 1;
+            if (e % 2 == 1 || mesh.IsBoundaryVertex(v))
+            {
+              continue;
+            }
+            double extreme = minima ? infinity : -infinity;
+            bool isExtremum = true; // the floods may leave a few without converging
+            for (Index w : link(v))
+            {
+              extreme = minima ? std::min(extreme, noisy.Values[w]) : std::max(extreme, noisy.Values[w]);
+              isExtremum = isExtremum && below(noisy.Values, v, w) == minima;
+            }
+            if (isExtremum)
+            {
+              lifted.emplace_back(v, noisy.Values[v]);
+              noisy.Values[v] = std::nextafter(extreme, minima ? -infinity : infinity);
+            }
+          }
+        }
+        std::uniform_real_distribution<double> unit(0, 1);
+        for (Index v = 0; v < mesh.NumberOfVertices(); ++v)
+        {
+          if (extremum[v] || unit(random) > 1.0 / 3)
+          {
+            continue;
+          }
+          double low = noisy.Values[v] - 1, high = noisy.Values[v] + 1;
+          for (Index w : link(v))
+          {
+            (below(noisy.Values, w, v) ? low : high) = below(noisy.Values, w, v)
+              ? std::max(low, std::nextafter(noisy.Values[w], infinity))
+              : std::min(high, std::nextafter(noisy.Values[w], -infinity));
+          }
+          noisy.Values[v] = low < high ? low + (high - low) * unit(random) : noisy.Values[v];
+        }
+        const std::vector<double> flooded = noisy.Values;
+        MorseSmaleComplex before;
+        CHECK(extraction.Extract(noisy, before, error));
+        const Index moves = RelaxTowardTargets(mesh, targets, noisy.Values);
+        MorseSmaleComplex after;
+        CHECK(extraction.Extract(noisy, after, error));
+
+        // Every vertex keeps its lower link's shape: the number of pieces (vertices below less
+        // link edges below: the link is a cycle or, on the boundary, a path) and whether it is
+        // empty or whole, counted here from the triangle list. Edges at the boundary keep their
+        // order (stage 1 judges boundary vertices along the boundary curve too); inside, edges
+        // may flip where no kind changes.
+        const std::vector<Index> triangles = randomDiagonals ? field.Triangles : GridTriangles(nx, ny);
+        auto shapes = [&](const std::vector<double>& f) {
+          std::vector<std::array<int, 3>> linkBelow(f.size(), { 0, 0, 0 }); // vertices, edges, all
+          std::vector<std::vector<Index>> link(f.size());
+          for (std::size_t t = 0; t < triangles.size(); t += 3)
+          {
+            for (int k = 0; k < 3; ++k)
+            {
+              const Index u = triangles[t + k], a = triangles[t + (k + 1) % 3], b = triangles[t + (k + 2) % 3];
+              link[u].push_back(a);
+              link[u].push_back(b);
+              linkBelow[u][1] += below(f, a, u) && below(f, b, u) ? 1 : 0;
+            }
+          }
+          std::vector<std::array<int, 3>> shape(f.size());
+          for (std::size_t u = 0; u < f.size(); ++u)
+          {
+            std::sort(link[u].begin(), link[u].end());
+            link[u].erase(std::unique(link[u].begin(), link[u].end()), link[u].end());
+            int lower = 0;
+            for (Index a : link[u])
+            {
+              lower += below(f, a, Index(u)) ? 1 : 0;
+            }
+            shape[u] = { lower - linkBelow[u][1], lower == 0 ? 1 : 0, lower == int(link[u].size()) ? 1 : 0 };
+          }
+          return shape;
+        };
+        const auto shapesBefore = shapes(flooded), shapesAfter = shapes(noisy.Values);
+        Index reshaped = 0, flipped = 0, flippedAtBoundary = 0;
+        for (std::size_t u = 0; u < shapesBefore.size(); ++u)
+        {
+          reshaped += shapesBefore[u] != shapesAfter[u] ? 1 : 0;
+        }
+        for (std::size_t t = 0; t < triangles.size(); t += 3)
+        {
+          for (int e = 0; e < 3; ++e)
+          {
+            const Index a = triangles[t + e], b = triangles[t + (e + 1) % 3];
+            const bool flip = below(flooded, a, b) != below(noisy.Values, a, b);
+            flipped += flip ? 1 : 0;
+            flippedAtBoundary += flip && (mesh.IsBoundaryVertex(a) || mesh.IsBoundaryVertex(b)) ? 1 : 0;
+          }
+        }
+        auto cells = [](const MorseSmaleComplex& complex) {
+          std::vector<std::pair<Index, int>> result;
+          for (const CriticalPoint& cp : complex.CriticalPoints)
+          {
+            result.emplace_back(cp.Vertex, cp.MorseIndex);
+          }
+          std::sort(result.begin(), result.end());
+          return result;
+        };
+        double farther = 0, distanceBefore = 0, distanceAfter = 0;
+        Index changedBefore = 0, changedAfter = 0;
+        for (std::size_t v = 0; v < targets.size(); ++v)
+        {
+          const double d0 = std::abs(flooded[v] - targets[v]), d1 = std::abs(noisy.Values[v] - targets[v]);
+          farther = std::max(farther, d1 - d0);
+          distanceBefore += d0;
+          distanceAfter += d1;
+          changedBefore += d0 > 0 ? 1 : 0;
+          changedAfter += d1 > 0 ? 1 : 0;
+        }
+        std::printf("  seed %d, %s, %s: %zu critical points; flooding changed %d vertices (sum %.3f), after %d "
+                    "moves %d (sum %.3f); %d edge sides flipped, %d at the boundary; %d vertices reshaped\n",
+          seed, randomDiagonals ? "random diagonals" : "grid", rounded ? "rounded" : "continuous",
+          after.CriticalPoints.size(), int(changedBefore), distanceBefore, int(moves), int(changedAfter),
+          distanceAfter, int(flipped), int(flippedAtBoundary), int(reshaped));
+        Index back = 0; // lifted extrema back on their values after the floods
+        for (const auto& [v, value] : lifted)
+        {
+          // Or within an ulp: a pit the floods filled beside it may stand on its value, above it by id.
+          back += std::abs(noisy.Values[v] - value) <= 1e-15 * (1 + std::abs(value)) ? 1 : 0;
+        }
+        std::printf("    %zu extrema lifted, %d back on their values\n", lifted.size(), int(back));
+        CHECK(!lifted.empty() && back == Index(lifted.size()));
+        CHECK_EQ(reshaped, Index(0));
+        CHECK_EQ(flippedAtBoundary, Index(0));
+        CHECK(cells(after) == cells(before));
+        CHECK(farther <= 0);
+        CHECK(moves > 0 && distanceAfter < 0.9 * distanceBefore); // the case exercises what it tests
+      }
+    }
+  }
 }
 
 int main()
