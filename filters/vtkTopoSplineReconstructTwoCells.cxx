@@ -298,6 +298,7 @@ void WriteReport(const topospline::FieldReconstructionReport& report, vtkFieldDa
       { report.Values.empty() ? 0.0 : static_cast<double>(report.Sampling.ChangedVertices) / report.Values.size() });
     AddFieldNumbers(fd, names::SamplingConverged, { report.Sampling.Converged ? 1.0 : 0.0 });
     AddFieldNumbers(fd, names::SamplingDisplacedSaddles, { static_cast<double>(report.Sampling.DisplacedSaddles) });
+    AddFieldNumbers(fd, names::SamplingBlockedWaysUp, { static_cast<double>(report.Sampling.BlockedWaysUp.size() / 2) });
   }
   if (!report.VerificationRan)
   {
@@ -519,11 +520,24 @@ void vtkTopoSplineReconstructTwoCells::WarnAbout(const topospline::FieldReconstr
                 << p.Position[0] << ", " << p.Position[1] << ")";
         }
       }
+      // A likely cause the sampling saw itself: a wanted boundary saddle with no way into the
+      // domain but through a wanted minimum or saddle (a corner saddle whose only interior
+      // neighbour is a wanted minimum): no value at these vertices holds the complex there.
+      std::ostringstream why;
+      const auto& blocked = report.BlockedWaysUpNearMisses;
+      if (check == &report.Input && !blocked.empty())
+      {
+        why << " Near them, " << blocked.size() / 2 << " boundary saddle(s) of the complex stand above every neighbour with"
+            << " no way into the domain but through a minimum or saddle it also wants (the first at (" << blocked[0]
+            << ", " << blocked[1] << ")): the input's vertices are too few there for this complex (a finer"
+            << " Output Resolution gives the resampled output room, a higher Persistence Threshold fewer"
+            << " critical points).";
+      }
       vtkWarningMacro("Reconstruct 2-Cells: the " << prefix << " sampling of the reconstruction has "
                       << c.Spurious.size() << " spurious and " << c.Missing.size()
                       << " missing critical point(s) (found "
                       << c.Found[0] << "/" << c.Found[1] << "/" << c.Found[2] << ", expected " << c.Expected[0] << "/"
-                      << c.Expected[1] << "/" << c.Expected[2] << "): " << where.str() << ".");
+                      << c.Expected[1] << "/" << c.Expected[2] << "): " << where.str() << "." << why.str());
     }
   }
 }

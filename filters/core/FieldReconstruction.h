@@ -72,6 +72,9 @@ struct FieldReconstructionReport
   Index RawSpuriousNearOneCells = 0;
   Index RawSpuriousFarFromOneCells = 0;
   SamplingTopologyCheck Input;     // Values
+  // x, y: of Sampling.BlockedWaysUp, those within 3 spacings of a spurious or missing critical
+  // point of Input (a likely cause of it, which a warning names).
+  std::vector<double> BlockedWaysUpNearMisses;
   SamplingTopologyCheck Resampled; // Finer.Values
   std::vector<CriticalPointLocation> Expected;
   std::vector<CriticalPointLocation> Spurious, Missing; // of the judged samplings

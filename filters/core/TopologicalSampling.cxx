@@ -392,7 +392,7 @@ NearestPoint NearestOnOneCell(const SaddleOneCell& cell, double x, double y)
 // search broke convergence: a saddle with no way up is cut, and the boundary pass fills it
 // again.)
 Index RaiseWayUp(const Graph& g, const TriangleMeshTopology& mesh, std::vector<double>& values, Index v,
-  VisitMarks& visits, const std::function<bool(Index)>& avoided)
+  VisitMarks& visits, const std::function<bool(Index)>& avoided, std::vector<Index>* raisedPath = nullptr)
 {
   std::vector<unsigned>& mark = visits.Mark;
   const Key top{ values[v], v };
@@ -459,6 +459,10 @@ Index RaiseWayUp(const Graph& g, const TriangleMeshTopology& mesh, std::vector<d
     previous = std::max(from + 1e-3 * (to - from) * static_cast<double>(k + 1) / steps,
       std::nextafter(previous, std::numeric_limits<double>::infinity()));
     values[path[k]] = previous;
+  }
+  if (raisedPath)
+  {
+    *raisedPath = path;
   }
   return static_cast<Index>(path.size());
 }
@@ -728,9 +732,25 @@ private:
       return false;
     };
     const Index raised = RaiseWayUp(g, this->Mesh, values, v, this->Visits, avoided);
-    return raised > 0 ? raised : RaiseWayUp(g, this->Mesh, values, v, this->Visits, nullptr);
+    if (raised > 0)
+    {
+      return raised;
+    }
+    std::vector<Index> path;
+    const Index throughWanted = RaiseWayUp(g, this->Mesh, values, v, this->Visits, nullptr, &path);
+    if (this->BlockedWaysUp &&
+      std::any_of(path.begin(), path.end(), [&](Index w) { return wanted[w] & (WantedMinimum | WantedSaddle); }))
+    {
+      this->BlockedWaysUp->push_back(v);
+    }
+    return throughWanted;
   }
 
+public:
+  // Where given, the wanted boundary saddles whose way up had to raise a wanted minimum or saddle.
+  std::vector<Index>* BlockedWaysUp = nullptr;
+
+private:
   const TriangleMeshTopology& Mesh;
   VertexGraphs Graphs;
   std::vector<unsigned char> Wanted;
@@ -739,11 +759,13 @@ private:
 } // namespace
 
 TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
-  const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds)
+  const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds,
+  std::vector<Index>* blockedWaysUp)
 {
   TopologicalSamplingReport report;
   const std::vector<double> original = values;
   FloodPass floods(mesh, constraints);
+  floods.BlockedWaysUp = blockedWaysUp;
   Index previousChanged = -1;
   for (report.Rounds = 1; report.Rounds <= maximumRounds; ++report.Rounds)
   {
@@ -1270,7 +1292,10 @@ TopologicalSamplingReport TopologicalSampling::Settle(const PlanarScalarField& s
     constraints.BoundaryMinima.push_back(v);
     constraints.Saddles.push_back(v);
   }
-  TopologicalSamplingReport report = EnforceCriticalVertices(mesh, constraints, values);
+  // The saddles whose way up took a wanted point away, from this pass's own floods (not from
+  // the relocation's trials, which are kept only if they match better).
+  std::vector<Index> blocked;
+  TopologicalSamplingReport report = EnforceCriticalVertices(mesh, constraints, values, 6, &blocked);
   // With every wanted extremum an extremum and no other one, the saddles (with multiplicity)
   // are as many as the complex's: min - saddle + max is the same on every disk. A flood of
   // one kind can take a wanted extremum of the other kind away (a cut peak sinking below a
@@ -1287,10 +1312,16 @@ TopologicalSamplingReport TopologicalSampling::Settle(const PlanarScalarField& s
     {
       break;
     }
-    EnforceCriticalVertices(mesh, constraints, values);
+    EnforceCriticalVertices(mesh, constraints, values, 6, &blocked);
   }
   constraints.BoundaryMinima.resize(boundaryMinimaBefore);
   constraints.Saddles.resize(saddlesBefore);
+  std::sort(blocked.begin(), blocked.end());
+  blocked.erase(std::unique(blocked.begin(), blocked.end()), blocked.end());
+  for (Index v : blocked)
+  {
+    report.BlockedWaysUp.insert(report.BlockedWaysUp.end(), { sampling.Points[2 * v], sampling.Points[2 * v + 1] });
+  }
   return report;
 }
 

@@ -36,6 +36,10 @@ struct TopologicalSamplingReport
   Index ChangedVertices = 0;
   double MaximumChange = 0;
   int DisplacedSaddles = 0; // wanted saddles with no sampled saddle within the spacing
+  // x, y of each wanted boundary saddle that stood above its whole link and whose only way into
+  // the domain ran through a wanted minimum or saddle: its way up raised one (the sampling's
+  // vertices are too few there for the complex).
+  std::vector<double> BlockedWaysUp;
 };
 
 // One smoothed 1-cell of a wanted saddle, sampled from the saddle outwards: x, y and height per
@@ -169,8 +173,11 @@ private:
 // as a safeguard it stops after `maximumRounds` or when a round
 // changes as many vertices as the one before (Converged is then false, and a few spurious
 // pairs may remain).
+// `blockedWaysUp`, if given, collects the wanted boundary saddles whose way up could not keep off
+// the wanted points (see TopologicalSamplingReport::BlockedWaysUp).
 TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
-  const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds = 6);
+  const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds = 6,
+  std::vector<Index>* blockedWaysUp = nullptr);
 
 // Makes every wanted extremum an extremum again where a step before (a flood of the other
 // kind, a carved 1-cell, a saddle moved back) took that away: the vertex is moved just past its

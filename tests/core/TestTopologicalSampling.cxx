@@ -3,7 +3,7 @@
 // ridge running between two rows of vertices is carved in, a cut leaves no pit on its plateau
 // of a triangle mesh, and wanted extrema taken away by
 // the floods of the other kind are restored; relaxing toward the values before keeps every
-// link. Each sampled result is checked by
+// critical point; a corner saddle with no way up but through a wanted minimum is reported. Each sampled result is checked by
 // extracting its critical points again (stage 1) against the wanted complex. (The whole
 // sequence on real reconstructions is tested in TestFieldReconstruction.)
 //
@@ -719,6 +719,39 @@ TEST_CASE(RelaxingTowardTargetsKeepsEveryCriticalPoint)
         CHECK(moves > 0 && distanceAfter < 0.9 * distanceBefore); // the case exercises what it tests
       }
     }
+  }
+}
+
+TEST_CASE(ACornerSaddleWithoutAWayUpIsReported)
+{
+  // A wanted boundary saddle at (0, 1) of a 5 x 5 ramp stands above its whole link, and its only
+  // interior neighbour, (1, 1), is a wanted minimum (stress case #38 had this in a corner): its
+  // way up can only run through the minimum, which no value at these vertices can keep, and
+  // EnforceCriticalVertices names it. With (1, 1) not wanted the way up runs through it
+  // unreported.
+  constexpr int n = 5;
+  const PlanarScalarField field = UnitGrid(n, n, [](int i, int j) {
+    return i == 0 && j == 1 ? 5.0 : (i == 1 && j == 1 ? -1.0 : double(i + j));
+  });
+  TriangleMeshTopology mesh;
+  mesh.BuildGrid(n, n, SequentialFor);
+  const Index corner = 0, saddle = n, pit = n + 1, top = n * n - 1, side = 2 * n;
+  for (bool pitWanted : { true, false })
+  {
+    SamplingConstraints constraints;
+    constraints.Minima = pitWanted ? std::vector<Index>{ pit } : std::vector<Index>{};
+    constraints.Maxima = { top };
+    constraints.BoundaryMinima = { corner, side };
+    constraints.BoundaryMaxima = { saddle, top };
+    std::vector<double> values = field.Values;
+    std::vector<Index> blocked;
+    EnforceCriticalVertices(mesh, constraints, values, 6, &blocked);
+    std::sort(blocked.begin(), blocked.end());
+    blocked.erase(std::unique(blocked.begin(), blocked.end()), blocked.end());
+    std::printf("  minimum at (1, 1) wanted: %d; blocked ways up: %zu (saddle %s); (1, 1) now %.3g, (0, 1) %.3g\n",
+      pitWanted ? 1 : 0, blocked.size(), blocked.empty() ? "-" : std::to_string(blocked[0]).c_str(), values[pit],
+      values[saddle]);
+    CHECK(blocked == (pitWanted ? std::vector<Index>{ saddle } : std::vector<Index>{}));
   }
 }
 

@@ -6,7 +6,9 @@ resampling (4x; 2x if the machine lacks the memory) are output; the outputs' sam
 sampling) have exactly the simplified complex's number of minima, saddles and maxima, at the
 input resolution and finer; and the topology verdict, which also requires every critical point
 within one grid spacing of its node, holds on every run but the listed known misses (which
-must still miss). Printed for the
+must still miss). A 48 x 48 noise field whose complex the input's vertices cannot hold (a
+corner saddle with no way up but through a wanted minimum) must be reported, refused the
+verdict, and verify at 4x. Printed for the
 record: the counts before topological sampling, how far it moved values, and the L-infinity and
 RMS errors."""
 import os
@@ -161,4 +163,35 @@ for name, source in inputs:
             Delete(reconstruct)
             Delete(smooth)
         Delete(simplified)
+
+# A complex the input's vertices cannot hold (docs/Reconstruction.md, "Saddles with no way up";
+# stress case #38): on this 48 x 48 noise at 25 %, the boundary saddle at (0, 1) stands above
+# its whole link, and its only interior neighbour, (1, 1), is a wanted minimum. Checked here
+# from the output's values: the sampling keeps a maximum at (0, 1) or loses the minimum at
+# (1, 1) (its link on the grid's triangulation: right, up, up-left, left, down, down-right); the
+# reconstruction reports the blocked way up and refuses the verdict; the resampled output at 4x
+# has the complex's counts.
+noise = np.random.default_rng(1525008249).uniform(0, 1, (48, 48))
+producer = TrivialProducer()
+producer.GetClientSideObject().SetOutput(tt.image_data(noise))
+ms = MorseSmaleComplex(Input=producer, ScalarField=["POINTS", "f"])
+simplified = SimplifyMorseSmaleComplex(Input=ms, PersistenceThreshold=25)
+smooth = Smooth1Cells(Input=simplified, CurveSegments=18)
+reconstruct = Reconstruct2Cells(Input=smooth, OutputResolution=4)
+out = sm.Fetch(reconstruct)
+fd = out.GetFieldData()
+sampled = vtk_to_numpy(out.GetPointData().GetArray("Reconstructed")).reshape(48, 48)
+c = tt.fetch_complex(simplified)
+nodes = {(int(v) % 48, int(v) // 48): int(i) for v, i in zip(c["cp_VertexId"], c["cp_CriticalIndex"])}
+checks.check(nodes.get((1, 1)) == 0 and nodes.get((0, 1)) == 1, "corner case: the complex has a minimum at (1, 1), a saddle at (0, 1)")
+saddle_peak = all(sampled[1, 0] > sampled[y, x] for x, y in ((1, 1), (0, 2), (0, 0), (1, 0)))
+pit = all(sampled[1, 1] < sampled[y, x] for x, y in ((2, 1), (1, 2), (0, 2), (0, 1), (1, 0), (2, 0)))
+checks.check(saddle_peak or not pit, "corner case: the sampling keeps a maximum at (0, 1) or loses the minimum at (1, 1)")
+checks.check(tt.field_value(fd, "SamplingBlockedWaysUp") >= 1, "corner case: the blocked way up is reported")
+checks.equal(tt.field_value(fd, "TopologyVerified"), 0, "corner case: no verdict at the input's vertices")
+expected = [tt.field_value(fd, "ExpectedCriticalPoints", i) for i in range(3)]
+checks.equal([tt.field_value(fd, "ResampledCriticalPoints", i) for i in range(3)], expected,
+             "corner case: the resampled output at 4x has the complex's counts")
+print("corner case: (0, 1) a peak %d, (1, 1) a pit %d, blocked ways up %d, expected %s" % (
+    saddle_peak, pit, tt.field_value(fd, "SamplingBlockedWaysUp"), expected), flush=True)
 checks.finish()
