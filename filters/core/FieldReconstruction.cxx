@@ -615,12 +615,12 @@ void FieldReconstruction::Verify(const PlanarScalarField& field, const TriangleM
   report.Input = CheckSampling(WithValues(field, report.Values), report.Expected, tolerance, this->Parallel, &mesh);
   judge(report.Input);
   const auto& blocked = report.Sampling.BlockedWaysUp;
+  const auto& c = report.Input.Comparison;
   for (std::size_t b = 0; b + 1 < blocked.size(); b += 2)
   {
     const auto near = [&](const CriticalPointLocation& p) {
       return std::hypot(p.Position[0] - blocked[b], p.Position[1] - blocked[b + 1]) <= 3 * tolerance;
     };
-    const auto& c = report.Input.Comparison;
     if (std::any_of(c.Missing.begin(), c.Missing.end(), near) || std::any_of(c.Spurious.begin(), c.Spurious.end(), near))
     {
       report.BlockedWaysUpNearMisses.insert(report.BlockedWaysUpNearMisses.end(), { blocked[b], blocked[b + 1] });

@@ -602,10 +602,14 @@ public:
     WantedSaddle = 16
   };
 
-  FloodPass(const TriangleMeshTopology& mesh, const SamplingConstraints& constraints)
+  // `blockedWaysUp`, if given, collects the wanted boundary saddles whose way up had to raise a
+  // wanted minimum or saddle.
+  FloodPass(const TriangleMeshTopology& mesh, const SamplingConstraints& constraints,
+    std::vector<Index>* blockedWaysUp = nullptr)
     : Mesh(mesh)
     , Graphs(mesh)
     , Wanted(mesh.NumberOfVertices(), 0)
+    , BlockedWaysUp(blockedWaysUp)
   {
     this->Visits.Mark.assign(mesh.NumberOfVertices(), 0);
     for (Index v : constraints.Minima)
@@ -737,23 +741,19 @@ private:
       return raised;
     }
     std::vector<Index> path;
-    const Index throughWanted = RaiseWayUp(g, this->Mesh, values, v, this->Visits, nullptr, &path);
+    const Index raisedAnyway = RaiseWayUp(g, this->Mesh, values, v, this->Visits, nullptr, &path);
     if (this->BlockedWaysUp &&
       std::any_of(path.begin(), path.end(), [&](Index w) { return wanted[w] & (WantedMinimum | WantedSaddle); }))
     {
       this->BlockedWaysUp->push_back(v);
     }
-    return throughWanted;
+    return raisedAnyway;
   }
 
-public:
-  // Where given, the wanted boundary saddles whose way up had to raise a wanted minimum or saddle.
-  std::vector<Index>* BlockedWaysUp = nullptr;
-
-private:
   const TriangleMeshTopology& Mesh;
   VertexGraphs Graphs;
   std::vector<unsigned char> Wanted;
+  std::vector<Index>* BlockedWaysUp;
   VisitMarks Visits;
 };
 } // namespace
@@ -764,8 +764,7 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
 {
   TopologicalSamplingReport report;
   const std::vector<double> original = values;
-  FloodPass floods(mesh, constraints);
-  floods.BlockedWaysUp = blockedWaysUp;
+  FloodPass floods(mesh, constraints, blockedWaysUp);
   Index previousChanged = -1;
   for (report.Rounds = 1; report.Rounds <= maximumRounds; ++report.Rounds)
   {
@@ -889,8 +888,7 @@ Index RelaxTowardTargets(const TriangleMeshTopology& mesh, const std::vector<dou
   // The kind of u with v at `value` instead of its own value.
   auto kindWith = [&](Index u, Index v, double value) {
     return LowerLinkKind(mesh, u, [&](Index w) {
-      const double a = w == v ? value : values[w], b = u == v ? value : values[u];
-      return a < b || (a == b && w < u);
+      return Key{ w == v ? value : values[w], w } < Key{ u == v ? value : values[u], u };
     });
   };
   std::vector<Index> away;
@@ -922,7 +920,14 @@ Index RelaxTowardTargets(const TriangleMeshTopology& mesh, const std::vector<dou
       double floor = -infinity, ceiling = infinity;
       for (Index w : VertexLink(mesh, v))
       {
-        (below(w, v) ? floor : ceiling) = below(w, v) ? std::max(floor, values[w]) : std::min(ceiling, values[w]);
+        if (below(w, v))
+        {
+          floor = std::max(floor, values[w]);
+        }
+        else
+        {
+          ceiling = std::min(ceiling, values[w]);
+        }
       }
       const double low = std::nextafter(floor, infinity), high = std::nextafter(ceiling, -infinity);
       double relaxed = low <= high ? std::clamp(target, low, high) : current;
@@ -942,7 +947,7 @@ Index RelaxTowardTargets(const TriangleMeshTopology& mesh, const std::vector<dou
         }
         std::sort(candidates.begin(), candidates.end(),
           [target](double a, double b) { return std::abs(a - target) < std::abs(b - target); });
-        const int ownKind = LowerLinkKind(mesh, v, [&](Index w) { return below(w, v); });
+        const int ownKind = kindWith(v, v, current);
         for (double x : candidates)
         {
           if (std::abs(x - target) >= std::abs(relaxed - target))
@@ -952,8 +957,7 @@ Index RelaxTowardTargets(const TriangleMeshTopology& mesh, const std::vector<dou
           bool allowed = kindWith(v, v, x) == ownKind;
           for (Index w : VertexLink(mesh, v))
           {
-            const bool nowBelow = x < values[w] || (x == values[w] && v < w);
-            if (allowed && nowBelow != below(v, w))
+            if (allowed && (Key{ x, v } < Key{ values[w], w }) != below(v, w))
             {
               allowed = !mesh.IsBoundaryVertex(w) && kindWith(w, v, x) == kindWith(w, v, current);
             }
@@ -1244,10 +1248,10 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   // set's noise a gentle carving alone lost verdicts that the full one keeps (and gained
   // others; docs/Reconstruction.md, "Gentle carving first"). Not on samplings beyond
   // MaximumVerticesForMorePasses: there a pass costs seconds (2 s of the 2000 x 2000 terrain's
-  // 14, for one saddle that it left off all the same), and the start is not kept.
-  const std::vector<double> targets = values;
+  // 14, for one saddle that it left off all the same). The start is kept in any case: it is
+  // also what RelaxTowardTargets moves the vertices back toward.
+  const std::vector<double> prepared = values;
   const bool morePasses = mesh.NumberOfVertices() <= this->MaximumVerticesForMorePasses;
-  const std::vector<double> prepared = morePasses ? values : std::vector<double>();
   TopologicalSamplingReport report =
     this->Settle(sampling, mesh, vertexAt, constraints, OneCellCarving::JustPastTheWalk, values);
   for (const OneCellCarving carving : { OneCellCarving::WhereNeeded, OneCellCarving::Everywhere })
@@ -1266,7 +1270,7 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   }
   // What the carving, the floods and the relocations changed beyond what the critical points
   // need goes back toward F o Phi (the nodes' vertices toward their critical values).
-  RelaxTowardTargets(mesh, targets, values);
+  RelaxTowardTargets(mesh, prepared, values);
   report.ChangedVertices = 0;
   report.MaximumChange = 0;
   CountChanges(before, values, report);
