@@ -755,6 +755,91 @@ TEST_CASE(ACornerSaddleWithoutAWayUpIsReported)
   }
 }
 
+TEST_CASE(AValleyBesideARidgeGoesRoundTheVerticesBothClaim)
+{
+  // A valley (a descending 1-cell) and a ridge (an ascending one) run side by side less than a
+  // spacing apart over nearly flat data, as on a terraced crop: where a vertex is the nearest
+  // to both curves, both walks claim it, it keeps its value, and the chain breaks there unless
+  // it goes round. After carving, each 1-cell must leave a strictly monotone chain of vertices
+  // from near its saddle to its extremum: checked here by searching the mesh for a path that
+  // falls (rises) at every step, in the stage-1 order (value, then vertex id), from the vertex
+  // nearest the curve two spacings past its saddle to the extremum. The data is 1e-3 of noise,
+  // the 1-cells fall (rise) 1e-3 per spacing, so no such path exists off the carved chains.
+  const int nx = 44, ny = 12;
+  const double startX = 3, endX = 38;
+  auto valleyY = [](double x) { return 5.0 + 0.45 * std::sin(0.5 * x); };
+  auto ridgeY = [&](double x) { return valleyY(x) + 0.7; };
+  PlanarScalarField field =
+    UnitGrid(nx, ny, [](int i, int j) { return 1e-3 * std::sin(1.3 * i + 0.7 * j) * std::cos(0.9 * j - 0.4 * i); });
+  TriangleMeshTopology mesh;
+  mesh.BuildGrid(nx, ny, SequentialFor);
+  auto vertexNear = [&](double x, double y) { return static_cast<Index>(std::lround(y)) * nx + std::lround(x); };
+  SamplingConstraints constraints;
+  for (bool up : { false, true })
+  {
+    SaddleOneCell cell;
+    cell.Ascending = up;
+    for (double x = startX; x <= endX + 1e-9; x += 0.125)
+    {
+      const double y = up ? ridgeY(x) : valleyY(x);
+      cell.Points.insert(cell.Points.end(), { x, y, (up ? 1e-3 : -1e-3) * (x - startX) });
+    }
+    cell.Saddle = vertexNear(startX, up ? ridgeY(startX) : valleyY(startX));
+    constraints.OneCells.push_back(cell);
+    constraints.Saddles.push_back(cell.Saddle);
+    const Index end = vertexNear(endX, up ? ridgeY(endX) : valleyY(endX));
+    (up ? constraints.Maxima : constraints.Minima).push_back(end);
+    field.Values[cell.Saddle] = 0;
+    field.Values[end] = up ? 1 : -1;
+  }
+  // Whether a strictly falling (rising) path leads from `from` to `to`.
+  auto monotonePath = [&](const std::vector<double>& values, Index from, Index to, bool up) {
+    auto before = [&](Index a, Index b) { return values[a] < values[b] || (values[a] == values[b] && a < b); };
+    std::vector<char> seen(values.size(), 0);
+    std::vector<Index> stack{ from };
+    seen[from] = 1;
+    while (!stack.empty())
+    {
+      const Index v = stack.back();
+      stack.pop_back();
+      if (v == to)
+      {
+        return true;
+      }
+      for (Index i = mesh.VertexTriangleBegin(v); i < mesh.VertexTriangleEnd(v); ++i)
+      {
+        for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
+        {
+          if (!seen[w] && (up ? before(v, w) : before(w, v)))
+          {
+            seen[w] = 1;
+            stack.push_back(w);
+          }
+        }
+      }
+    }
+    return false;
+  };
+  for (const OneCellCarving carving :
+    { OneCellCarving::JustPastTheWalk, OneCellCarving::WhereNeeded, OneCellCarving::Everywhere })
+  {
+    std::vector<double> values = field.Values;
+    const Index changed = CarveOneCells(field, mesh, constraints, 1.0, values, carving);
+    bool valley = false, ridge = false;
+    for (bool up : { false, true })
+    {
+      const double x = startX + 2;
+      const Index from = vertexNear(x, up ? ridgeY(x) : valleyY(x));
+      const Index to = up ? constraints.Maxima[0] : constraints.Minima[0];
+      (up ? ridge : valley) = monotonePath(values, from, to, up);
+    }
+    std::printf("  carving %d: %d vertices changed; falling chain along the valley: %d, rising along the ridge: %d\n",
+      static_cast<int>(carving), static_cast<int>(changed), valley ? 1 : 0, ridge ? 1 : 0);
+    CHECK(valley);
+    CHECK(ridge);
+  }
+}
+
 int main()
 {
   return testing_harness::RunAll();
