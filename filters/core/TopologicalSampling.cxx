@@ -2123,18 +2123,15 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
   // connected); the others are walked as before. Walking every 1-cell again that way changed
   // chains far from any conflict and lost a noise case (stress #77, 128² at 2 %), and so did
   // walking again every walk that met a vertex only the other kind claims.
-  const auto claimedByBoth = [&](std::size_t c) {
-    const auto& other = constraints.OneCells[c].Ascending ? requests.LowerTo : requests.RaiseTo;
-    const auto& own = constraints.OneCells[c].Ascending ? requests.RaiseTo : requests.LowerTo;
-    return std::any_of(walked.begin() + walkStart[c], walked.begin() + walkStart[c + 1],
-      [&other, &own](Index v) { return other.count(v) > 0 && own.count(v) > 0; });
-  };
+  auto claimedByBoth = [&requests](Index v) { return requests.RaiseTo.count(v) > 0 && requests.LowerTo.count(v) > 0; };
   std::vector<char> rewalk(constraints.OneCells.size(), 0);
+  bool anyRewalk = false;
   for (std::size_t c = 0; c < constraints.OneCells.size(); ++c)
   {
-    rewalk[c] = claimedByBoth(c) ? 1 : 0;
+    rewalk[c] = std::any_of(walked.begin() + walkStart[c], walked.begin() + walkStart[c + 1], claimedByBoth);
+    anyRewalk = anyRewalk || rewalk[c];
   }
-  if (std::find(rewalk.begin(), rewalk.end(), 1) != rewalk.end())
+  if (anyRewalk)
   {
     CarvingRequests again;
     again.Carving = carving;

@@ -99,9 +99,10 @@ enum class OneCellCarving : int
 // curve), raised to the 1-cell's height for an ascending one (lowered for a descending one)
 // and strictly monotone from the saddle on. Vertices within `spacing` of the 1-cell's saddle
 // or extremum are left to the floods and to CarveSaddleOneCells; so are vertices that a
-// ridge and a valley both claim, and boundary vertices the 1-cell does not run through. Where
-// any vertex is claimed by both (a ridge and a valley less than a spacing apart), every 1-cell
-// is walked again round the vertices the other kind claimed, so that no chain breaks there.
+// ridge and a valley both claim, and boundary vertices the 1-cell does not run through. A
+// 1-cell whose walk met a vertex claimed by both (a ridge and a valley less than a spacing
+// apart) is walked again round the vertices the other kind claimed, so that its chain does not
+// break there; the other 1-cells are walked once.
 // Critical vertices keep their values (the nodes' critical values, as Apply sets them), and
 // no vertex next to a wanted maximum (minimum) is raised (lowered) past it.
 // `carving` says how far (OneCellCarving). Returns the number of changed vertices.
