@@ -31,6 +31,10 @@
 #include <algorithm>
 #include <cmath>
 
+#if defined(__GLIBC__)
+#include <malloc.h> // malloc_trim
+#endif
+
 namespace names = vtkTopoSplineArrayNames;
 using topospline::Index;
 
@@ -232,6 +236,13 @@ bool MeshToField(vtkDataSet* input, topospline::PlanarScalarField& field, std::s
 
 namespace vtkTopoSplineDomainConversion
 {
+ReleaseFreedMemoryOnReturn::~ReleaseFreedMemoryOnReturn()
+{
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
+}
+
 topospline::ParallelFor SMPParallelFor()
 {
   return [](Index begin, Index end, const topospline::RangeBody& body) {

@@ -356,6 +356,8 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   vtkLogScopeFunction(TRACE);
+  // Declared first, so that it runs last: after every core object of the run is gone.
+  const vtkTopoSplineDomainConversion::ReleaseFreedMemoryOnReturn releaseFreedMemory;
   vtkMultiBlockDataSet* input = vtkMultiBlockDataSet::GetData(inputVector[0], 0);
   auto* patchesOutput = vtkUnstructuredGrid::GetData(outputVector, 1);
   auto* resampledOutput = vtkImageData::GetData(outputVector, 2);

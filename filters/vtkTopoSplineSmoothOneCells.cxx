@@ -75,6 +75,8 @@ int vtkTopoSplineSmoothOneCells::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   vtkLogScopeFunction(TRACE);
+  // Declared first, so that it runs last: after every core object of the run is gone.
+  const vtkTopoSplineDomainConversion::ReleaseFreedMemoryOnReturn releaseFreedMemory;
   vtkMultiBlockDataSet* input = vtkMultiBlockDataSet::GetData(inputVector[0], 0);
   vtkMultiBlockDataSet* output = vtkMultiBlockDataSet::GetData(outputVector, 0);
   if (!input || !output)
