@@ -546,6 +546,20 @@ vtkSmartPointer<vtkUnstructuredGrid> SmoothedOneCellsBlock(
   auto segments = conversion::NewArray<vtkIntArray>(names::PieceSegments);
   auto type = conversion::NewArray<vtkIntArray>(names::SeparatrixType);
   vtkNew<vtkCellArray> cells;
+  // Allocated at their final sizes: grown by doubling, these blocks (kept as long as the
+  // pipeline) held up to twice what they need.
+  vtkIdType segmentCount = 0;
+  for (const auto& smoothedPiece : smoothed.Pieces)
+  {
+    segmentCount += smoothedPiece.Curve.Segments;
+  }
+  points->Allocate(4 * segmentCount);
+  height->Allocate(4 * segmentCount);
+  cells->AllocateExact(segmentCount, 4 * segmentCount);
+  for (auto* array : { piece.GetPointer(), segments.GetPointer(), type.GetPointer() })
+  {
+    array->Allocate(segmentCount);
+  }
   for (Index p = 0; p < static_cast<Index>(smoothed.Pieces.size()); ++p)
   {
   const auto& smoothedPiece = smoothed.Pieces[p];
@@ -606,6 +620,24 @@ vtkSmartPointer<vtkPolyData> SampledOneCellsBlock(const topospline::MorseSmaleCo
   auto destination = conversion::NewArray<vtkIntArray>(names::DestinationId);
   auto type = conversion::NewArray<vtkIntArray>(names::SeparatrixType);
   std::vector<vtkIdType> ids;
+  vtkIdType pointCount = 0;
+  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
+  {
+    vtkIdType count = 0;
+    for (Index p : smoothed.PiecesOfOneCell[a])
+    {
+      count += smoothed.Pieces[p].Curve.Segments * samplesPerSegment + (count == 0 ? 1 : 0);
+    }
+    pointCount += std::max<vtkIdType>(count, 1);
+  }
+  const auto oneCellCount = static_cast<vtkIdType>(complex.OneCells.size());
+  points->Allocate(pointCount);
+  height->Allocate(pointCount);
+  lines->AllocateExact(oneCellCount, pointCount);
+  for (auto* array : { id.GetPointer(), source.GetPointer(), destination.GetPointer(), type.GetPointer() })
+  {
+    array->Allocate(oneCellCount);
+  }
   for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
   {
   ids.clear();

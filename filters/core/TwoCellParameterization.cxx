@@ -1216,7 +1216,6 @@ bool TwoCellParameterization::Parameterize(
 {
   this->Mesh = TwoCellMesh();
   this->PointGrid = BucketGrid();
-  this->ParameterGrid = BucketGrid();
 
   // The boundary: (u, v) once around the square, an outer loop with slits, a simple polygon;
   // then the mesh of the cell (paper, section 5.1).
@@ -1303,8 +1302,13 @@ bool TwoCellParameterization::Parameterize(
     this->Mesh = TwoCellMesh();
     return false;
   }
+  // The mesh is kept as long as the reconstruction, for every cell at once (half a million on
+  // 1000 x 1000 noise), and its arrays grew by doubling: about a third of what they held was
+  // spare capacity.
+  mesh.Points.shrink_to_fit();
+  mesh.Parameters.shrink_to_fit();
+  mesh.Triangles.shrink_to_fit();
   BuildGrid(mesh.Points, mesh.Triangles, this->PointGrid);
-  BuildGrid(mesh.Parameters, mesh.Triangles, this->ParameterGrid);
   return true;
 }
 
@@ -1576,17 +1580,27 @@ bool TwoCellParameterization::Evaluate(double x, double y, double uv[2]) const
   return true;
 }
 
-bool TwoCellParameterization::InverseEvaluate(double u, double v, double xy[2]) const
+TwoCellParameterization::Inverse::Inverse(const TwoCellMesh& mesh)
+  : Mesh(&mesh)
+{
+  if (mesh.NumberOfTriangles() > 0)
+  {
+    BuildGrid(mesh.Parameters, mesh.Triangles, this->Grid);
+  }
+}
+
+bool TwoCellParameterization::Inverse::Evaluate(double u, double v, double xy[2]) const
 {
   Index triangle;
   double barycentric[3];
   // Triangles are clockwise in (u, v) when Phi is a mirror map.
-  if (!LocateInGrid(this->ParameterGrid, this->Mesh.Parameters, this->Mesh.Triangles, this->Mesh.Orientation, u, v,
-        triangle, barycentric))
+  if (this->Mesh->NumberOfTriangles() == 0 ||
+    !LocateInGrid(this->Grid, this->Mesh->Parameters, this->Mesh->Triangles, this->Mesh->Orientation, u, v, triangle,
+      barycentric))
   {
     return false;
   }
-  Interpolate(this->Mesh.Points, &this->Mesh.Triangles[3 * triangle], barycentric, xy);
+  Interpolate(this->Mesh->Points, &this->Mesh->Triangles[3 * triangle], barycentric, xy);
   return true;
 }
 } // namespace topospline

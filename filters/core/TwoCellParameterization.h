@@ -3,8 +3,8 @@
 // (constrained Delaunay + Delaunay refinement that never splits the boundary, so the boundary
 // vertices are exactly the samples), and every interior vertex gets (u, v) from Floater's mean
 // value coordinates with the boundary fixed on the border of the square. A point location
-// grid then evaluates Phi(x, y) anywhere in the cell, which is what F o Phi needs, and a second
-// grid over the square evaluates Phi^-1(u, v).
+// grid then evaluates Phi(x, y) anywhere in the cell, which is what F o Phi needs; Phi^-1(u, v)
+// is made on request (TwoCellParameterization::Inverse), with a second grid over the square.
 //
 // Pouch cells: the boundary walk may run out along a slit (a tree of boundary edges hanging
 // from the outer loop into the cell) and straight back. The mesh is then cut open along the
@@ -105,10 +105,6 @@ public:
   bool Locate(double x, double y, Index& triangle, double barycentric[3]) const;
   // Phi(x, y): the piecewise linear parameterization at (x, y). False outside the cell.
   bool Evaluate(double x, double y, double uv[2]) const;
-  // Phi^-1(u, v): the triangle containing (u, v) in parameter space, its corners' (x, y)
-  // interpolated. (u, v) on the border of the square or outside by rounding only (1e-9) are
-  // found; false outside the square (or before a successful Parameterize).
-  bool InverseEvaluate(double u, double v, double xy[2]) const;
 
 private:
   // Uniform grid over the bounding box of some vertex coordinates; cell c holds the triangles
@@ -122,6 +118,29 @@ private:
     std::vector<Index> Start;
     std::vector<Index> Triangles;
   };
+
+public:
+  // Phi^-1, for as long as the parameterization it was made from lives unchanged. Only the
+  // planar Bezier patches need it, and its grid over the square is as large as the one Phi
+  // uses (about 2 kB of a typical cell's 9), so cells do not keep one: half a million cells of
+  // 1000 x 1000 noise would hold a gigabyte for an output that is left empty there.
+  class Inverse
+  {
+  public:
+    // Phi^-1(u, v): the triangle containing (u, v) in parameter space, its corners' (x, y)
+    // interpolated. (u, v) on the border of the square or outside by rounding only (1e-9) are
+    // found; false outside the square (or when made before a successful Parameterize).
+    bool Evaluate(double u, double v, double xy[2]) const;
+
+  private:
+    friend class TwoCellParameterization;
+    explicit Inverse(const TwoCellMesh& mesh);
+    const TwoCellMesh* Mesh;
+    BucketGrid Grid;
+  };
+  Inverse MakeInverse() const { return Inverse(this->Mesh); }
+
+private:
   static void BuildGrid(const std::vector<double>& coordinates, const std::vector<Index>& triangles, BucketGrid& grid);
   // The triangle of `grid` in which (x, y) lies deepest; orientation is the sign of the
   // triangles' areas in `coordinates`.
@@ -129,7 +148,6 @@ private:
     const std::vector<Index>& triangles, int orientation, double x, double y, Index& triangle, double barycentric[3]);
 
   TwoCellMesh Mesh;
-  BucketGrid PointGrid;     // over (x, y): Locate, Evaluate
-  BucketGrid ParameterGrid; // over (u, v): InverseEvaluate
+  BucketGrid PointGrid; // over (x, y): Locate, Evaluate
 };
 } // namespace topospline

@@ -1268,16 +1268,17 @@ std::vector<PlanarBezierTriangle> TwoCellReconstruction::PlanarBezierTriangles(I
   // split of an N x N grid, points of the (6N + 1)^2 lattice, most of them shared by two to
   // eight triangles. Each is mapped back to (x, y) once.
   const double steps = 6.0 * cell.Surface.GetGridSize();
+  const TwoCellParameterization::Inverse phiInverse = cell.Parameterization.MakeInverse();
   std::unordered_map<std::uint64_t, std::array<double, 2>> mapped;
   mapped.reserve(5 * patches.size());
   const auto inverse = [&](double u, double v) {
     const auto key = (static_cast<std::uint64_t>(std::llround(std::clamp(u, 0.0, 1.0) * steps)) << 32) |
       static_cast<std::uint64_t>(std::llround(std::clamp(v, 0.0, 1.0) * steps));
     auto [it, added] = mapped.try_emplace(key, std::array<double, 2>{ 0, 0 });
-    if (added && !cell.Parameterization.InverseEvaluate(u, v, it->second.data()))
+    if (added && !phiInverse.Evaluate(u, v, it->second.data()))
     {
       // Only rounding can put a lattice point outside the square's mesh; clamp it in.
-      cell.Parameterization.InverseEvaluate(std::clamp(u, 0.0, 1.0), std::clamp(v, 0.0, 1.0), it->second.data());
+      phiInverse.Evaluate(std::clamp(u, 0.0, 1.0), std::clamp(v, 0.0, 1.0), it->second.data());
     }
     return it->second;
   };

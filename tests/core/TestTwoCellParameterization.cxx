@@ -324,6 +324,7 @@ int CheckParameterization(const TwoCellParameterization& tcp, const Cell& cell, 
     bounds[3] = std::max(bounds[3], cell.Points[2 * i + 1]);
   }
   const double size = std::max(bounds[1] - bounds[0], bounds[3] - bounds[2]);
+  const TwoCellParameterization::Inverse phiInverse = tcp.MakeInverse();
 
   // Point location: vertices and centroids map to their (u, v); random points inside the
   // polygon are found and land in the square; points well outside are rejected. A slit
@@ -351,10 +352,10 @@ int CheckParameterization(const TwoCellParameterization& tcp, const Cell& cell, 
     // image; it is only checked on meshes without them.
     inverseAtVertices = inverseAtVertices &&
       (crowded > 0 ||
-        (tcp.InverseEvaluate(mesh.Parameters[2 * i], mesh.Parameters[2 * i + 1], xy) &&
+        (phiInverse.Evaluate(mesh.Parameters[2 * i], mesh.Parameters[2 * i + 1], xy) &&
           std::hypot(xy[0] - mesh.Points[2 * i], xy[1] - mesh.Points[2 * i + 1]) <= 1e-9 * size));
   }
-  expect(inverseAtVertices, "InverseEvaluate maps every vertex's (u, v) to its (x, y) (meshes without crowded triangles)");
+  expect(inverseAtVertices, "Phi^-1 maps every vertex's (u, v) to its (x, y) (meshes without crowded triangles)");
   for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
   {
     const Index* tri = &mesh.Triangles[3 * t];
@@ -391,7 +392,7 @@ int CheckParameterization(const TwoCellParameterization& tcp, const Cell& cell, 
       insideFound = insideFound && found && uv[0] >= 0 && uv[0] <= 1 && uv[1] >= 0 && uv[1] <= 1;
       // Phi^-1(Phi(x, y)) = (x, y).
       double xy[2], back[2];
-      if (found && tcp.InverseEvaluate(uv[0], uv[1], xy) && tcp.Evaluate(xy[0], xy[1], back))
+      if (found && phiInverse.Evaluate(uv[0], uv[1], xy) && tcp.Evaluate(xy[0], xy[1], back))
       {
         const double forward = std::hypot(xy[0] - x, xy[1] - y) / size;
         inverseError = std::max(inverseError, forward);
@@ -416,7 +417,7 @@ int CheckParameterization(const TwoCellParameterization& tcp, const Cell& cell, 
   expect(insideFound, "random inside points located, (u, v) in the square");
   expect(outsideRejected, "random outside points rejected");
   expect(crowded > 0 || inverseError <= 1e-9 || inverseBackward <= 1e-14,
-    "InverseEvaluate(Evaluate(x, y)) = (x, y) at random inside points (1e-9, or exact backwards)");
+    "Phi^-1(Phi(x, y)) = (x, y) at random inside points (1e-9, or exact backwards)");
   // The corners of the square: the corner samples; outside the square: nothing.
   bool corners = true;
   for (int k = 0; k < 4; ++k)
@@ -424,7 +425,7 @@ int CheckParameterization(const TwoCellParameterization& tcp, const Cell& cell, 
     const double corner[2] = { static_cast<double>(k == 1 || k == 2), static_cast<double>(k >= 2) };
     double xy[2];
     bool matched = false;
-    if (tcp.InverseEvaluate(corner[0], corner[1], xy))
+    if (phiInverse.Evaluate(corner[0], corner[1], xy))
     {
       for (Index i = 0; i < n; ++i)
       {
@@ -436,10 +437,10 @@ int CheckParameterization(const TwoCellParameterization& tcp, const Cell& cell, 
     corners = corners && matched;
   }
   double xy[2];
-  expect(corners, "InverseEvaluate maps the corners of the square to the corner samples");
-  expect(!tcp.InverseEvaluate(-0.01, 0.5, xy) && !tcp.InverseEvaluate(0.5, 1.01, xy) &&
-      !tcp.InverseEvaluate(std::nan(""), 0.5, xy),
-    "InverseEvaluate rejects (u, v) outside the square");
+  expect(corners, "Phi^-1 maps the corners of the square to the corner samples");
+  expect(!phiInverse.Evaluate(-0.01, 0.5, xy) && !phiInverse.Evaluate(0.5, 1.01, xy) &&
+      !phiInverse.Evaluate(std::nan(""), 0.5, xy),
+    "Phi^-1 rejects (u, v) outside the square");
   return failures;
 }
 
@@ -1079,6 +1080,7 @@ double CellSize(const Cell& cell)
 // one is not found).
 double InverseRoundTripError(const TwoCellParameterization& tcp, const Cell& cell, Random& random, int samples)
 {
+  const TwoCellParameterization::Inverse phiInverse = tcp.MakeInverse();
   const double size = CellSize(cell);
   double lo[2] = { 1e300, 1e300 }, hi[2] = { -1e300, -1e300 };
   for (std::size_t i = 0; i < cell.Points.size() / 2; ++i)
@@ -1099,7 +1101,7 @@ double InverseRoundTripError(const TwoCellParameterization& tcp, const Cell& cel
     }
     ++found;
     double uv[2], xy[2];
-    if (!tcp.Evaluate(x, y, uv) || !tcp.InverseEvaluate(uv[0], uv[1], xy))
+    if (!tcp.Evaluate(x, y, uv) || !phiInverse.Evaluate(uv[0], uv[1], xy))
     {
       return 1e300;
     }
@@ -1114,6 +1116,7 @@ double InverseRoundTripError(const TwoCellParameterization& tcp, const Cell& cel
 // Returns the number of slit edges checked, -1 on a failure.
 int CheckSlits(const TwoCellParameterization& tcp, const Cell& cell)
 {
+  const TwoCellParameterization::Inverse phiInverse = tcp.MakeInverse();
   const int n = static_cast<int>(cell.Points.size() / 2);
   const double size = CellSize(cell);
   const double* p = cell.Points.data();
@@ -1152,7 +1155,7 @@ int CheckSlits(const TwoCellParameterization& tcp, const Cell& cell)
       for (int side = 0; side < 2; ++side)
       {
         oneSide = oneSide || (std::abs(uv[0] - sides[side][0]) < 1e-9 && std::abs(uv[1] - sides[side][1]) < 1e-9);
-        if (!tcp.InverseEvaluate(sides[side][0], sides[side][1], xy) || std::hypot(xy[0] - x, xy[1] - y) > 1e-9 * size)
+        if (!phiInverse.Evaluate(sides[side][0], sides[side][1], xy) || std::hypot(xy[0] - x, xy[1] - y) > 1e-9 * size)
         {
           return -1;
         }
@@ -1334,6 +1337,7 @@ TEST_CASE(InverseEvaluation)
     std::string error;
     CHECK(tcp.Parameterize(cell.Points, cell.Parameters, error));
     CHECK_EQ(tcp.GetMesh().Orientation, mirrored ? -1 : 1);
+    const TwoCellParameterization::Inverse phiInverse = tcp.MakeInverse();
     const double roundTrip = InverseRoundTripError(tcp, cell, random, 2000);
     std::printf("  perturbed circle%s: max |Phi^-1 Phi - id| / size = %.1e\n", mirrored ? " (mirrored)" : "", roundTrip);
     CHECK(roundTrip <= 1e-9);
@@ -1345,13 +1349,13 @@ TEST_CASE(InverseEvaluation)
     {
       const double uv[2] = { random.Uniform(), random.Uniform() };
       double xy[2], back[2];
-      CHECK(tcp.InverseEvaluate(uv[0], uv[1], xy) && tcp.Evaluate(xy[0], xy[1], back));
+      CHECK(phiInverse.Evaluate(uv[0], uv[1], xy) && tcp.Evaluate(xy[0], xy[1], back));
       worst = std::max(worst, std::hypot(back[0] - uv[0], back[1] - uv[1]));
       const double t = random.Uniform(), off = random.Uniform(-1e-12, 1e-12);
       const double onBorder[4][2] = { { t, off }, { 1 + off, t }, { t, 1 + off }, { off, t } };
       for (const auto& b : onBorder)
       {
-        CHECK(tcp.InverseEvaluate(b[0], b[1], xy));
+        CHECK(phiInverse.Evaluate(b[0], b[1], xy));
         border = std::max(border, DistanceToPolygon(cell.Points, xy[0], xy[1]) / size);
       }
     }
@@ -1359,13 +1363,13 @@ TEST_CASE(InverseEvaluation)
     CHECK(worst <= 1e-12);
     CHECK(border <= 1e-9);
     double xy[2];
-    CHECK(!tcp.InverseEvaluate(1 + 1e-6, 0.5, xy));
-    CHECK(!tcp.InverseEvaluate(0.5, -1e-6, xy));
+    CHECK(!phiInverse.Evaluate(1 + 1e-6, 0.5, xy));
+    CHECK(!phiInverse.Evaluate(0.5, -1e-6, xy));
   }
   // Before any (or after a failed) Parameterize nothing is found.
   TwoCellParameterization empty;
   double xy[2];
-  CHECK(!empty.InverseEvaluate(0.5, 0.5, xy));
+  CHECK(!empty.MakeInverse().Evaluate(0.5, 0.5, xy));
 }
 
 // A pinched cell (uniform noise makes them): two lobes touching at one point that the boundary
