@@ -620,16 +620,9 @@ vtkSmartPointer<vtkPolyData> SampledOneCellsBlock(const topospline::MorseSmaleCo
   auto destination = conversion::NewArray<vtkIntArray>(names::DestinationId);
   auto type = conversion::NewArray<vtkIntArray>(names::SeparatrixType);
   std::vector<vtkIdType> ids;
-  vtkIdType pointCount = 0;
-  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
-  {
-    vtkIdType count = 0;
-    for (Index p : smoothed.PiecesOfOneCell[a])
-    {
-      count += smoothed.Pieces[p].Curve.Segments * samplesPerSegment + (count == 0 ? 1 : 0);
-    }
-    pointCount += std::max<vtkIdType>(count, 1);
-  }
+  // Allocated at their final sizes: grown by doubling, this block (kept as long as the
+  // pipeline) held up to twice what it needs.
+  const vtkIdType pointCount = vtkTopoSplineWireFormat::SampledOneCellPoints(complex, smoothed, samplesPerSegment);
   const auto oneCellCount = static_cast<vtkIdType>(complex.OneCells.size());
   points->Allocate(pointCount);
   height->Allocate(pointCount);

@@ -1593,10 +1593,10 @@ bool TwoCellParameterization::Inverse::Evaluate(double u, double v, double xy[2]
 {
   Index triangle;
   double barycentric[3];
-  // Triangles are clockwise in (u, v) when Phi is a mirror map.
-  if (this->Mesh->NumberOfTriangles() == 0 ||
-    !LocateInGrid(this->Grid, this->Mesh->Parameters, this->Mesh->Triangles, this->Mesh->Orientation, u, v, triangle,
-      barycentric))
+  // Triangles are clockwise in (u, v) when Phi is a mirror map. Without a mesh the grid is
+  // empty, and nothing is found.
+  if (!LocateInGrid(this->Grid, this->Mesh->Parameters, this->Mesh->Triangles, this->Mesh->Orientation, u, v, triangle,
+        barycentric))
   {
     return false;
   }
