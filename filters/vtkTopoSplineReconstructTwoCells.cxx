@@ -299,6 +299,7 @@ void WriteReport(const topospline::FieldReconstructionReport& report, vtkFieldDa
     AddFieldNumbers(fd, names::SamplingConverged, { report.Sampling.Converged ? 1.0 : 0.0 });
     AddFieldNumbers(fd, names::SamplingDisplacedSaddles, { static_cast<double>(report.Sampling.DisplacedSaddles) });
     AddFieldNumbers(fd, names::SamplingBlockedWaysUp, { static_cast<double>(report.Sampling.BlockedWaysUp.size() / 2) });
+    AddFieldNumbers(fd, names::SamplingMovedBoundarySaddles, { static_cast<double>(report.Sampling.MovedBoundarySaddles) });
   }
   if (!report.VerificationRan)
   {

@@ -546,6 +546,7 @@ void FieldReconstruction::Resample(const PlanarScalarField& field, const Triangl
       },
       fine.Values);
     report.Sampling.DisplacedSaddles += fineReport.DisplacedSaddles;
+    report.Sampling.MovedBoundarySaddles += fineReport.MovedBoundarySaddles;
     report.Sampling.ChangedVertices += fineReport.ChangedVertices;
     report.Sampling.MaximumChange = std::max(report.Sampling.MaximumChange, fineReport.MaximumChange);
     report.Sampling.Converged = report.Sampling.Converged && fineReport.Converged;

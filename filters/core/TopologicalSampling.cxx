@@ -9,6 +9,7 @@
 #include <functional>
 #include <iterator>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <queue>
 #include <unordered_map>
@@ -377,22 +378,10 @@ NearestPoint NearestOnOneCell(const SaddleOneCell& cell, double x, double y)
   return best;
 }
 
-// A wanted boundary saddle (a maximum of the boundary curve) whose whole link is lower is a
-// maximum of the sampling too. Cutting it, as Fill would, makes it a pit of the boundary curve
-// that the boundary pass fills again, round after round. It needs a way up into the domain
-// instead: the interior is searched, highest vertices first, for the nearest vertex with a
-// neighbour above the saddle, and the path to it is raised to rise from just above the saddle
-// towards that neighbour. Path vertices keep a lower and a higher neighbour, so no extremum
-// appears, and the boundary curve is not touched. The path leaves out the vertices `avoided`
-// names (a wanted saddle and the neighbours below it: raising one takes a wanted saddle away,
-// and on heavy noise a way up would run straight through one); if there is no such way, the
-// caller searches again without them. Returns the number of changed vertices (0: no way up).
-// (Tried and dropped: following the saddle's smoothed ascending 1-cell instead; it left more
-// saddles off their nodes on the climate field. Keeping off wanted saddles with no second
-// search broke convergence: a saddle with no way up is cut, and the boundary pass fills it
-// again.)
-Index RaiseWayUp(const Graph& g, const TriangleMeshTopology& mesh, std::vector<double>& values, Index v,
-  VisitMarks& visits, const std::function<bool(Index)>& avoided, std::vector<Index>* raisedPath = nullptr)
+// The search of RaiseWayUp (below) alone: the interior path from v (v excluded) to the vertex
+// whose neighbour `above` stands high enough above v, in `path`; false if there is none.
+bool FindWayUp(const Graph& g, const TriangleMeshTopology& mesh, const std::vector<double>& values, Index v,
+  VisitMarks& visits, const std::function<bool(Index)>& avoided, std::vector<Index>& path, Index& above)
 {
   std::vector<unsigned>& mark = visits.Mark;
   const Key top{ values[v], v };
@@ -419,7 +408,8 @@ Index RaiseWayUp(const Graph& g, const TriangleMeshTopology& mesh, std::vector<d
   {
     visit(g.Adjacent[i], v);
   }
-  Index end = InvalidIndex, above = InvalidIndex;
+  Index end = InvalidIndex;
+  above = InvalidIndex;
   while (!queue.empty() && end == InvalidIndex)
   {
     const Index u = queue.top().Vertex;
@@ -438,16 +428,42 @@ Index RaiseWayUp(const Graph& g, const TriangleMeshTopology& mesh, std::vector<d
       visit(g.Adjacent[i], u);
     }
   }
+  path.clear();
   if (end == InvalidIndex)
   {
-    return 0;
+    return false;
   }
-  std::vector<Index> path;
   for (Index u = end; u != v; u = parent[u])
   {
     path.push_back(u);
   }
   std::reverse(path.begin(), path.end());
+  return true;
+}
+
+// A wanted boundary saddle (a maximum of the boundary curve) whose whole link is lower is a
+// maximum of the sampling too. Cutting it, as Fill would, makes it a pit of the boundary curve
+// that the boundary pass fills again, round after round. It needs a way up into the domain
+// instead: the interior is searched, highest vertices first, for the nearest vertex with a
+// neighbour above the saddle, and the path to it is raised to rise from just above the saddle
+// towards that neighbour. Path vertices keep a lower and a higher neighbour, so no extremum
+// appears, and the boundary curve is not touched. The path leaves out the vertices `avoided`
+// names (a wanted saddle and the neighbours below it: raising one takes a wanted saddle away,
+// and on heavy noise a way up would run straight through one); if there is no such way, the
+// caller searches again without them. Returns the number of changed vertices (0: no way up).
+// (Tried and dropped: following the saddle's smoothed ascending 1-cell instead; it left more
+// saddles off their nodes on the climate field. Keeping off wanted saddles with no second
+// search broke convergence: a saddle with no way up is cut, and the boundary pass fills it
+// again.)
+Index RaiseWayUp(const Graph& g, const TriangleMeshTopology& mesh, std::vector<double>& values, Index v,
+  VisitMarks& visits, const std::function<bool(Index)>& avoided, std::vector<Index>* raisedPath = nullptr)
+{
+  std::vector<Index> path;
+  Index above = InvalidIndex;
+  if (!FindWayUp(g, mesh, values, v, visits, avoided, path, above))
+  {
+    return 0;
+  }
   const double from = values[v], to = values[above];
   const double steps = static_cast<double>(path.size() + 1);
   double previous = from;
@@ -1213,6 +1229,89 @@ std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, cons
 }
 } // namespace
 
+int MoveBlockedBoundarySaddles(const TriangleMeshTopology& mesh, const std::vector<Index>& blocked,
+  const std::vector<double>& settled, SamplingConstraints& constraints, std::vector<double>& start)
+{
+  enum : unsigned char
+  {
+    Low = 1,  // a wanted minimum or saddle: no way up may run through it
+    Other = 2 // wanted as anything else
+  };
+  std::vector<unsigned char> wanted(mesh.NumberOfVertices(), 0);
+  for (const std::vector<Index>* list : { &constraints.Minima, &constraints.Saddles })
+  {
+    for (Index v : *list)
+    {
+      wanted[v] |= Low;
+    }
+  }
+  for (const std::vector<Index>* list : { &constraints.Maxima, &constraints.BoundaryMinima, &constraints.BoundaryMaxima })
+  {
+    for (Index v : *list)
+    {
+      wanted[v] |= Other;
+    }
+  }
+  const std::unordered_set<Index> wantedMaxima(constraints.Maxima.begin(), constraints.Maxima.end());
+  const std::unordered_set<Index> candidates(blocked.begin(), blocked.end());
+  const VertexGraphs graphs(mesh);
+  const Graph& curve = graphs.Boundary;
+  std::vector<double> values = settled;
+  VisitMarks visits;
+  visits.Mark.assign(mesh.NumberOfVertices(), 0);
+  auto avoided = [&wanted](Index w) { return (wanted[w] & Low) != 0; };
+  int moved = 0;
+  for (Index& v : constraints.BoundaryMaxima)
+  {
+    if (!candidates.count(v) || wantedMaxima.count(v))
+    {
+      continue;
+    }
+    // The saddle's own vertex will be lowered below its replacement: it is no way up.
+    const double saddleValue = values[v];
+    values[v] = -std::numeric_limits<double>::infinity();
+    Index best = InvalidIndex;
+    for (Index i = curve.Start[v]; i < curve.Start[v + 1]; ++i)
+    {
+      const Index w = curve.Adjacent[i];
+      const VertexLink link(mesh, w);
+      if (wanted[w] || std::all_of(link.begin(), link.end(), [&mesh](Index u) { return mesh.IsBoundaryVertex(u); }))
+      {
+        continue;
+      }
+      const double kept = values[w];
+      values[w] = saddleValue;
+      // Its other neighbour along the curve must not be a wanted point above it.
+      bool possible = true;
+      for (Index j = curve.Start[w]; j < curve.Start[w + 1]; ++j)
+      {
+        const Index x = curve.Adjacent[j];
+        possible = possible && (x == v || !wanted[x] || Key{ values[x], x } < Key{ values[w], w });
+      }
+      std::vector<Index> path;
+      Index above;
+      if (possible && FindWayUp(graphs.All, mesh, values, w, visits, avoided, path, above) &&
+        (best == InvalidIndex || std::abs(start[w] - start[v]) < std::abs(start[best] - start[v])))
+      {
+        best = w;
+      }
+      values[w] = kept;
+    }
+    values[v] = saddleValue;
+    if (best == InvalidIndex)
+    {
+      continue;
+    }
+    start[best] = start[v];
+    std::replace(constraints.Saddles.begin(), constraints.Saddles.end(), v, best);
+    wanted[best] = wanted[v];
+    wanted[v] = 0;
+    v = best;
+    ++moved;
+  }
+  return moved;
+}
+
 TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sampling,
   const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, std::vector<double>& values) const
 {
@@ -1258,10 +1357,10 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   // MaximumVerticesForMorePasses: there a pass costs seconds (2 s of the 2000 x 2000 terrain's
   // 14, for one saddle that it left off all the same). The start is kept in any case: it is
   // also what RelaxTowardTargets moves the vertices back toward.
-  const std::vector<double> prepared = values;
+  std::vector<double> prepared = values;
   const bool morePasses = mesh.NumberOfVertices() <= this->MaximumVerticesForMorePasses;
-  TopologicalSamplingReport report =
-    this->Settle(sampling, mesh, vertexAt, constraints, OneCellCarving::JustPastTheWalk, values);
+  OneCellCarving kept = OneCellCarving::JustPastTheWalk;
+  TopologicalSamplingReport report = this->Settle(sampling, mesh, vertexAt, constraints, kept, values);
   for (const OneCellCarving carving : { OneCellCarving::WhereNeeded, OneCellCarving::Everywhere })
   {
     if (report.DisplacedSaddles == 0 || !morePasses)
@@ -1274,6 +1373,37 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
     {
       values = std::move(carved);
       report = next;
+      kept = carving;
+    }
+  }
+  // Boundary saddles whose way up the floods forced through a wanted point: wanted one step
+  // along the boundary where that has a way (MoveBlockedBoundarySaddles), and the kept carving
+  // runs once more; kept if it leaves fewer saddles off their nodes, or as many and fewer
+  // blocked ways up.
+  int movedSaddles = 0;
+  if (!report.BlockedWaysUpVertices.empty() && morePasses)
+  {
+    const std::vector<Index> boundaryMaxima = constraints.BoundaryMaxima;
+    const std::vector<Index> saddles = constraints.Saddles;
+    std::vector<double> moved = prepared;
+    movedSaddles = MoveBlockedBoundarySaddles(mesh, report.BlockedWaysUpVertices, values, constraints, moved);
+    if (movedSaddles > 0)
+    {
+      std::vector<double> settled = moved;
+      const TopologicalSamplingReport next = this->Settle(sampling, mesh, vertexAt, constraints, kept, settled);
+      if (next.DisplacedSaddles < report.DisplacedSaddles ||
+        (next.DisplacedSaddles == report.DisplacedSaddles && next.BlockedWaysUp.size() < report.BlockedWaysUp.size()))
+      {
+        values = std::move(settled);
+        prepared = std::move(moved);
+        report = next;
+      }
+      else
+      {
+        constraints.BoundaryMaxima = boundaryMaxima;
+        constraints.Saddles = saddles;
+        movedSaddles = 0;
+      }
     }
   }
   // What the carving, the floods and the relocations changed beyond what the critical points
@@ -1281,6 +1411,7 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   RelaxTowardTargets(mesh, prepared, values);
   report.ChangedVertices = 0;
   report.MaximumChange = 0;
+  report.MovedBoundarySaddles = movedSaddles;
   CountChanges(before, values, report);
   return report;
 }
@@ -1334,6 +1465,7 @@ TopologicalSamplingReport TopologicalSampling::Settle(const PlanarScalarField& s
   {
     report.BlockedWaysUp.insert(report.BlockedWaysUp.end(), { sampling.Points[2 * v], sampling.Points[2 * v + 1] });
   }
+  report.BlockedWaysUpVertices = std::move(blocked);
   return report;
 }
 
@@ -2168,3 +2300,4 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
   return requests.Apply(values);
 }
 } // namespace topospline
+

@@ -40,6 +40,10 @@ struct TopologicalSamplingReport
   // the domain ran through a wanted minimum or saddle: its way up raised one (the sampling's
   // vertices are too few there for the complex).
   std::vector<double> BlockedWaysUp;
+  std::vector<Index> BlockedWaysUpVertices; // the same saddles' vertices in the sampling
+  // Wanted boundary saddles with no way up that the sampling wants one step along the boundary
+  // instead, where there is one.
+  int MovedBoundarySaddles = 0;
 };
 
 // One smoothed 1-cell of a wanted saddle, sampled from the saddle outwards: x, y and height per
@@ -117,7 +121,10 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
 // (RelaxTowardTargets). The 1-cells are carved gently first (OneCellCarving); while
 // saddles are left off their nodes, the whole sequence runs again with the next carving (on
 // samplings of at most MaximumVerticesForMorePasses vertices), and the sampling with the fewest
-// displaced saddles is kept, the gentler one of equals. The complex side is fixed at
+// displaced saddles is kept, the gentler one of equals. Boundary saddles whose way up the floods
+// forced through a wanted point are then wanted one step along the boundary where that has a
+// way (MoveBlockedBoundarySaddles), and the kept carving runs once more (kept if it leaves fewer
+// saddles off, or as many and fewer blocked). The complex side is fixed at
 // construction; Apply samples one sampling of the reconstruction (the input vertices, a finer
 // grid).
 // `complexPoints` (x, y per vertex of `complexMesh`) tells where the nodes are: on a sampling
@@ -181,6 +188,22 @@ private:
 TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds = 6,
   std::vector<Index>* blockedWaysUp = nullptr);
+
+// A wanted boundary saddle whose way up the floods had to force through a wanted minimum or
+// saddle (SamplingBlockedWaysUp; on noise its only interior neighbour can be a wanted minimum)
+// cannot be sampled on its vertex as the complex wants it: above both boundary neighbours with
+// no higher vertex it can reach, it is a maximum as well, and the forced way up takes the wanted
+// point away. A boundary neighbour, one step along the curve (within the verdict's spacing),
+// can have a way: the peak of the boundary curve is then wanted there, at the saddle's value
+// (in `start`), and the floods lower the saddle's own vertex below it. The neighbour must be
+// wanted as nothing else, must not be a domain corner, and must have a way up that keeps off
+// the wanted minima and saddles in `settled` (the values of the pass that was blocked); of two,
+// the one whose value changes less. `blocked`: the saddles' vertices, as EnforceCriticalVertices
+// lists them. `constraints` (BoundaryMaxima, Saddles) and `start` are changed; returns the number
+// of saddles moved. TopologicalSampling::Apply then settles the sampling again from `start` and
+// keeps the result if it leaves fewer saddles off their nodes (or as many, fewer blocked).
+int MoveBlockedBoundarySaddles(const TriangleMeshTopology& mesh, const std::vector<Index>& blocked,
+  const std::vector<double>& settled, SamplingConstraints& constraints, std::vector<double>& start);
 
 // Makes every wanted extremum an extremum again where a step before (a flood of the other
 // kind, a carved 1-cell, a saddle moved back) took that away: the vertex is moved just past its

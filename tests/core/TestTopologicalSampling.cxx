@@ -3,7 +3,8 @@
 // ridge running between two rows of vertices is carved in, a cut leaves no pit on its plateau
 // of a triangle mesh, and wanted extrema taken away by
 // the floods of the other kind are restored; relaxing toward the values before keeps every
-// critical point; a corner saddle with no way up but through a wanted minimum is reported. Each sampled result is checked by
+// critical point; a corner saddle with no way up but through a wanted minimum is reported, and
+// one with a free neighbour along the boundary moves there. Each sampled result is checked by
 // extracting its critical points again (stage 1) against the wanted complex. (The whole
 // sequence on real reconstructions is tested in TestFieldReconstruction.)
 //
@@ -753,6 +754,66 @@ TEST_CASE(ACornerSaddleWithoutAWayUpIsReported)
       values[saddle]);
     CHECK(blocked == (pitWanted ? std::vector<Index>{ saddle } : std::vector<Index>{}));
   }
+}
+
+TEST_CASE(ABlockedBoundarySaddleMovesOneStepAlongTheBoundary)
+{
+  // The blocked saddle at (0, 1) of a 5 x 5 ramp, as above, with the left side falling from
+  // (0, 2) to a wanted boundary minimum at (0, 3): (0, 2) is free, and its interior neighbour
+  // (1, 2) leads up. The saddle is wanted there instead, at its value; settled again from the
+  // moved start, nothing is blocked, the minimum at (1, 1) stays, and the stage-1 extraction of
+  // the result finds the wanted counts with the boundary saddle at (0, 2), one spacing from its node.
+  constexpr int n = 5;
+  PlanarScalarField field = UnitGrid(n, n, [](int i, int j) {
+    if (i == 0 && j > 0 && j < 4)
+    {
+      return j == 1 ? 5.0 : (j == 2 ? 4.5 : 1.0);
+    }
+    return i == 1 && j == 1 ? -1.0 : double(i + j);
+  });
+  TriangleMeshTopology mesh;
+  mesh.BuildGrid(n, n, SequentialFor);
+  const Index corner = 0, saddle = n, pit = n + 1, top = n * n - 1, free = 2 * n, side = 3 * n;
+  SamplingConstraints constraints;
+  constraints.Minima = { pit };
+  constraints.Maxima = { top };
+  constraints.BoundaryMinima = { corner, side };
+  constraints.BoundaryMaxima = { saddle, top };
+  constraints.Saddles = { saddle };
+  std::vector<double> settled = field.Values;
+  std::vector<Index> blocked;
+  EnforceCriticalVertices(mesh, constraints, settled, 6, &blocked);
+  CHECK(std::find(blocked.begin(), blocked.end(), saddle) != blocked.end());
+  std::vector<double> start = field.Values;
+  const int moved = MoveBlockedBoundarySaddles(mesh, blocked, settled, constraints, start);
+  CHECK_EQ(moved, 1);
+  CHECK(constraints.BoundaryMaxima == (std::vector<Index>{ free, top }));
+  CHECK(constraints.Saddles == std::vector<Index>{ free });
+  CHECK_EQ(start[free], field.Values[saddle]);
+  std::vector<Index> blockedAfter;
+  const auto report = EnforceCriticalVertices(mesh, constraints, start, 6, &blockedAfter);
+  CHECK(report.Converged);
+  CHECK(blockedAfter.empty());
+  field.Values = start;
+  MorseSmaleComplexExtraction extraction;
+  std::string error;
+  MorseSmaleComplex after;
+  CHECK(extraction.Extract(field, after, error));
+  std::vector<Index> found[3];
+  for (const CriticalPoint& cp : after.CriticalPoints)
+  {
+    found[cp.MorseIndex].push_back(cp.Vertex);
+  }
+  for (std::vector<Index>& list : found)
+  {
+    std::sort(list.begin(), list.end());
+  }
+  std::printf("  moved %d; after: %zu minima, %zu saddles, %zu maxima; pit (1, 1) %.3g, (0, 1) %.3g, (0, 2) %.3g\n",
+    moved, found[0].size(), found[1].size(), found[2].size(), start[pit], start[saddle], start[free]);
+  CHECK(found[0] == (std::vector<Index>{ corner, pit, side }));
+  CHECK(found[2] == std::vector<Index>{ top });
+  CHECK(std::find(found[1].begin(), found[1].end(), free) != found[1].end());
+  CHECK(std::find(found[1].begin(), found[1].end(), saddle) == found[1].end());
 }
 
 TEST_CASE(AValleyBesideARidgeGoesRoundTheVerticesBothClaim)
