@@ -325,14 +325,16 @@ bool TraceDescendingOneCell(const ExtractionState& state, Index saddle, int side
 
 // The ascending 1-cell of `saddle` that starts at triangle t of its edge: the triangle
 // V-path up to a maximum, from the saddle's vertex to the maximum's, one point per triangle:
-// its centroid, unless the segment to the next triangle's centroid does not cross the edge
+// its centroid, unless the segment to the next triangle's point does not cross the edge
 // between them (the two form a non-convex quad, on a triangle mesh), then the midpoint of that
 // edge. Such a segment leaves the two triangles and can cross a descending 1-cell; a polyline
-// whose every segment stays in one triangle meets none (descending 1-cells run along edges no
-// triangle of the gradient is paired with), and stage 3 falls back to these polylines where
-// smoothed curves cross. Either point of a triangle lies in the next one's quad, so the rule
-// holds whichever its neighbours chose. A grid's quads are convex: all centroids. Returns false
-// if the path does not end (a cycle of the gradient).
+// whose every segment stays in its two triangles meets none (descending 1-cells run along edges
+// no triangle of the gradient is paired with), and stage 3 falls back to these polylines where
+// smoothed curves cross. The points are decided from the maximum back, each against the next
+// one as finally chosen: deciding each against the next centroid let a centroid's segment run
+// to the next triangle's midpoint outside the quad (stress case #275, a Delaunay mesh: an
+// ascending polyline crossed both descending 1-cells of a saddle). A grid's quads are convex:
+// all centroids. Returns false if the path does not end (a cycle of the gradient).
 bool TraceAscendingOneCell(const ExtractionState& state, Index saddle, Index t, OneCell& oneCell)
 {
   const PlanarScalarField& field = state.Field;
@@ -360,41 +362,46 @@ bool TraceAscendingOneCell(const ExtractionState& state, Index saddle, Index t, 
       c[1] += field.Points[2 * v + 1] / 3;
     }
   };
+  // Centroids first; then, from the maximum back, a centroid whose segment to the next point
+  // (final by then) does not cross the edge between the two triangles gives way to that edge's
+  // midpoint, from which both neighbouring segments stay in their triangles.
+  const std::size_t first = oneCell.Points.size() / 2;
   for (std::size_t i = 0; i < n; ++i)
   {
     const auto& tv = mesh.TriangleVertices[oneCell.MeshCells[i]];
     double c[2];
     centroid(oneCell.MeshCells[i], c);
-    double value = (f[tv[0]] / 3 + f[tv[1]] / 3) + f[tv[2]] / 3;
-    Index shared[2] = { InvalidIndex, InvalidIndex };
-    int count = 0;
-    if (i + 1 < n && !field.IsGrid())
-    {
-      const auto& next = mesh.TriangleVertices[oneCell.MeshCells[i + 1]];
-      for (Index v : tv)
-      {
-        if (std::find(next.begin(), next.end(), v) != next.end() && count < 2)
-        {
-          shared[count++] = v;
-        }
-      }
-    }
-    if (count == 2)
-    {
-      double d[2];
-      centroid(oneCell.MeshCells[i + 1], d);
-      const double* a = &field.Points[2 * shared[0]];
-      const double* b = &field.Points[2 * shared[1]];
-      if (!SegmentsCrossProperly(c, d, a, b))
-      {
-        c[0] = a[0] / 2 + b[0] / 2;
-        c[1] = a[1] / 2 + b[1] / 2;
-        value = f[shared[0]] / 2 + f[shared[1]] / 2;
-      }
-    }
     oneCell.Points.push_back(c[0]);
     oneCell.Points.push_back(c[1]);
-    oneCell.Values.push_back(value);
+    oneCell.Values.push_back((f[tv[0]] / 3 + f[tv[1]] / 3) + f[tv[2]] / 3);
+  }
+  for (std::size_t i = n - 1; i-- > 0 && !field.IsGrid();)
+  {
+    const auto& tv = mesh.TriangleVertices[oneCell.MeshCells[i]];
+    const auto& next = mesh.TriangleVertices[oneCell.MeshCells[i + 1]];
+    Index shared[2] = { InvalidIndex, InvalidIndex };
+    int count = 0;
+    for (Index v : tv)
+    {
+      if (std::find(next.begin(), next.end(), v) != next.end() && count < 2)
+      {
+        shared[count++] = v;
+      }
+    }
+    if (count < 2)
+    {
+      continue;
+    }
+    double* c = &oneCell.Points[2 * (first + i)];
+    const double* d = &oneCell.Points[2 * (first + i + 1)];
+    const double* a = &field.Points[2 * shared[0]];
+    const double* b = &field.Points[2 * shared[1]];
+    if (!SegmentsCrossProperly(c, d, a, b))
+    {
+      c[0] = a[0] / 2 + b[0] / 2;
+      c[1] = a[1] / 2 + b[1] / 2;
+      oneCell.Values[first + i] = f[shared[0]] / 2 + f[shared[1]] / 2;
+    }
   }
   oneCell.Destination = state.MaximumOfTriangle[t];
   const Index top = cps[oneCell.Destination].Vertex;

@@ -463,8 +463,18 @@ void AddEndsAndOrderCuts(const OneCell& oneCell, std::vector<Cut>& at)
 
 // The pieces of 1-cell `a` between consecutive cuts; a piece already made by another 1-cell
 // on the same points (merged 1-cells) is shared.
+// An ascending piece whose last segment was made straight from the point before the maximum's
+// triangle to the maximum (AddPiecesOfOneCell): the centroid of that triangle it left out.
+struct Shortcut
+{
+  Index Piece = InvalidIndex;
+  double Centroid[2] = { 0, 0 };
+  double Value = 0;
+};
+
 void AddPiecesOfOneCell(Index a, const OneCell& oneCell, const std::vector<Cut>& at,
-  std::map<std::vector<double>, Index>& pieceOfGeometry, OneCellSmoothingResult& result)
+  std::map<std::vector<double>, Index>& pieceOfGeometry, OneCellSmoothingResult& result,
+  std::vector<Shortcut>& shortcuts)
 {
   const long n = static_cast<long>(oneCell.Values.size());
   for (size_t k = 0; k + 1 < at.size(); ++k)
@@ -492,6 +502,8 @@ void AddPiecesOfOneCell(Index a, const OneCell& oneCell, const std::vector<Cut>&
         !(q[0] == q[q.size() - 2] && q[1] == q[q.size() - 1]);
       if (oneCell.Type == OneCell::Ascending && to == n - 1 && piece.Values.size() > 2 && !fromSaddleVertex)
       {
+        const std::size_t c = piece.Values.size() - 2;
+        shortcuts.push_back({ static_cast<Index>(result.Pieces.size()), { q[2 * c], q[2 * c + 1] }, piece.Values[c] });
         piece.Points.erase(piece.Points.end() - 4, piece.Points.end() - 2);
         piece.Values.erase(piece.Values.end() - 2);
       }
@@ -500,6 +512,154 @@ void AddPiecesOfOneCell(Index a, const OneCell& oneCell, const std::vector<Cut>&
     }
     result.Pieces[found->second].OneCells.push_back(a);
     result.PiecesOfOneCell[a].push_back(found->second);
+  }
+}
+
+// The straight last segment of a shortcut (AddPiecesOfOneCell) leaves the two triangles it
+// joins where they form a non-convex quad, and can then cross another 1-cell: on a Delaunay
+// mesh at 2 % (stress case #275) six pairs of pieces crossed so, and still crossed as the
+// jagged polylines stage 3 falls back to. The segments before it (point P, centroid C) and
+// from C to the maximum M stay in their triangles and cross nothing, so a 1-cell that crosses
+// P-M has a point inside the triangle P C M (it cannot leave through P-C or C-M); so does one
+// whose own shortcut crosses P-M, once the centroids left out count as points. Where some
+// point lies there, the piece goes through Q = C + t (P - C) instead, for the largest t of
+// 1/2, 1/4, ..., 1/16 whose triangle Q C M holds none (Q-M then crosses nothing, and the
+// pieces into one maximum still share no segment), or through C itself. Checked on all
+// pieces' points and the centroids at once, through a grid.
+void KeepShortcutsClear(const std::vector<Shortcut>& shortcuts, OneCellSmoothingResult& result)
+{
+  if (shortcuts.empty())
+  {
+    return;
+  }
+  // A grid of every piece's points, cells about as large as the mean step between points.
+  double low[2] = { std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity() };
+  double high[2] = { -low[0], -low[1] };
+  double steps = 0;
+  std::size_t count = 0;
+  for (const SmoothedPiece& piece : result.Pieces)
+  {
+    const std::vector<double>& q = piece.Points;
+    for (std::size_t i = 0; 2 * i + 1 < q.size(); ++i)
+    {
+      for (int d = 0; d < 2; ++d)
+      {
+        low[d] = std::min(low[d], q[2 * i + d]);
+        high[d] = std::max(high[d], q[2 * i + d]);
+      }
+      if (i > 0)
+      {
+        steps += std::hypot(q[2 * i] - q[2 * i - 2], q[2 * i + 1] - q[2 * i - 1]);
+        ++count;
+      }
+    }
+  }
+  for (const Shortcut& shortcut : shortcuts)
+  {
+    for (int d = 0; d < 2; ++d)
+    {
+      low[d] = std::min(low[d], shortcut.Centroid[d]);
+      high[d] = std::max(high[d], shortcut.Centroid[d]);
+    }
+  }
+  const double size = count > 0 && steps > 0 ? steps / static_cast<double>(count) : 1.0;
+  const auto cellsAlong = [&](int d) {
+    return static_cast<Index>(std::min(4096.0, std::floor((high[d] - low[d]) / size) + 1));
+  };
+  const Index nx = cellsAlong(0), ny = cellsAlong(1);
+  const auto column = [&](double x) { return std::clamp(static_cast<Index>((x - low[0]) / size), Index(0), nx - 1); };
+  const auto row = [&](double y) { return std::clamp(static_cast<Index>((y - low[1]) / size), Index(0), ny - 1); };
+  std::vector<Index> start(static_cast<std::size_t>(nx * ny) + 1, 0);
+  for (const SmoothedPiece& piece : result.Pieces)
+  {
+    for (std::size_t i = 0; 2 * i + 1 < piece.Points.size(); ++i)
+    {
+      ++start[row(piece.Points[2 * i + 1]) * nx + column(piece.Points[2 * i]) + 1];
+    }
+  }
+  for (const Shortcut& shortcut : shortcuts)
+  {
+    ++start[row(shortcut.Centroid[1]) * nx + column(shortcut.Centroid[0]) + 1];
+  }
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<std::array<double, 2>> points(static_cast<std::size_t>(start.back()));
+  std::vector<Index> fill(start.begin(), start.end() - 1);
+  for (const SmoothedPiece& piece : result.Pieces)
+  {
+    for (std::size_t i = 0; 2 * i + 1 < piece.Points.size(); ++i)
+    {
+      const double x = piece.Points[2 * i], y = piece.Points[2 * i + 1];
+      points[fill[row(y) * nx + column(x)]++] = { x, y };
+    }
+  }
+  for (const Shortcut& shortcut : shortcuts)
+  {
+    const double x = shortcut.Centroid[0], y = shortcut.Centroid[1];
+    points[fill[row(y) * nx + column(x)]++] = { x, y };
+  }
+  // Whether a point other than the triangle's corners lies in the triangle (q, c, m) or on q-m.
+  const auto holdsAPoint = [&](const double* q, const double* c, const double* m) {
+    const double turn = Orientation2D(q, c, m);
+    if (turn == 0)
+    {
+      return false;
+    }
+    const Index x0 = column(std::min({ q[0], c[0], m[0] })), x1 = column(std::max({ q[0], c[0], m[0] }));
+    const Index y0 = row(std::min({ q[1], c[1], m[1] })), y1 = row(std::max({ q[1], c[1], m[1] }));
+    for (Index j = y0; j <= y1; ++j)
+    {
+      for (Index i = x0; i <= x1; ++i)
+      {
+        for (Index k = start[j * nx + i]; k < start[j * nx + i + 1]; ++k)
+        {
+          const double* x = points[k].data();
+          if ((x[0] == q[0] && x[1] == q[1]) || (x[0] == c[0] && x[1] == c[1]) || (x[0] == m[0] && x[1] == m[1]))
+          {
+            continue;
+          }
+          // Strictly inside, or on q-m (the side a crossing would pass).
+          const double a = Orientation2D(q, c, x) * turn, b = Orientation2D(c, m, x) * turn,
+                       e = Orientation2D(m, q, x) * turn;
+          if (a > 0 && b > 0 && e >= 0)
+          {
+            return true;
+          }
+        }
+      }
+    }
+    return false;
+  };
+  for (const Shortcut& shortcut : shortcuts)
+  {
+    SmoothedPiece& piece = result.Pieces[shortcut.Piece];
+    const std::size_t n = piece.Values.size();
+    const double* p = &piece.Points[2 * n - 4];
+    const double* m = &piece.Points[2 * n - 2];
+    const double* c = shortcut.Centroid;
+    if (!holdsAPoint(p, c, m))
+    {
+      continue;
+    }
+    double t = 0.5;
+    double q[2];
+    for (; t >= 1.0 / 16; t /= 2)
+    {
+      q[0] = c[0] + t * (p[0] - c[0]);
+      q[1] = c[1] + t * (p[1] - c[1]);
+      if (!holdsAPoint(q, c, m))
+      {
+        break;
+      }
+    }
+    if (t < 1.0 / 16)
+    {
+      t = 0;
+      q[0] = c[0];
+      q[1] = c[1];
+    }
+    const double value = shortcut.Value + t * (piece.Values[n - 2] - shortcut.Value);
+    piece.Points.insert(piece.Points.end() - 2, { q[0], q[1] });
+    piece.Values.insert(piece.Values.end() - 1, value);
   }
 }
 
@@ -520,14 +680,16 @@ void CutIntoPieces(const std::vector<const OneCell*>& oneCells, const std::vecto
   }
   const std::vector<Index> rank = RankNodes(nodes, cuts);
   std::map<std::vector<double>, Index> pieceOfGeometry;
+  std::vector<Shortcut> shortcuts;
   result.PiecesOfOneCell.resize(oneCells.size());
   for (Index a = 0; a < static_cast<Index>(oneCells.size()); ++a)
   {
     const size_t before = cuts[a].size();
     KeepRisingCuts(cuts[a], rank);
     result.DroppedCuts += static_cast<int>(before - cuts[a].size());
-    AddPiecesOfOneCell(a, *oneCells[a], cuts[a], pieceOfGeometry, result);
+    AddPiecesOfOneCell(a, *oneCells[a], cuts[a], pieceOfGeometry, result, shortcuts);
   }
+  KeepShortcutsClear(shortcuts, result);
   // Node positions: the ends of the pieces that meet there.
   for (const SmoothedPiece& piece : result.Pieces)
   {

@@ -452,19 +452,23 @@ TEST_CASE(AscendingOneCellsNeverCrossDescendingOnes)
   // two triangles form a non-convex quad, the segment between their centroids leaves them.
   // Oracle: no segment of an ascending 1-cell's polyline properly crosses a segment of a
   // descending one (stage 3 falls back to these polylines where smoothed curves cross). The
-  // same check on the centroid polylines (rebuilt here) shows the meshes are a real test.
-  // The points are where the rule says (checked here from the mesh).
-  int crossings = 0, centroidCrossings = 0, midpoints = 0;
+  // same check on the centroid polylines, and on the points an earlier rule chose (each
+  // triangle's centroid unless the segment to the next triangle's *centroid* left their quad,
+  // which let a segment run to the next triangle's midpoint outside it: stress case #275),
+  // both rebuilt here, shows the meshes are a real test. The points are where the rule says
+  // (checked here from the mesh: from the maximum back, each against the next point chosen).
+  int crossings = 0, centroidCrossings = 0, forwardRuleCrossings = 0, midpoints = 0;
   bool onSharedEdges = true;
-  for (std::uint64_t seed = 1; seed <= 6; ++seed)
+  for (std::uint64_t seed = 1; seed <= 24; ++seed)
   {
     std::uint64_t state = seed * 7919;
     const auto uniform = [&state]() {
       state = state * 6364136223846793005ULL + 1442695040888963407ULL;
       return static_cast<double>(state >> 11) / 9007199254740992.0;
     };
+    const int points = seed <= 6 ? 400 : 1500;
     PlanarScalarField field;
-    for (int k = 0; k < 400; ++k)
+    for (int k = 0; k < points; ++k)
     {
       const double x = 20 * uniform(), y = 20 * uniform();
       field.Points.push_back(x);
@@ -484,6 +488,7 @@ TEST_CASE(AscendingOneCellsNeverCrossDescendingOnes)
     const TriangleMeshTopology& mesh = extraction.Mesh;
 
     using Segment = std::array<double, 4>;
+    using Point = std::array<double, 2>;
     const auto properlyCross = [](const Segment& s, const Segment& t) {
       const auto orient = [](double ax, double ay, double bx, double by, double cx, double cy) {
         const double d = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
@@ -492,31 +497,37 @@ TEST_CASE(AscendingOneCellsNeverCrossDescendingOnes)
       return orient(s[0], s[1], s[2], s[3], t[0], t[1]) * orient(s[0], s[1], s[2], s[3], t[2], t[3]) < 0 &&
         orient(t[0], t[1], t[2], t[3], s[0], s[1]) * orient(t[0], t[1], t[2], t[3], s[2], s[3]) < 0;
     };
-    const auto segmentsOf = [](const std::vector<double>& p) {
+    const auto segmentsOf = [](const std::vector<Point>& p) {
       std::vector<Segment> segments;
-      for (std::size_t i = 0; i + 3 < p.size(); i += 2)
+      for (std::size_t i = 0; i + 1 < p.size(); ++i)
       {
-        segments.push_back({ p[i], p[i + 1], p[i + 2], p[i + 3] });
+        segments.push_back({ p[i][0], p[i][1], p[i + 1][0], p[i + 1][1] });
       }
       return segments;
     };
-    std::vector<Segment> descending, ascending, centroidPaths;
+    const auto pointsOf = [](const std::vector<double>& p) {
+      std::vector<Point> points;
+      for (std::size_t i = 0; i + 1 < p.size(); i += 2)
+      {
+        points.push_back({ p[i], p[i + 1] });
+      }
+      return points;
+    };
+    std::vector<Segment> descending, ascending, centroidPaths, forwardRulePaths;
     for (const OneCell& oneCell : complex.OneCells)
     {
-      std::vector<Segment> segments = segmentsOf(oneCell.Points);
+      const std::vector<Point> actual = pointsOf(oneCell.Points);
+      std::vector<Segment> segments = segmentsOf(actual);
       if (oneCell.Type == OneCell::Descending)
       {
         descending.insert(descending.end(), segments.begin(), segments.end());
         continue;
       }
       ascending.insert(ascending.end(), segments.begin(), segments.end());
-      // Points: the saddle's vertex, one per triangle, the maximum's vertex. A triangle's point
-      // is its centroid where the segment to the next triangle's centroid crosses the edge
-      // between them, else that edge's midpoint.
-      std::vector<double> centroids(oneCell.Points.begin(), oneCell.Points.begin() + 2);
+      // Points: the saddle's vertex, one per triangle, the maximum's vertex.
       const std::size_t n = oneCell.MeshCells.size();
       const auto centroidOf = [&](Index t) {
-        std::array<double, 2> c{ 0, 0 };
+        Point c{ 0, 0 };
         for (Index v : mesh.TriangleVertices[t])
         {
           c[0] += field.Points[2 * v] / 3;
@@ -524,43 +535,64 @@ TEST_CASE(AscendingOneCellsNeverCrossDescendingOnes)
         }
         return c;
       };
-      for (std::size_t k = 0; k < n; ++k)
-      {
+      // The edge between triangles k and k + 1.
+      const auto sharedEdge = [&](std::size_t k, Point& a, Point& b) {
         const auto& tv = mesh.TriangleVertices[oneCell.MeshCells[k]];
-        const std::array<double, 2> c = centroidOf(oneCell.MeshCells[k]);
-        centroids.push_back(c[0]);
-        centroids.push_back(c[1]);
-        std::array<double, 2> expected = c;
-        if (k + 1 < n)
+        const auto& next = mesh.TriangleVertices[oneCell.MeshCells[k + 1]];
+        std::vector<Index> shared;
+        for (Index v : tv)
         {
-          const auto& next = mesh.TriangleVertices[oneCell.MeshCells[k + 1]];
-          std::vector<Index> shared;
-          for (Index v : tv)
+          if (std::find(next.begin(), next.end(), v) != next.end())
           {
-            if (std::find(next.begin(), next.end(), v) != next.end())
-            {
-              shared.push_back(v);
-            }
-          }
-          onSharedEdges = onSharedEdges && shared.size() == 2;
-          if (shared.size() == 2)
-          {
-            const std::array<double, 2> d = centroidOf(oneCell.MeshCells[k + 1]);
-            const double* a = &field.Points[2 * shared[0]];
-            const double* b = &field.Points[2 * shared[1]];
-            if (!properlyCross({ c[0], c[1], d[0], d[1] }, { a[0], a[1], b[0], b[1] }))
-            {
-              expected = { (a[0] + b[0]) / 2, (a[1] + b[1]) / 2 };
-              ++midpoints;
-            }
+            shared.push_back(v);
           }
         }
-        onSharedEdges = onSharedEdges && std::abs(oneCell.Points[2 * (k + 1)] - expected[0]) < 1e-12 &&
-          std::abs(oneCell.Points[2 * (k + 1) + 1] - expected[1]) < 1e-12;
+        if (shared.size() != 2)
+        {
+          return false;
+        }
+        a = { field.Points[2 * shared[0]], field.Points[2 * shared[0] + 1] };
+        b = { field.Points[2 * shared[1]], field.Points[2 * shared[1] + 1] };
+        return true;
+      };
+      std::vector<Point> centroids{ actual.front() };
+      for (std::size_t k = 0; k < n; ++k)
+      {
+        centroids.push_back(centroidOf(oneCell.MeshCells[k]));
       }
-      centroids.insert(centroids.end(), oneCell.Points.end() - 2, oneCell.Points.end());
+      centroids.push_back(actual.back());
+      std::vector<Point> expected = centroids, forward = centroids;
+      for (std::size_t k = n - 1; k-- > 0;)
+      {
+        Point a, b;
+        if (!sharedEdge(k, a, b))
+        {
+          onSharedEdges = false;
+          continue;
+        }
+        const Point middle{ (a[0] + b[0]) / 2, (a[1] + b[1]) / 2 };
+        const Point& c = centroids[k + 1];
+        const Point& d = centroids[k + 2];
+        if (!properlyCross({ c[0], c[1], d[0], d[1] }, { a[0], a[1], b[0], b[1] }))
+        {
+          forward[k + 1] = middle;
+        }
+        const Point& e = expected[k + 2];
+        if (!properlyCross({ c[0], c[1], e[0], e[1] }, { a[0], a[1], b[0], b[1] }))
+        {
+          expected[k + 1] = middle;
+          ++midpoints;
+        }
+      }
+      for (std::size_t k = 0; k < actual.size() && k < expected.size(); ++k)
+      {
+        onSharedEdges = onSharedEdges && actual.size() == expected.size() &&
+          std::abs(actual[k][0] - expected[k][0]) < 1e-12 && std::abs(actual[k][1] - expected[k][1]) < 1e-12;
+      }
       const std::vector<Segment> c = segmentsOf(centroids);
       centroidPaths.insert(centroidPaths.end(), c.begin(), c.end());
+      const std::vector<Segment> f = segmentsOf(forward);
+      forwardRulePaths.insert(forwardRulePaths.end(), f.begin(), f.end());
     }
     const auto countCrossings = [&](const std::vector<Segment>& paths) {
       int count = 0;
@@ -575,12 +607,15 @@ TEST_CASE(AscendingOneCellsNeverCrossDescendingOnes)
     };
     crossings += countCrossings(ascending);
     centroidCrossings += countCrossings(centroidPaths);
+    forwardRuleCrossings += countCrossings(forwardRulePaths);
   }
-  std::printf("  6 Delaunay meshes of 400 points: %d crossings (through the centroids: %d); %d edge midpoints\n",
-    crossings, centroidCrossings, midpoints);
+  std::printf("  24 Delaunay meshes of 400 and 1500 points: %d crossings (through the centroids: %d, by the "
+              "forward rule: %d); %d edge midpoints\n",
+    crossings, centroidCrossings, forwardRuleCrossings, midpoints);
   CHECK(onSharedEdges);
   CHECK_EQ(crossings, 0);
   CHECK(centroidCrossings > 0);
+  CHECK(forwardRuleCrossings > 0);
 }
 
 int main()
