@@ -562,10 +562,16 @@ void KeepShortcutsClear(const std::vector<Shortcut>& shortcuts, OneCellSmoothing
       high[d] = std::max(high[d], shortcut.Centroid[d]);
     }
   }
-  const double size = count > 0 && steps > 0 ? steps / static_cast<double>(count) : 1.0;
+  double size = count > 0 && steps > 0 ? steps / static_cast<double>(count) : 1.0;
   const auto cellsAlong = [&](int d) {
     return static_cast<Index>(std::min(4096.0, std::floor((high[d] - low[d]) / size) + 1));
   };
+  // No more cells than points (1-cells cover a fraction of the domain only).
+  while (static_cast<double>(cellsAlong(0)) * static_cast<double>(cellsAlong(1)) >
+    static_cast<double>(count + shortcuts.size() + 1))
+  {
+    size *= 2;
+  }
   const Index nx = cellsAlong(0), ny = cellsAlong(1);
   const auto column = [&](double x) { return std::clamp(static_cast<Index>((x - low[0]) / size), Index(0), nx - 1); };
   const auto row = [&](double y) { return std::clamp(static_cast<Index>((y - low[1]) / size), Index(0), ny - 1); };
