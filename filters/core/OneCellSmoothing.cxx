@@ -532,43 +532,46 @@ void KeepShortcutsClear(const std::vector<Shortcut>& shortcuts, OneCellSmoothing
   {
     return;
   }
-  // A grid of every piece's points, cells about as large as the mean step between points.
-  double low[2] = { std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity() };
-  double high[2] = { -low[0], -low[1] };
+  // Every piece's point and every centroid left out, in a grid of cells about as large as the
+  // mean step between points.
+  const auto forEachPoint = [&](const auto& visit) {
+    for (const SmoothedPiece& piece : result.Pieces)
+    {
+      for (std::size_t i = 0; 2 * i + 1 < piece.Points.size(); ++i)
+      {
+        visit(piece.Points[2 * i], piece.Points[2 * i + 1]);
+      }
+    }
+    for (const Shortcut& shortcut : shortcuts)
+    {
+      visit(shortcut.Centroid[0], shortcut.Centroid[1]);
+    }
+  };
   double steps = 0;
-  std::size_t count = 0;
+  std::size_t count = 0, total = 0;
   for (const SmoothedPiece& piece : result.Pieces)
   {
     const std::vector<double>& q = piece.Points;
-    for (std::size_t i = 0; 2 * i + 1 < q.size(); ++i)
+    for (std::size_t i = 2; i + 1 < q.size(); i += 2, ++count)
     {
-      for (int d = 0; d < 2; ++d)
-      {
-        low[d] = std::min(low[d], q[2 * i + d]);
-        high[d] = std::max(high[d], q[2 * i + d]);
-      }
-      if (i > 0)
-      {
-        steps += std::hypot(q[2 * i] - q[2 * i - 2], q[2 * i + 1] - q[2 * i - 1]);
-        ++count;
-      }
+      steps += std::hypot(q[i] - q[i - 2], q[i + 1] - q[i - 1]);
     }
   }
-  for (const Shortcut& shortcut : shortcuts)
-  {
-    for (int d = 0; d < 2; ++d)
-    {
-      low[d] = std::min(low[d], shortcut.Centroid[d]);
-      high[d] = std::max(high[d], shortcut.Centroid[d]);
-    }
-  }
+  double low[2] = { std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity() };
+  double high[2] = { -low[0], -low[1] };
+  forEachPoint([&](double x, double y) {
+    low[0] = std::min(low[0], x);
+    high[0] = std::max(high[0], x);
+    low[1] = std::min(low[1], y);
+    high[1] = std::max(high[1], y);
+    ++total;
+  });
   double size = count > 0 && steps > 0 ? steps / static_cast<double>(count) : 1.0;
   const auto cellsAlong = [&](int d) {
     return static_cast<Index>(std::min(4096.0, std::floor((high[d] - low[d]) / size) + 1));
   };
   // No more cells than points (1-cells cover a fraction of the domain only).
-  while (static_cast<double>(cellsAlong(0)) * static_cast<double>(cellsAlong(1)) >
-    static_cast<double>(count + shortcuts.size() + 1))
+  while (static_cast<double>(cellsAlong(0)) * static_cast<double>(cellsAlong(1)) > static_cast<double>(total + 1))
   {
     size *= 2;
   }
@@ -576,33 +579,11 @@ void KeepShortcutsClear(const std::vector<Shortcut>& shortcuts, OneCellSmoothing
   const auto column = [&](double x) { return std::clamp(static_cast<Index>((x - low[0]) / size), Index(0), nx - 1); };
   const auto row = [&](double y) { return std::clamp(static_cast<Index>((y - low[1]) / size), Index(0), ny - 1); };
   std::vector<Index> start(static_cast<std::size_t>(nx * ny) + 1, 0);
-  for (const SmoothedPiece& piece : result.Pieces)
-  {
-    for (std::size_t i = 0; 2 * i + 1 < piece.Points.size(); ++i)
-    {
-      ++start[row(piece.Points[2 * i + 1]) * nx + column(piece.Points[2 * i]) + 1];
-    }
-  }
-  for (const Shortcut& shortcut : shortcuts)
-  {
-    ++start[row(shortcut.Centroid[1]) * nx + column(shortcut.Centroid[0]) + 1];
-  }
+  forEachPoint([&](double x, double y) { ++start[row(y) * nx + column(x) + 1]; });
   std::partial_sum(start.begin(), start.end(), start.begin());
-  std::vector<std::array<double, 2>> points(static_cast<std::size_t>(start.back()));
+  std::vector<std::array<double, 2>> points(total);
   std::vector<Index> fill(start.begin(), start.end() - 1);
-  for (const SmoothedPiece& piece : result.Pieces)
-  {
-    for (std::size_t i = 0; 2 * i + 1 < piece.Points.size(); ++i)
-    {
-      const double x = piece.Points[2 * i], y = piece.Points[2 * i + 1];
-      points[fill[row(y) * nx + column(x)]++] = { x, y };
-    }
-  }
-  for (const Shortcut& shortcut : shortcuts)
-  {
-    const double x = shortcut.Centroid[0], y = shortcut.Centroid[1];
-    points[fill[row(y) * nx + column(x)]++] = { x, y };
-  }
+  forEachPoint([&](double x, double y) { points[fill[row(y) * nx + column(x)]++] = { x, y }; });
   // Whether a point other than the triangle's corners lies in the triangle (q, c, m) or on q-m.
   const auto holdsAPoint = [&](const double* q, const double* c, const double* m) {
     const double turn = Orientation2D(q, c, m);

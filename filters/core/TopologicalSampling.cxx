@@ -9,7 +9,6 @@
 #include <functional>
 #include <iterator>
 #include <limits>
-#include <memory>
 #include <numeric>
 #include <queue>
 #include <unordered_map>
@@ -602,21 +601,46 @@ struct VertexGraphs
   }
 };
 
+// Bits of WantedFlags: which constraint wants a vertex as an extremum (or saddle).
+enum : unsigned char
+{
+  WantedMinimum = 1,
+  WantedMaximum = 2,
+  WantedBoundaryMinimum = 4,
+  WantedBoundaryMaximum = 8,
+  WantedSaddle = 16
+};
+
+// Per vertex, the bits of the constraints that name it.
+std::vector<unsigned char> WantedFlags(Index numberOfVertices, const SamplingConstraints& constraints)
+{
+  std::vector<unsigned char> wanted(numberOfVertices, 0);
+  const std::pair<const std::vector<Index>*, unsigned char> lists[] = { { &constraints.Minima, WantedMinimum },
+    { &constraints.Maxima, WantedMaximum }, { &constraints.BoundaryMinima, WantedBoundaryMinimum },
+    { &constraints.BoundaryMaxima, WantedBoundaryMaximum }, { &constraints.Saddles, WantedSaddle } };
+  for (const auto& [list, flag] : lists)
+  {
+    for (Index v : *list)
+    {
+      wanted[v] |= flag;
+    }
+  }
+  return wanted;
+}
+
+// A domain corner: every neighbour lies on the boundary too.
+bool IsDomainCorner(const TriangleMeshTopology& mesh, Index v)
+{
+  const VertexLink link(mesh, v);
+  return std::all_of(link.begin(), link.end(), [&mesh](Index w) { return mesh.IsBoundaryVertex(w); });
+}
+
 // One sweep of the floods: every unwanted extremum of one kind (pits when ascending, peaks
 // otherwise) along the boundary curve or over whole links is filled (cut), or a wanted boundary
 // saddle above its whole link gets a way up.
 class FloodPass
 {
 public:
-  // Bits of Wanted: which constraint wants a vertex as an extremum.
-  enum : unsigned char
-  {
-    WantedMinimum = 1,
-    WantedMaximum = 2,
-    WantedBoundaryMinimum = 4,
-    WantedBoundaryMaximum = 8,
-    WantedSaddle = 16
-  };
 
   // `blockedWaysUp`, if given, collects the wanted boundary saddles whose way up had to raise a
   // wanted minimum or saddle.
@@ -624,30 +648,10 @@ public:
     std::vector<Index>* blockedWaysUp = nullptr)
     : Mesh(mesh)
     , Graphs(mesh)
-    , Wanted(mesh.NumberOfVertices(), 0)
+    , Wanted(WantedFlags(mesh.NumberOfVertices(), constraints))
     , BlockedWaysUp(blockedWaysUp)
   {
     this->Visits.Mark.assign(mesh.NumberOfVertices(), 0);
-    for (Index v : constraints.Minima)
-    {
-      this->Wanted[v] |= WantedMinimum;
-    }
-    for (Index v : constraints.Maxima)
-    {
-      this->Wanted[v] |= WantedMaximum;
-    }
-    for (Index v : constraints.BoundaryMinima)
-    {
-      this->Wanted[v] |= WantedBoundaryMinimum;
-    }
-    for (Index v : constraints.BoundaryMaxima)
-    {
-      this->Wanted[v] |= WantedBoundaryMaximum;
-    }
-    for (Index v : constraints.Saddles)
-    {
-      this->Wanted[v] |= WantedSaddle;
-    }
   }
 
   // One round: along the boundary curve first (stage 1's boundary rule), then whole links.
@@ -1232,38 +1236,19 @@ std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, cons
 int MoveBlockedBoundarySaddles(const TriangleMeshTopology& mesh, const std::vector<Index>& blocked,
   const std::vector<double>& settled, SamplingConstraints& constraints, std::vector<double>& start)
 {
-  enum : unsigned char
-  {
-    Low = 1,  // a wanted minimum or saddle: no way up may run through it
-    Other = 2 // wanted as anything else
-  };
-  std::vector<unsigned char> wanted(mesh.NumberOfVertices(), 0);
-  for (const std::vector<Index>* list : { &constraints.Minima, &constraints.Saddles })
-  {
-    for (Index v : *list)
-    {
-      wanted[v] |= Low;
-    }
-  }
-  for (const std::vector<Index>* list : { &constraints.Maxima, &constraints.BoundaryMinima, &constraints.BoundaryMaxima })
-  {
-    for (Index v : *list)
-    {
-      wanted[v] |= Other;
-    }
-  }
-  const std::unordered_set<Index> wantedMaxima(constraints.Maxima.begin(), constraints.Maxima.end());
+  std::vector<unsigned char> wanted = WantedFlags(mesh.NumberOfVertices(), constraints);
   const std::unordered_set<Index> candidates(blocked.begin(), blocked.end());
   const VertexGraphs graphs(mesh);
   const Graph& curve = graphs.Boundary;
   std::vector<double> values = settled;
   VisitMarks visits;
   visits.Mark.assign(mesh.NumberOfVertices(), 0);
-  auto avoided = [&wanted](Index w) { return (wanted[w] & Low) != 0; };
+  // No way up may run through a wanted minimum or saddle.
+  auto avoided = [&wanted](Index w) { return (wanted[w] & (WantedMinimum | WantedSaddle)) != 0; };
   int moved = 0;
   for (Index& v : constraints.BoundaryMaxima)
   {
-    if (!candidates.count(v) || wantedMaxima.count(v))
+    if (!candidates.count(v) || (wanted[v] & WantedMaximum))
     {
       continue;
     }
@@ -1274,8 +1259,7 @@ int MoveBlockedBoundarySaddles(const TriangleMeshTopology& mesh, const std::vect
     for (Index i = curve.Start[v]; i < curve.Start[v + 1]; ++i)
     {
       const Index w = curve.Adjacent[i];
-      const VertexLink link(mesh, w);
-      if (wanted[w] || std::all_of(link.begin(), link.end(), [&mesh](Index u) { return mesh.IsBoundaryVertex(u); }))
+      if (wanted[w] || IsDomainCorner(mesh, w))
       {
         continue;
       }
@@ -1339,7 +1323,7 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   for (Index& v : constraints.BoundaryMaxima)
   {
     const std::vector<Index> link = LinkOf(mesh, v);
-    if (!wantedMaxima.count(v) && std::all_of(link.begin(), link.end(), [&mesh](Index w) { return mesh.IsBoundaryVertex(w); }))
+    if (!wantedMaxima.count(v) && IsDomainCorner(mesh, v))
     {
       const auto higher = std::max_element(link.begin(), link.end(),
         [&values](Index a, Index b) { return Key{ values[a], a } < Key{ values[b], b }; });
@@ -2300,4 +2284,3 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
   return requests.Apply(values);
 }
 } // namespace topospline
-

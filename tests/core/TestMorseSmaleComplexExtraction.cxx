@@ -490,12 +490,7 @@ TEST_CASE(AscendingOneCellsNeverCrossDescendingOnes)
     using Segment = std::array<double, 4>;
     using Point = std::array<double, 2>;
     const auto properlyCross = [](const Segment& s, const Segment& t) {
-      const auto orient = [](double ax, double ay, double bx, double by, double cx, double cy) {
-        const double d = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
-        return (d > 0) - (d < 0);
-      };
-      return orient(s[0], s[1], s[2], s[3], t[0], t[1]) * orient(s[0], s[1], s[2], s[3], t[2], t[3]) < 0 &&
-        orient(t[0], t[1], t[2], t[3], s[0], s[1]) * orient(t[0], t[1], t[2], t[3], s[2], s[3]) < 0;
+      return SegmentsCrossProperlyInTest(&s[0], &s[2], &t[0], &t[2]);
     };
     const auto segmentsOf = [](const std::vector<Point>& p) {
       std::vector<Segment> segments;

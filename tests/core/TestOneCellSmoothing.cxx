@@ -615,13 +615,6 @@ TEST_CASE(JaggedPiecesAddNoCrossingOnTriangleMeshes)
   // simplified complex's 1-cells cross on some of these meshes, its input's do not: left open,
   // docs/OneCellSmoothing.md.)
   using Segment = std::array<double, 4>;
-  const auto orient = [](const double* a, const double* b, const double* c) {
-    const double d = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-    return (d > 0) - (d < 0);
-  };
-  const auto properlyCross = [&](const double* a, const double* b, const double* c, const double* d) {
-    return orient(a, b, c) * orient(a, b, d) < 0 && orient(c, d, a) * orient(c, d, b) < 0;
-  };
   const auto undirected = [](const double* a, const double* b) {
     const Segment s{ a[0], a[1], b[0], b[1] }, t{ b[0], b[1], a[0], a[1] };
     return std::min(s, t);
@@ -655,7 +648,7 @@ TEST_CASE(JaggedPiecesAddNoCrossingOnTriangleMeshes)
         {
           for (std::size_t j = p == q ? i + 4 : 0; j + 3 < b.size(); j += 2)
           {
-            if (properlyCross(&a[i], &a[i + 2], &b[j], &b[j + 2]))
+            if (SegmentsCrossProperlyInTest(&a[i], &a[i + 2], &b[j], &b[j + 2]))
             {
               const Segment s = undirected(&a[i], &a[i + 2]), t = undirected(&b[j], &b[j + 2]);
               pairs.insert({ std::min(s, t), std::max(s, t) });

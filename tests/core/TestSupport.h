@@ -1,5 +1,5 @@
 // What several core tests share: grid fields as triangle meshes, Delaunay meshes of random
-// points, a ParallelFor over real threads, and the real stages 1-3 run on a synthetic grid (what
+// points, a segment-crossing predicate, a ParallelFor over real threads, and the real stages 1-3 run on a synthetic grid (what
 // the stage-4 tests start from).
 #pragma once
 
@@ -19,6 +19,17 @@
 
 namespace topospline
 {
+// Whether segments a-b and c-d cross at one point inside both (the tests' own predicate, by the
+// signs of exact-enough orientations; touching, collinear or shared ends do not count).
+inline bool SegmentsCrossProperlyInTest(const double* a, const double* b, const double* c, const double* d)
+{
+  const auto orient = [](const double* o, const double* p, const double* q) {
+    const double s = (p[0] - o[0]) * (q[1] - o[1]) - (p[1] - o[1]) * (q[0] - o[0]);
+    return (s > 0) - (s < 0);
+  };
+  return orient(a, b, c) * orient(a, b, d) < 0 && orient(c, d, a) * orient(c, d, b) < 0;
+}
+
 // The grid with its triangles spelled out (GridTriangles), so that the stages take the general
 // triangle-mesh path instead of the grid's closed forms.
 inline PlanarScalarField MeshFieldOnGrid(const GridField& grid)
