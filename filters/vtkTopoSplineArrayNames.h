@@ -34,6 +34,7 @@ constexpr const char* CriticalValue = "CriticalValue";
 constexpr const char* VertexId = "VertexId";
 constexpr const char* IsOnBoundary = "IsOnBoundary";
 constexpr const char* CriticalCellId = "CriticalCellId"; // the critical vertex, edge or triangle
+constexpr const char* SaddleEdgeVertexId = "SaddleEdgeVertexId"; // a saddle's other edge vertex; -1 else
 
 // 1-cells (cell data of the "OneCells" block; point data: the scalar along the 1-cell).
 constexpr const char* SeparatrixId = "SeparatrixId";

@@ -9,7 +9,8 @@
  * Output: one vtkMultiBlockDataSet holding the whole complex, so the next stage takes a single
  * input. Blocks (names and arrays in vtkTopoSplineArrayNames.h):
  *  0 "CriticalPoints"   vertices: CriticalPointId (stable), CriticalIndex (0/1/2),
- *                       CriticalValue, VertexId, IsOnBoundary
+ *                       CriticalValue, VertexId, IsOnBoundary, CriticalCellId,
+ *                       SaddleEdgeVertexId (a saddle's other edge vertex, -1 for extrema)
  *  1 "OneCells"         polylines (the 1-cells) from the lower to the higher critical point: cell data
  *                       SeparatrixId, SourceId, DestinationId, SeparatrixType (0 descending
  *                       minimum-saddle, 1 ascending saddle-maximum); point data ScalarValue

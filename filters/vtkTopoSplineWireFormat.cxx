@@ -64,6 +64,7 @@ vtkSmartPointer<vtkPolyData> CriticalPointsBlock(const topospline::MorseSmaleCom
   auto vertex = conversion::NewArray<vtkIdTypeArray>(names::VertexId, 1, n);
   auto cell = conversion::NewArray<vtkIdTypeArray>(names::CriticalCellId, 1, n);
   auto boundary = conversion::NewArray<vtkCharArray>(names::IsOnBoundary, 1, n);
+  auto edgeVertex = conversion::NewArray<vtkIdTypeArray>(names::SaddleEdgeVertexId, 1, n);
   for (vtkIdType i = 0; i < n; ++i)
   {
     points->SetPoint(i, domain->GetPoint(cps[i].Vertex));
@@ -74,10 +75,11 @@ vtkSmartPointer<vtkPolyData> CriticalPointsBlock(const topospline::MorseSmaleCom
     vertex->SetValue(i, cps[i].Vertex);
     cell->SetValue(i, cps[i].Cell);
     boundary->SetValue(i, cps[i].OnBoundary ? 1 : 0);
+    edgeVertex->SetValue(i, cps[i].EdgeVertex);
   }
   critical->SetPoints(points);
   critical->SetVerts(verts);
-  conversion::AddArrays(critical->GetPointData(), { id, index, value, vertex, cell, boundary });
+  conversion::AddArrays(critical->GetPointData(), { id, index, value, vertex, cell, boundary, edgeVertex });
   critical->GetPointData()->SetActiveScalars(names::CriticalIndex);
   return critical;
 }
@@ -263,6 +265,7 @@ struct ComplexArrays
   vtkPolyData* TwoCells = nullptr;
   vtkDataSet* Segmentation = nullptr;
   vtkDataArray *Id, *Index, *Value, *Vertex, *Cell, *Boundary;       // critical points
+  vtkDataArray* EdgeVertex = nullptr; // optional: complexes written before it existed
   vtkDataArray *Source, *Destination, *Type, *Along, *MeshCell;       // 1-cells
   vtkDataArray *Ascending, *Descending, *TwoCellOfVertex;             // segmentation
   vtkDataArray *Minimum, *Maximum, *Saddles, *Sides, *Pouch, *Size;   // 2-cells
@@ -276,6 +279,7 @@ struct ComplexArrays
     this->Vertex = RequireArray(pd, names::VertexId, error);
     this->Cell = RequireArray(pd, names::CriticalCellId, error);
     this->Boundary = RequireArray(pd, names::IsOnBoundary, error);
+    this->EdgeVertex = pd->GetArray(names::SaddleEdgeVertexId);
     auto* cd = this->OneCells->GetCellData();
     this->Source = RequireArray(cd, names::SourceId, error);
     this->Destination = RequireArray(cd, names::DestinationId, error);
@@ -337,6 +341,7 @@ bool ReadCriticalPoints(const ComplexArrays& in, topospline::MorseSmaleComplex& 
     cp.Vertex = static_cast<Index>(in.Vertex->GetComponent(i, 0));
     cp.Cell = static_cast<Index>(in.Cell->GetComponent(i, 0));
     cp.OnBoundary = in.Boundary->GetComponent(i, 0) != 0;
+    cp.EdgeVertex = in.EdgeVertex ? static_cast<Index>(in.EdgeVertex->GetComponent(i, 0)) : topospline::InvalidIndex;
     if (!local.Add(cp.Id, static_cast<Index>(i)))
     {
       error = "the input is not a Morse-Smale complex: negative critical point id";

@@ -80,7 +80,10 @@ std::vector<Index> TreeOfCell(const MorseSmaleComplex& complex, OneCell::Kind ki
 }
 
 // Calls visit(a, path, i) for every step i >= 1 of every 1-cell a of `kind`, followed from
-// its extremum, that lies in the extremum's tree (TreeOfCell).
+// its extremum, that lies in the extremum's tree (TreeOfCell). A triangle entered twice in a
+// row is one step: a merged ascending 1-cell passes a cancelled saddle's edge midpoint as a
+// second entry of the triangle (MorseSmaleComplexSimplification::BuildMergedOneCells), met
+// first from the extremum; the triangle's own point is the second.
 template <typename Visit>
 void ForEachStepInTree(
   const MorseSmaleComplex& complex, OneCell::Kind kind, const std::vector<Index>& tree, Visit&& visit)
@@ -94,7 +97,8 @@ void ForEachStepInTree(
     }
     for (size_t i = 1; i < path.Size(); ++i)
     {
-      if (tree[path.MeshCell(i)] == path.Extremum())
+      const bool repeated = i + 1 < path.Size() && path.MeshCell(i + 1) == path.MeshCell(i);
+      if (!repeated && tree[path.MeshCell(i)] == path.Extremum())
       {
         visit(a, path, i);
       }

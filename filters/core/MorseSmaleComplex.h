@@ -33,6 +33,9 @@ struct CriticalPoint
   Index Cell = InvalidIndex;    // the critical vertex, edge or triangle
   double Value = 0;
   bool OnBoundary = false;     // its vertex lies on the domain boundary
+  // A saddle's: the other (lower) vertex of its critical edge. Stage 2 draws a merged ascending
+  // 1-cell across the edge of a cancelled saddle through the edge's midpoint (triangle meshes).
+  Index EdgeVertex = InvalidIndex;
 };
 
 // A 1-cell between a lower-index source and a higher-index destination critical point.

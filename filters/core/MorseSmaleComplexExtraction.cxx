@@ -229,7 +229,8 @@ void CollectCriticalPoints(ExtractionState& state)
     if (grad.IsCriticalEdge(e))
     {
       const Index o = DiscreteGradient::EdgeOwner(mesh, order, e);
-      cps.push_back({ InvalidIndex, 1, o, e, f[o], mesh.IsBoundaryVertex(o) });
+      const Index other = mesh.EdgeVertices[e][0] == o ? mesh.EdgeVertices[e][1] : mesh.EdgeVertices[e][0];
+      cps.push_back({ InvalidIndex, 1, o, e, f[o], mesh.IsBoundaryVertex(o), other });
     }
   }
   for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)

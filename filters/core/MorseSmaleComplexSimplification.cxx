@@ -334,6 +334,26 @@ void MorseSmaleComplexSimplification::IndexOneCellsBySaddle()
     slots[slots[first] == InvalidIndex ? first : first + 1] = a;
     this->ArcExtremum[a] = oneCell.Type == OneCell::Descending ? oneCell.Source : oneCell.Destination;
   }
+  // A saddle's edge runs from its vertex to CriticalPoint::EdgeVertex: the last step of the
+  // descending 1-cell that leaves the edge at that end.
+  const auto& cps = this->Input.CriticalPoints;
+  this->SaddleEdgeEnd.assign(3 * static_cast<size_t>(nCP), std::numeric_limits<double>::quiet_NaN());
+  for (Index s = 0; s < nCP; ++s)
+  {
+    for (int k = 0; k < 2 && cps[s].MorseIndex == 1 && cps[s].EdgeVertex != InvalidIndex; ++k)
+    {
+      const Index d = this->SaddleOneCells[s][k];
+      const OneCell* oneCell = d == InvalidIndex ? nullptr : &oneCells[d];
+      const size_t n = oneCell ? oneCell->MeshCells.size() : 0;
+      if (n >= 2 && oneCell->MeshCells[n - 2] == cps[s].EdgeVertex)
+      {
+        this->SaddleEdgeEnd[3 * s] = oneCell->Points[2 * (n - 2)];
+        this->SaddleEdgeEnd[3 * s + 1] = oneCell->Points[2 * (n - 2) + 1];
+        this->SaddleEdgeEnd[3 * s + 2] = oneCell->Values[n - 2];
+        break;
+      }
+    }
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -1108,6 +1128,9 @@ struct MorseSmaleComplexSimplification::Replay
 struct MorseSmaleComplexSimplification::MergedForests
 {
   std::vector<Index> DescendingParent, DescendingTree, AscendingParent, AscendingTree;
+  // Per ascending node: the cancelled saddle whose edge its forest edge to its parent crosses
+  // (a join of two triangles of that edge), InvalidIndex for a gradient step.
+  std::vector<Index> AscendingJoinSaddle;
 };
 
 bool MorseSmaleComplexSimplification::Simplify(
@@ -1282,6 +1305,7 @@ MorseSmaleComplexSimplification::MergedForests MorseSmaleComplexSimplification::
   const auto& cps = this->Input.CriticalPoints;
   const Index nCP = static_cast<Index>(cps.size());
   std::vector<std::array<Index, 2>> descendingJoins, ascendingJoins;
+  std::vector<Index> joinSaddles; // per ascending join
   for (Index j = 0; j < replay.Performed; ++j)
   {
     const Step& step = this->Steps[j];
@@ -1299,6 +1323,7 @@ MorseSmaleComplexSimplification::MergedForests MorseSmaleComplexSimplification::
     else
     {
       ascendingJoins.push_back({ this->ArcFirstNode[slots[2]], this->ArcFirstNode[slots[3]] });
+      joinSaddles.push_back(step.Saddle);
     }
   }
   auto growForest = [&](const NodeSet& nodes, const std::vector<std::array<Index, 2>>& joins, int morseIndex,
@@ -1338,6 +1363,19 @@ MorseSmaleComplexSimplification::MergedForests MorseSmaleComplexSimplification::
   MergedForests forests;
   growForest(this->DescendingNodes, descendingJoins, 0, forests.DescendingParent, forests.DescendingTree);
   growForest(this->AscendingNodes, ascendingJoins, 2, forests.AscendingParent, forests.AscendingTree);
+  forests.AscendingJoinSaddle.assign(forests.AscendingParent.size(), InvalidIndex);
+  for (size_t j = 0; j < ascendingJoins.size(); ++j)
+  {
+    const Index a = ascendingJoins[j][0], b = ascendingJoins[j][1];
+    if (forests.AscendingParent[a] == b && a != b)
+    {
+      forests.AscendingJoinSaddle[a] = joinSaddles[j];
+    }
+    else if (forests.AscendingParent[b] == a && a != b)
+    {
+      forests.AscendingJoinSaddle[b] = joinSaddles[j];
+    }
+  }
   return forests;
 }
 
@@ -1373,7 +1411,19 @@ bool MorseSmaleComplexSimplification::BuildMergedOneCells(
     std::vector<Index> path = PathFromRoot(parent, start);
     if (descending && this->ArcLastNode[a] != InvalidIndex)
     {
-      path.push_back(this->ArcLastNode[a]);
+      // The merged forest's path to the 1-cell's first vertex below the saddle can pass the
+      // saddle's own vertex (the gradient step from it, when joins make that way shorter): the
+      // 1-cell then ends there instead of retracing that step (on 11 of 72 Delaunay runs, and the
+      // saddle's vertex became a false junction of the 1-cell with itself).
+      const auto it = std::find(path.begin(), path.end(), this->ArcLastNode[a]);
+      if (it != path.end())
+      {
+        path.erase(it + 1, path.end());
+      }
+      else
+      {
+        path.push_back(this->ArcLastNode[a]);
+      }
     }
 
     replay.OutputOneCell[a] = static_cast<Index>(out.OneCells.size());
@@ -1398,23 +1448,40 @@ bool MorseSmaleComplexSimplification::BuildMergedOneCells(
     }
     else
     {
-      // Saddle vertex, triangle centroids from the saddle to the maximum, maximum vertex.
-      merged.Points.resize(2 * (n + 2));
-      merged.Values.resize(n + 2);
-      merged.Points[0] = oneCell.Points[0];
-      merged.Points[1] = oneCell.Points[1];
-      merged.Values[0] = oneCell.Values[0];
+      // Saddle vertex, one point per triangle from the saddle to the maximum, maximum vertex.
+      // Where the path crosses the edge of a cancelled saddle (a join), the segment between
+      // the two triangles' points is new: on a triangle mesh the two can form a non-convex
+      // quad, and the segment then leaves them and can cross a descending 1-cell (11 of 24
+      // Delaunay meshes at 2 %, stress case #275). The path then also passes the edge's
+      // midpoint, from which both segments stay in their triangles; it is stored as a second
+      // entry of the triangle before it (from the saddle), so each triangle's first entry is
+      // still its own point (JunctionPointDetection, stage 3's cuts).
+      merged.MeshCells.clear();
+      merged.Points.assign(oneCell.Points.begin(), oneCell.Points.begin() + 2);
+      merged.Values.assign(1, oneCell.Values[0]);
       for (size_t i = 0; i < n; ++i)
       {
         const Index u = path[n - 1 - i];
-        merged.MeshCells[i] = nodes.Cell[u];
-        merged.Points[2 * (i + 1)] = nodes.Point[2 * u];
-        merged.Points[2 * (i + 1) + 1] = nodes.Point[2 * u + 1];
-        merged.Values[i + 1] = nodes.Value[u];
+        merged.MeshCells.push_back(nodes.Cell[u]);
+        merged.Points.insert(merged.Points.end(), { nodes.Point[2 * u], nodes.Point[2 * u + 1] });
+        merged.Values.push_back(nodes.Value[u]);
+        const Index joined = forests.AscendingJoinSaddle[u];
+        if (i + 1 < n && joined != InvalidIndex)
+        {
+          const Index w = path[n - 2 - i];
+          const double* end = &this->SaddleEdgeEnd[3 * joined];
+          const double* s = &this->CriticalPointPosition[2 * joined];
+          if (!std::isnan(end[0]) && !SegmentsCrossProperly(&nodes.Point[2 * u], &nodes.Point[2 * w], s, end))
+          {
+            merged.MeshCells.push_back(nodes.Cell[u]);
+            merged.Points.insert(merged.Points.end(), { s[0] / 2 + end[0] / 2, s[1] / 2 + end[1] / 2 });
+            merged.Values.push_back(cps[joined].Value / 2 + end[2] / 2);
+          }
+        }
       }
-      merged.Points[2 * (n + 1)] = this->CriticalPointPosition[2 * extremum];
-      merged.Points[2 * (n + 1) + 1] = this->CriticalPointPosition[2 * extremum + 1];
-      merged.Values[n + 1] = cps[extremum].Value;
+      merged.Points.insert(merged.Points.end(),
+        { this->CriticalPointPosition[2 * extremum], this->CriticalPointPosition[2 * extremum + 1] });
+      merged.Values.push_back(cps[extremum].Value);
     }
   }
   return true;

@@ -213,5 +213,8 @@ private:
   std::vector<Index> ArcLastNode;  // per descending 1-cell: the saddle's vertex (none if 1 vertex)
   std::vector<Index> RootNode;     // per extremum: its vertex / triangle node
   std::vector<double> CriticalPointPosition; // x, y per critical point (its vertex)
+  // Per critical point: x, y, value of a saddle's other edge vertex (CriticalPoint::EdgeVertex),
+  // NaN where unknown (extrema; a complex read without it). See BuildMergedOneCells.
+  std::vector<double> SaddleEdgeEnd;
 };
 } // namespace topospline

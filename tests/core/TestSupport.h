@@ -1,9 +1,10 @@
 // What several core tests share: grid fields as triangle meshes, Delaunay meshes of random
-// points, a segment-crossing predicate, a ParallelFor over real threads, and the real stages 1-3 run on a synthetic grid (what
+// points, a segment-crossing predicate and the crossing segment pairs of polylines, a ParallelFor over real threads, and the real stages 1-3 run on a synthetic grid (what
 // the stage-4 tests start from).
 #pragma once
 
 #include "CoreTypes.h"
+#include "DeterministicRandom.h"
 #include "MorseSmaleComplex.h"
 #include "MorseSmaleComplexExtraction.h"
 #include "MorseSmaleComplexSimplification.h"
@@ -12,7 +13,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <map>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -28,6 +31,56 @@ inline bool SegmentsCrossProperlyInTest(const double* a, const double* b, const 
     return (s > 0) - (s < 0);
   };
   return orient(a, b, c) * orient(a, b, d) < 0 && orient(c, d, a) * orient(c, d, b) < 0;
+}
+
+// The pairs of segments of polylines (x, y per point) that cross properly, each segment as its
+// end coordinates in a fixed order, so a segment shared by two polylines is one (pairs of one
+// polyline count, but not two segments that follow each other). Found pair by pair within
+// overlapping boxes.
+using TestSegment = std::array<double, 4>;
+inline std::set<std::pair<TestSegment, TestSegment>> CrossingSegmentPairs(
+  const std::vector<const std::vector<double>*>& lines)
+{
+  const auto undirected = [](const double* a, const double* b) {
+    const TestSegment s{ a[0], a[1], b[0], b[1] }, t{ b[0], b[1], a[0], a[1] };
+    return std::min(s, t);
+  };
+  std::set<std::pair<TestSegment, TestSegment>> pairs;
+  std::vector<std::array<double, 4>> boxes(lines.size(), { 1e300, -1e300, 1e300, -1e300 });
+  for (std::size_t p = 0; p < lines.size(); ++p)
+  {
+    const std::vector<double>& q = *lines[p];
+    for (std::size_t i = 0; i + 1 < q.size(); i += 2)
+    {
+      boxes[p] = { std::min(boxes[p][0], q[i]), std::max(boxes[p][1], q[i]), std::min(boxes[p][2], q[i + 1]),
+        std::max(boxes[p][3], q[i + 1]) };
+    }
+  }
+  for (std::size_t p = 0; p < lines.size(); ++p)
+  {
+    const std::vector<double>& a = *lines[p];
+    for (std::size_t q = p; q < lines.size(); ++q)
+    {
+      if (boxes[p][0] > boxes[q][1] || boxes[q][0] > boxes[p][1] || boxes[p][2] > boxes[q][3] ||
+        boxes[q][2] > boxes[p][3])
+      {
+        continue;
+      }
+      const std::vector<double>& b = *lines[q];
+      for (std::size_t i = 0; i + 3 < a.size(); i += 2)
+      {
+        for (std::size_t j = p == q ? i + 4 : 0; j + 3 < b.size(); j += 2)
+        {
+          if (SegmentsCrossProperlyInTest(&a[i], &a[i + 2], &b[j], &b[j + 2]))
+          {
+            const TestSegment s = undirected(&a[i], &a[i + 2]), t = undirected(&b[j], &b[j + 2]);
+            pairs.insert({ std::min(s, t), std::max(s, t) });
+          }
+        }
+      }
+    }
+  }
+  return pairs;
 }
 
 // The grid with its triangles spelled out (GridTriangles), so that the stages take the general
@@ -142,6 +195,22 @@ inline std::vector<Index> DelaunayTriangles(const std::vector<double>& points)
     }
   }
   return result;
+}
+
+// The stress test's "delaunay" kind in small: `points` uniform random points in the unit
+// square, triangulated by DelaunayTriangles, with a wavy field plus 20 % noise.
+inline PlanarScalarField RandomDelaunayField(std::uint64_t seed, int points)
+{
+  DeterministicRandom random(seed);
+  PlanarScalarField field;
+  for (int k = 0; k < points; ++k)
+  {
+    const double x = random.Uniform(), y = random.Uniform();
+    field.Points.insert(field.Points.end(), { x, y });
+    field.Values.push_back(std::sin(6 * x) * std::cos(5 * y) + 0.2 * random.Uniform());
+  }
+  field.Triangles = DelaunayTriangles(field.Points);
+  return field;
 }
 
 } // namespace topospline
