@@ -1411,21 +1411,22 @@ bool MorseSmaleComplexSimplification::BuildMergedOneCells(
     std::vector<Index> path = PathFromRoot(parent, start);
     if (descending && this->ArcLastNode[a] != InvalidIndex)
     {
-      // The merged forest's path to the 1-cell's first vertex below the saddle can pass the
-      // saddle's own vertex (the gradient step from it, when joins make that way shorter): the
-      // 1-cell then ends there instead of retracing that step (on 11 of 72 Delaunay runs, and the
-      // saddle's vertex became a false junction of the 1-cell with itself).
-      const auto it = std::find(path.begin(), path.end(), this->ArcLastNode[a]);
-      if (it != path.end())
+      // The merged forest's path to the 1-cell's first vertex below the saddle can come
+      // through the saddle's own vertex, by the gradient step down from it (when joins make that
+      // way shorter): the 1-cell then ends there instead of retracing that step, which made the
+      // saddle's vertex a junction of the 1-cell with itself (11 of 72 Delaunay runs). A longer
+      // way round back to the saddle's vertex encloses a region the 2-cells are built around,
+      // and stays.
+      const Index last = this->ArcLastNode[a];
+      if (path.size() >= 2 && path[path.size() - 2] == last)
       {
-        path.erase(it + 1, path.end());
+        path.pop_back();
       }
       else
       {
-        path.push_back(this->ArcLastNode[a]);
+        path.push_back(last);
       }
     }
-
     replay.OutputOneCell[a] = static_cast<Index>(out.OneCells.size());
     out.OneCells.emplace_back();
     OneCell& merged = out.OneCells.back();
