@@ -52,12 +52,12 @@ X_STARTUP_FAILURES = ("bad X server connection", "SupportsOpenGL", "Could not op
 
 def run_with_virtual_display(args, cwd, env, timeout=600, screen="1280x1024x24"):
     """Runs args under xvfb-run (display search from a random number, since two "xvfb-run -a"
-    starting together can pick the same display); up to two more tries, a few seconds apart, if
-    the X server failed to start (seen on a loaded machine: twice in a row once). Returns
-    (returncode, output)."""
-    for attempt in range(3):
+    starting together can pick the same display); up to four more tries, 5 to 40 s apart, if
+    the X server failed to start (seen on a loaded machine: twice in a row once, and three times
+    in a row while two stress runs shared the machine). Returns (returncode, output)."""
+    for attempt in range(5):
         if attempt:
-            time.sleep(5)
+            time.sleep(5 * 2 ** (attempt - 1))
         result = subprocess.run(["xvfb-run", "-a", "-n", str(random.randint(200, 30000)), "-s", "-screen 0 " + screen]
                                 + args, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
         output = result.stdout + result.stderr
