@@ -1875,113 +1875,13 @@ bool OneCellSmoothing::FitInParallel(OneCellSmoothingResult& result, const std::
 }
 
 //------------------------------------------------------------------------------
-namespace
-{
-// The direction in which a polyline (x, y per point) leaves `origin` from its first point
-// (atStart) or its last: towards the first point that differs from the origin; false if none.
-bool LeavingAngle(const std::vector<double>& points, bool atStart, const double origin[2], double& angle)
-{
-  const std::size_t n = points.size() / 2;
-  for (std::size_t k = 0; k < n; ++k)
-  {
-    const std::size_t i = atStart ? k : n - 1 - k;
-    const double dx = points[2 * i] - origin[0], dy = points[2 * i + 1] - origin[1];
-    if (dx != 0 || dy != 0)
-    {
-      angle = std::atan2(dy, dx);
-      return true;
-    }
-  }
-  return false;
-}
-} // namespace
-
-// Pieces whose curves leave a node in another cyclic order than their jagged 1-cells. Curves
-// that do not cross can still swap sides at their common node: a curve's tangent there may turn
-// past a short neighbour (stress case #275, a Delaunay mesh: a pouch's ascending curve left its
-// saddle on the far side of the 2-vertex descending 1-cell to the pouch's minimum, which then lay
-// outside the pouch's loop, and stage 4 could not map the cell). The jagged 1-cells' order is the
-// complex's (they are drawn without crossings); the curves' is that of their first control
-// points (the tangents; a curve that does not cross its neighbours keeps the order they start
-// in). Nodes where two directions tie are left alone. Returns every piece at a node out of
-// order.
-std::set<Index> OneCellSmoothing::PiecesOutOfOrderAtNodes(const OneCellSmoothingResult& result)
-{
-  std::vector<std::vector<std::pair<Index, bool>>> incident(result.Nodes.size()); // piece, at its start
-  for (Index p = 0; p < static_cast<Index>(result.Pieces.size()); ++p)
-  {
-    const SmoothedPiece& piece = result.Pieces[p];
-    if (piece.StartNode >= 0 && piece.EndNode >= 0 && piece.Curve.Dimension == 2)
-    {
-      incident[piece.StartNode].emplace_back(p, true);
-      incident[piece.EndNode].emplace_back(p, false);
-    }
-  }
-  std::set<Index> outOfOrder;
-  std::vector<std::pair<double, double>> angles; // jagged, curve
-  for (std::size_t node = 0; node < incident.size(); ++node)
-  {
-    const auto& around = incident[node];
-    if (around.size() < 3)
-    {
-      continue;
-    }
-    const double* origin = result.Nodes[node].Position;
-    angles.clear();
-    bool defined = true;
-    for (const auto& [p, atStart] : around)
-    {
-      double jagged = 0, curve = 0;
-      defined = defined && LeavingAngle(result.Pieces[p].Points, atStart, origin, jagged) &&
-        LeavingAngle(result.Pieces[p].Curve.ControlPoints, atStart, origin, curve);
-      angles.emplace_back(jagged, curve);
-    }
-    if (!defined)
-    {
-      continue;
-    }
-    std::sort(angles.begin(), angles.end());
-    std::vector<double> curves;
-    bool ties = false;
-    for (std::size_t i = 0; i < angles.size(); ++i)
-    {
-      ties = ties || (i > 0 && angles[i].first == angles[i - 1].first);
-      curves.push_back(angles[i].second);
-    }
-    std::vector<double> sorted = curves;
-    std::sort(sorted.begin(), sorted.end());
-    ties = ties || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end();
-    // In the same cyclic order, the curves' angles in the jagged order fall exactly once.
-    int falls = 0;
-    for (std::size_t i = 0; i < curves.size(); ++i)
-    {
-      falls += curves[(i + 1) % curves.size()] < curves[i];
-    }
-    if (!ties && falls != 1)
-    {
-      for (const auto& entry : around)
-      {
-        outOfOrder.insert(entry.first);
-      }
-    }
-  }
-  return outOfOrder;
-}
-
-//------------------------------------------------------------------------------
 bool OneCellSmoothing::RepairCrossings(
   OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const
 {
   // Where pieces cross, raise their k and fit again, until none cross or no k can rise.
   CrossingDetector detector(result, domainBounds, this->SamplesPerSegment, this->Parallel);
   std::set<Index> crossing;
-  // Pieces out of order at a node count as crossing, one each.
-  const auto addOutOfOrder = [&result, &crossing](int found) {
-    const std::set<Index> outOfOrder = PiecesOutOfOrderAtNodes(result);
-    crossing.insert(outOfOrder.begin(), outOfOrder.end());
-    return found + static_cast<int>(outOfOrder.size());
-  };
-  int pairs = addOutOfOrder(detector.FindCrossings(crossing));
+  int pairs = detector.FindCrossings(crossing);
   std::set<Index> adapted, followsPolyline;
   while (pairs > 0)
   {
@@ -2009,7 +1909,7 @@ bool OneCellSmoothing::RepairCrossings(
         return false;
       }
       crossing.clear();
-      pairs = addOutOfOrder(detector.UpdateCrossings(even, crossing));
+      pairs = detector.UpdateCrossings(even, crossing);
       continue;
     }
     // k doubles, and only doubles (a cap between would leave counts like 25 and 37, whose
@@ -2050,7 +1950,7 @@ bool OneCellSmoothing::RepairCrossings(
       break;
     }
     crossing.clear();
-    pairs = addOutOfOrder(detector.UpdateCrossings(changed, crossing));
+    pairs = detector.UpdateCrossings(changed, crossing);
   }
   result.AdaptedPieces = static_cast<int>(adapted.size());
   result.RiseKnotPieces = static_cast<int>(std::count_if(result.Pieces.begin(), result.Pieces.end(),

@@ -10,7 +10,6 @@
 #include "MorseSmaleComplex.h"
 
 #include <functional>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -110,9 +109,6 @@ public:
   // result is in the complex's coordinates. Returns false with a message.
   bool Smooth(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
     const double domainBounds[4], OneCellSmoothingResult& result, std::string& error) const;
-
-  // Pieces whose curves leave a node in another cyclic order than their jagged 1-cells.
-  static std::set<Index> PiecesOutOfOrderAtNodes(const OneCellSmoothingResult& result);
 
   // The piece's curve made its own jagged polyline (piece.Points, its ends moved onto its
   // nodes), in the same number of cubic segments, so that stage 4's grid layouts still fit:

@@ -19,7 +19,6 @@
 #include <array>
 #include <set>
 #include <map>
-#include <numeric>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -602,121 +601,6 @@ TEST_CASE(NoSamplingFindsCrossingsWhereNoneAreReported)
 }
 
 //------------------------------------------------------------------------------
-// The test's own check of the order in which pieces leave their nodes: per node, the pieces'
-// jagged polylines and curves are ranked by the angle of the first point (control point) off
-// the node; the curves must be the jagged ranks turned round (a cyclic shift). Nodes where two
-// angles tie are skipped. Returns the number of nodes out of order.
-int NodesOutOfOrderInTest(const OneCellSmoothingResult& result)
-{
-  std::map<Index, std::vector<std::pair<const SmoothedPiece*, bool>>> around;
-  for (const SmoothedPiece& piece : result.Pieces)
-  {
-    around[piece.StartNode].push_back({ &piece, true });
-    around[piece.EndNode].push_back({ &piece, false });
-  }
-  const auto angleOff = [](const std::vector<double>& xy, bool fromStart, const double* o, double& angle) {
-    const std::size_t n = xy.size() / 2;
-    for (std::size_t k = 0; k < n; ++k)
-    {
-      const std::size_t i = fromStart ? k : n - 1 - k;
-      if (xy[2 * i] != o[0] || xy[2 * i + 1] != o[1])
-      {
-        angle = std::atan2(xy[2 * i + 1] - o[1], xy[2 * i] - o[0]);
-        return true;
-      }
-    }
-    return false;
-  };
-  int outOfOrder = 0;
-  for (const auto& [node, pieces] : around)
-  {
-    if (pieces.size() < 3)
-    {
-      continue;
-    }
-    const double* o = result.Nodes[node].Position;
-    std::vector<double> jagged, curve;
-    bool defined = true;
-    for (const auto& [piece, fromStart] : pieces)
-    {
-      double a = 0, b = 0;
-      defined = defined && angleOff(piece->Points, fromStart, o, a) && angleOff(piece->Curve.ControlPoints, fromStart, o, b);
-      jagged.push_back(a);
-      curve.push_back(b);
-    }
-    const auto ranks = [](const std::vector<double>& angles) {
-      std::vector<std::size_t> order(angles.size());
-      std::iota(order.begin(), order.end(), std::size_t{ 0 });
-      std::sort(order.begin(), order.end(), [&angles](std::size_t a, std::size_t b) { return angles[a] < angles[b]; });
-      std::vector<std::size_t> rank(angles.size());
-      for (std::size_t r = 0; r < order.size(); ++r)
-      {
-        rank[order[r]] = r;
-      }
-      return rank;
-    };
-    if (!defined || std::set<double>(jagged.begin(), jagged.end()).size() != jagged.size() ||
-      std::set<double>(curve.begin(), curve.end()).size() != curve.size())
-    {
-      continue;
-    }
-    const auto a = ranks(jagged), b = ranks(curve);
-    const std::size_t n = a.size(), shift = (b[0] + n - a[0]) % n;
-    bool shifted = true;
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      shifted = shifted && b[i] == (a[i] + shift) % n;
-    }
-    outOfOrder += shifted ? 0 : 1;
-  }
-  return outOfOrder;
-}
-
-//------------------------------------------------------------------------------
-TEST_CASE(PiecesOutOfOrderAtANode)
-{
-  // Four pieces leave a node at 0, 90, 180 and 270 degrees; their curves start the same way,
-  // then one turns past its neighbour.
-  OneCellSmoothingResult result;
-  result.Nodes.resize(5);
-  const double directions[4][2] = { { 1, 0 }, { 0, 1 }, { -1, 0 }, { 0, -1 } };
-  for (int p = 0; p < 4; ++p)
-  {
-    result.Nodes[p + 1].Position[0] = 4 * directions[p][0];
-    result.Nodes[p + 1].Position[1] = 4 * directions[p][1];
-    SmoothedPiece piece;
-    piece.StartNode = 0;
-    piece.EndNode = p + 1;
-    piece.Points = { 0, 0, 2 * directions[p][0], 2 * directions[p][1], 4 * directions[p][0], 4 * directions[p][1] };
-    piece.Curve.Dimension = 2;
-    piece.Curve.Segments = 1;
-    piece.Curve.ControlPoints = { 0, 0, directions[p][0], directions[p][1], 3 * directions[p][0], 3 * directions[p][1],
-      4 * directions[p][0], 4 * directions[p][1] };
-    result.Pieces.push_back(piece);
-  }
-  CHECK(OneCellSmoothing::PiecesOutOfOrderAtNodes(result).empty());
-  CHECK_EQ(NodesOutOfOrderInTest(result), 0);
-  // The piece at 90 degrees now leaves at 200: between the pieces at 180 and 270.
-  result.Pieces[1].Curve.ControlPoints[2] = std::cos(200 * M_PI / 180);
-  result.Pieces[1].Curve.ControlPoints[3] = std::sin(200 * M_PI / 180);
-  CHECK_EQ(OneCellSmoothing::PiecesOutOfOrderAtNodes(result).size(), std::size_t{ 4 });
-  CHECK_EQ(NodesOutOfOrderInTest(result), 1);
-  // Leaving at 100 degrees keeps the order; a curve whose first control point sits on the node
-  // is read from its next one.
-  result.Pieces[1].Curve.ControlPoints[2] = std::cos(100 * M_PI / 180);
-  result.Pieces[1].Curve.ControlPoints[3] = std::sin(100 * M_PI / 180);
-  result.Pieces[3].Curve.ControlPoints[2] = 0;
-  result.Pieces[3].Curve.ControlPoints[3] = 0;
-  CHECK(OneCellSmoothing::PiecesOutOfOrderAtNodes(result).empty());
-  // Two jagged pieces leaving the same way: the node is left alone.
-  result.Pieces[1].Curve.ControlPoints[2] = std::cos(200 * M_PI / 180);
-  result.Pieces[1].Curve.ControlPoints[3] = std::sin(200 * M_PI / 180);
-  result.Pieces[2].Points[2] = 2;
-  result.Pieces[2].Points[3] = 0;
-  CHECK(OneCellSmoothing::PiecesOutOfOrderAtNodes(result).empty());
-}
-
-//------------------------------------------------------------------------------
 TEST_CASE(JaggedPiecesAddNoCrossingOnTriangleMeshes)
 {
   // Stage 3 falls back to the jagged pieces where smoothed curves cross, so those must not
@@ -730,7 +614,7 @@ TEST_CASE(JaggedPiecesAddNoCrossingOnTriangleMeshes)
   // another in the simplified complex's own 1-cells already (checked pair by pair here). (Those
   // crossed on 11 of these meshes until stage 2 passed a cancelled saddle's edge midpoint:
   // MergedOneCellsNeverCrossOnTriangleMeshes.)
-  int runs = 0, pieces = 0, added = 0, inherited = 0, nodesOutOfOrder = 0;
+  int runs = 0, pieces = 0, added = 0, inherited = 0;
   for (std::uint64_t seed = 1; seed <= 24; ++seed)
   {
     const PlanarScalarField field = RandomDelaunayField(500 + seed, 3000);
@@ -776,24 +660,19 @@ TEST_CASE(JaggedPiecesAddNoCrossingOnTriangleMeshes)
       {
         newOnes += crossingInComplex.count(pair.first) || crossingInComplex.count(pair.second) ? 0 : 1;
       }
-      const int outOfOrder = NodesOutOfOrderInTest(result);
       std::printf("  seed %d at %g %%: %zu pieces; crossing segment pairs: %zu in the complex's 1-cells, %d more "
-                  "of segments that cross nothing there (stage 3 reports %d crossing pairs, %d polyline pieces); "
-                  "%d nodes the curves leave in another order than the jagged 1-cells\n",
+                  "of segments that cross nothing there (stage 3 reports %d crossing pairs, %d polyline pieces)\n",
         static_cast<int>(500 + seed), percent, result.Pieces.size(), inComplex.size(), newOnes,
-        result.RemainingCrossings, result.PolylinePieces, outOfOrder);
+        result.RemainingCrossings, result.PolylinePieces);
       ++runs;
-      nodesOutOfOrder += outOfOrder;
       pieces += static_cast<int>(result.Pieces.size());
       added += newOnes;
       inherited += static_cast<int>(inComplex.size());
     }
   }
-  std::printf("  %d runs, %d pieces: %d crossing segment pairs added by the pieces (%d in the complexes); %d nodes "
-              "left by the curves in another order than by the jagged 1-cells\n",
-    runs, pieces, added, inherited, nodesOutOfOrder);
+  std::printf("  %d runs, %d pieces: %d crossing segment pairs added by the pieces (%d in the complexes)\n", runs,
+    pieces, added, inherited);
   CHECK_EQ(added, 0);
-  CHECK_EQ(nodesOutOfOrder, 0);
 }
 
 //------------------------------------------------------------------------------
