@@ -1367,11 +1367,15 @@ MorseSmaleComplexSimplification::MergedForests MorseSmaleComplexSimplification::
   for (size_t j = 0; j < ascendingJoins.size(); ++j)
   {
     const Index a = ascendingJoins[j][0], b = ascendingJoins[j][1];
-    if (forests.AscendingParent[a] == b && a != b)
+    if (a == b)
+    {
+      continue;
+    }
+    if (forests.AscendingParent[a] == b)
     {
       forests.AscendingJoinSaddle[a] = joinSaddles[j];
     }
-    else if (forests.AscendingParent[b] == a && a != b)
+    else if (forests.AscendingParent[b] == a)
     {
       forests.AscendingJoinSaddle[b] = joinSaddles[j];
     }
@@ -1414,7 +1418,7 @@ bool MorseSmaleComplexSimplification::BuildMergedOneCells(
       // The merged forest's path to the 1-cell's first vertex below the saddle can come
       // through the saddle's own vertex, by the gradient step down from it (when joins make that
       // way shorter): the 1-cell then ends there instead of retracing that step, which made the
-      // saddle's vertex a junction of the 1-cell with itself (11 of 72 Delaunay runs). A longer
+      // saddle's vertex a junction of the 1-cell with itself (7 1-cells in 72 Delaunay runs). A longer
       // way round back to the saddle's vertex encloses a region the 2-cells are built around,
       // and stays.
       const Index last = this->ArcLastNode[a];
@@ -1434,9 +1438,9 @@ bool MorseSmaleComplexSimplification::BuildMergedOneCells(
     merged.Source = descending ? replay.Position[extremum] : replay.Position[saddle];
     merged.Destination = descending ? replay.Position[saddle] : replay.Position[extremum];
     const size_t n = path.size();
-    merged.MeshCells.resize(n);
     if (descending)
     {
+      merged.MeshCells.resize(n);
       merged.Points.resize(2 * n);
       merged.Values.resize(n);
       for (size_t i = 0; i < n; ++i)
@@ -1457,7 +1461,6 @@ bool MorseSmaleComplexSimplification::BuildMergedOneCells(
       // midpoint, from which both segments stay in their triangles; it is stored as a second
       // entry of the triangle before it (from the saddle), so each triangle's first entry is
       // still its own point (JunctionPointDetection, stage 3's cuts).
-      merged.MeshCells.clear();
       merged.Points.assign(oneCell.Points.begin(), oneCell.Points.begin() + 2);
       merged.Values.assign(1, oneCell.Values[0]);
       for (size_t i = 0; i < n; ++i)

@@ -1,6 +1,7 @@
 // What several core tests share: grid fields as triangle meshes, Delaunay meshes of random
-// points, a segment-crossing predicate and the crossing segment pairs of polylines, a ParallelFor over real threads, and the real stages 1-3 run on a synthetic grid (what
-// the stage-4 tests start from).
+// points, a segment-crossing predicate and the crossing segment pairs of polylines, a
+// ParallelFor over real threads, and the real stages 1-3 run on a synthetic grid (what the
+// stage-4 tests start from).
 #pragma once
 
 #include "CoreTypes.h"
