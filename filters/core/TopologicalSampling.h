@@ -14,7 +14,8 @@
 // boundary saddles. Ties are ordered as stage 1 orders them: by value, then vertex id.
 // Before the floods, the complex's smoothed 1-cells are carved into the sampling
 // (CarveOneCells), so that a ridge or valley running between two rows of vertices is not cut
-// into islands; after them, saddles left off their nodes are moved back (RelocateSaddles).
+// into islands; after them, saddles left off their nodes are moved back (RelocateSaddles: their
+// 1-cells carved again, then the patterns of their links, PlaceMissingSaddlesByTheirLinks).
 // Last, every changed vertex moves back toward F o Phi as far as the critical points allow
 // (RelaxTowardTargets). TopologicalSampling::Apply runs the whole sequence.
 #pragma once
@@ -204,6 +205,21 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
 // keeps the result if it leaves fewer saddles off their nodes (or as many, fewer blocked).
 int MoveBlockedBoundarySaddles(const TriangleMeshTopology& mesh, const std::vector<Index>& blocked,
   const std::vector<double>& settled, SamplingConstraints& constraints, std::vector<double>& start);
+
+// A wanted saddle inside the domain that the carving of its 1-cells did not put on its vertex
+// (its smoothed 1-cells leave it where a carved link vertex is a dead end: raised past the
+// saddle with no higher vertex beyond it, a peak that the floods cut back again; or sampling
+// left a link vertex exactly at the saddle's value): its link vertices are put on the sides a
+// saddle of its multiplicity needs (just past the saddle's value), one pattern of sides at a
+// time in the order of the change it costs, and the floods run again; a pattern is kept if more
+// wanted saddles are then matched within `tolerance` without more found ones. Only if at most
+// `maximumMissing` wanted saddles are off (each pattern floods and extracts the whole sampling),
+// and the cheapest `maximumPatterns` patterns of each. Boundary saddles are left alone (the
+// boundary rule has its own passes). Returns the number of wanted saddles still off.
+// RelocateSaddles (TopologicalSampling::Apply) runs this after the carving.
+int PlaceMissingSaddlesByTheirLinks(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, double tolerance, std::vector<double>& values, int maximumMissing,
+  int maximumPatterns);
 
 // Makes every wanted extremum an extremum again where a step before (a flood of the other
 // kind, a carved 1-cell, a saddle moved back) took that away: the vertex is moved just past its
