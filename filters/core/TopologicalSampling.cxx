@@ -498,6 +498,14 @@ void AddOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult&
 // Adds to `report` how many of `after` differ from `before`, and by how much at most.
 void CountChanges(const std::vector<double>& before, const std::vector<double>& after,
   TopologicalSamplingReport& report);
+
+// RelocateSaddles tries the patterns of the links (PlaceMissingSaddlesByTheirLinks) of at most
+// this many saddles left off their nodes by the carving, and this many patterns per saddle: each
+// costs a flood and an extraction, and 10 saddles with 16 patterns each gained no verdict more
+// than these on the stress set's failing noise cases (#12-#80).
+constexpr int LinkPatternSaddles = 4;
+constexpr int LinkPatternsPerSaddle = 6;
+
 // After EnforceCriticalVertices the extrema are the wanted ones, but a saddle can sit a few
 // vertices from its node in a nearly flat pass. Each round extracts the complex of `field`
 // with `values`; for every wanted saddle (constraints.Saddles) with no saddle within `tolerance`, the nearest
@@ -510,14 +518,8 @@ void CountChanges(const std::vector<double>& before, const std::vector<double>& 
 // sampling (CarveSaddleOneCells, within `reach`; one extraction, whatever the number
 // unmatched): where a 1-cell runs between two rows of vertices, as next to the domain
 // boundary, the ridge or valley it follows is seen by no vertex and the saddle slides along
-// it; carving gives it vertices.
-// RelocateSaddles tries the patterns of the links (PlaceMissingSaddlesByTheirLinks) of at most
-// this many saddles left off their nodes by the carving, and this many patterns per saddle: each
-// costs a flood and an extraction, and 10 saddles with 16 patterns each gained no verdict more
-// than these on the stress set's failing noise cases (#12-#80).
-constexpr int LinkPatternSaddles = 4;
-constexpr int LinkPatternsPerSaddle = 6;
-
+// it; carving gives it vertices. Then the patterns of the links of the saddles still unmatched
+// (PlaceMissingSaddlesByTheirLinks), while few are.
 int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, double tolerance, double reach, std::vector<double>& values,
   int maximumRounds = 3, int maximumMissing = 10, const ParallelFor& parallel = SequentialFor);
