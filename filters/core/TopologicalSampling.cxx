@@ -1709,7 +1709,11 @@ struct SaddleRelocation
       const int multiplicity =
         static_cast<int>(std::count(this->Constraints.Saddles.begin(), this->Constraints.Saddles.end(), w));
       const Key saddle{ this->Values[w], w };
-      std::vector<std::pair<double, unsigned>> patterns; // (cost, bit i set: link[i] above)
+      // Whether pattern `bits` (bit i set: link[i] above) has link[i] on the other side now.
+      const auto moves = [&](unsigned bits, std::size_t i) {
+        return (((bits >> i) & 1u) != 0) != (saddle < Key{ this->Values[link[i]], link[i] });
+      };
+      std::vector<std::pair<double, unsigned>> patterns; // (cost, bits)
       for (unsigned bits = 1; bits + 1 < (1u << link.size()); ++bits)
       {
         const auto below = [&](Index u) {
@@ -1723,9 +1727,7 @@ struct SaddleRelocation
         double cost = 0;
         for (std::size_t i = 0; i < link.size(); ++i)
         {
-          const bool above = (bits >> i) & 1u;
-          const bool isAbove = saddle < Key{ this->Values[link[i]], link[i] };
-          cost += above == isAbove ? 0 : std::abs(this->Values[link[i]] - saddle.Value);
+          cost += moves(bits, i) ? std::abs(this->Values[link[i]] - saddle.Value) : 0;
         }
         if (cost > 0)
         {
@@ -1736,14 +1738,13 @@ struct SaddleRelocation
       const std::size_t tried = std::min<std::size_t>(patterns.size(), static_cast<std::size_t>(maximumPatterns));
       for (std::size_t p = 0; p < tried; ++p)
       {
+        const unsigned bits = patterns[p].second;
         std::vector<double> trial = this->Values;
         for (std::size_t i = 0; i < link.size(); ++i)
         {
-          const bool above = (patterns[p].second >> i) & 1u;
-          const bool isAbove = saddle < Key{ trial[link[i]], link[i] };
-          if (above != isAbove)
+          if (moves(bits, i))
           {
-            trial[link[i]] = std::nextafter(saddle.Value, above ? infinity : -infinity);
+            trial[link[i]] = std::nextafter(saddle.Value, ((bits >> i) & 1u) != 0 ? infinity : -infinity);
           }
         }
         if (this->KeepIfBetter(trial, this->Settle(trial)))

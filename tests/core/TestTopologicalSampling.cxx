@@ -916,13 +916,14 @@ TEST_CASE(AValleyBesideARidgeGoesRoundTheVerticesBothClaim)
 
 TEST_CASE(ASaddleLoweredOntoItsLinkComesBackByItsLink)
 {
-  // Each wanted interior saddle of the trigonometric field in turn loses its saddle: the one
-  // vertex of one of its upper link pieces is put just below it (as sampling can leave a link
-  // vertex exactly at the saddle's value, stress case #17), and the floods settle the extrema.
-  // The wanted saddle is then off its vertex (the lowered vertex is a saddle instead, so saddles
-  // are matched on their vertex here: tolerance 0.5). Trying the patterns of its link must
-  // bring it back: checked by the test's own count of the link's pieces above the saddle (the grid's
-  // split along (i+1, j)-(i, j+1), ties by vertex id) and by stage 1's counts.
+  // Each wanted interior saddle of the trigonometric field and of 3 seeded Shepard fields in
+  // turn loses its saddle: the one vertex of one of its upper link pieces is put just below it
+  // (as sampling can leave a link vertex exactly at the saddle's value, stress case #17), and the
+  // floods settle the extrema. The wanted saddle is then off its vertex (the lowered vertex is a
+  // saddle instead, so saddles are matched on their vertex here: tolerance 0.5). Trying the
+  // patterns of its link must bring it back: checked by the test's own count of the link's
+  // pieces above the saddle (the grid's split along (i+1, j)-(i, j+1), ties by vertex id) and by
+  // stage 1's counts.
   int tried = 0, restored = 0;
   for (int seed = -1; seed < 3; ++seed)
   {
@@ -955,6 +956,16 @@ TEST_CASE(ASaddleLoweredOntoItsLinkComesBackByItsLink)
       }
       return changes / 2;
     };
+    const auto wanted = [&constraints](Index v) {
+      for (const std::vector<Index>* kind : { &constraints.Minima, &constraints.Maxima, &constraints.Saddles })
+      {
+        if (std::find(kind->begin(), kind->end(), v) != kind->end())
+        {
+          return true;
+        }
+      }
+      return false;
+    };
     MorseSmaleComplexExtraction extraction;
     std::string error;
     for (Index w : constraints.Saddles)
@@ -976,16 +987,6 @@ TEST_CASE(ASaddleLoweredOntoItsLinkComesBackByItsLink)
           lone = link[k];
         }
       }
-      const auto wanted = [&constraints](Index v) {
-        for (const std::vector<Index>* kind : { &constraints.Minima, &constraints.Maxima, &constraints.Saddles })
-        {
-          if (std::find(kind->begin(), kind->end(), v) != kind->end())
-          {
-            return true;
-          }
-        }
-        return false;
-      };
       if (lone == InvalidIndex || wanted(lone))
       {
         continue; // a wanted extremum or saddle beside the saddle is not lowered
@@ -1007,7 +1008,6 @@ TEST_CASE(ASaddleLoweredOntoItsLinkComesBackByItsLink)
       restored += back ? 1 : 0;
       if (!back)
       {
-
         std::printf("  saddle (%d, %d) not restored: %d upper pieces, %d wanted saddles off\n", i, j,
           upperPieces(values, w), missing);
       }
