@@ -95,6 +95,7 @@ int vtkTopoSplineMorseSmaleComplex::RequestData(
   // The core reports between its passes, on this thread.
   extraction.Hooks.Progress = [this](double fraction) { this->UpdateProgress(0.05 + 0.85 * fraction); };
   extraction.Hooks.AbortRequested = [this]() { return this->GetAbortExecute() != 0; };
+  extraction.NearConstantAsConstant = true;
   topospline::MorseSmaleComplex complex;
   {
     vtkLogScopeF(TRACE, "extract Morse-Smale complex");
@@ -106,6 +107,13 @@ int vtkTopoSplineMorseSmaleComplex::RequestData(
       }
       return 1;
     }
+  }
+  if (extraction.ReadAsConstant)
+  {
+    vtkWarningMacro("Morse-Smale Complex: the field varies by less than "
+      << topospline::NearConstantRange
+      << " of its magnitude, too little for strictly monotone 1-cells and 2-cells in double precision; "
+         "it is read as the constant halfway between its extremes (a flat reconstruction).");
   }
   const auto counts = complex.CountByIndex();
   vtkLog(TRACE, "Morse-Smale complex: " << counts[0] << " minima, " << counts[1] << " saddles, " << counts[2]

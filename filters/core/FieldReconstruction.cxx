@@ -48,6 +48,16 @@ PlanarScalarField WithValues(const PlanarScalarField& field, const std::vector<d
   sampling.Values = values;
   return sampling;
 }
+
+// The global minimum and maximum of a field are critical points of its complex, and no
+// simplification cancels them: critical values that are all equal make a constant field (or
+// one stage 1 read as constant, MorseSmaleComplexExtraction::NearConstantAsConstant).
+bool IsConstantComplex(const MorseSmaleComplex& complex)
+{
+  const auto& points = complex.CriticalPoints;
+  return !points.empty() && std::all_of(points.begin(), points.end(),
+                              [&](const CriticalPoint& p) { return p.Value == points.front().Value; });
+}
 } // namespace
 
 double LargestEdgeLength(const PlanarScalarField& field)
@@ -349,6 +359,11 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
     this->Cells.SurfaceTolerance = this->SurfaceTolerance * (*highest - *lowest);
   }
   this->Cells.Parallel = this->Parallel;
+  if (IsConstantComplex(complex))
+  {
+    this->ReconstructConstant(field, complex, report);
+    return true;
+  }
   this->Cells.Hooks.Progress = [this](double f) { this->Hooks.Report(0.6 * f); };
   this->Cells.Hooks.AbortRequested = this->Hooks.AbortRequested;
   TriangleMeshTopology mesh;
@@ -391,6 +406,47 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
   }
   this->Hooks.Report(1.0);
   return true;
+}
+
+// A constant field's complex is that of its ties ordered by vertex id, which the constant
+// itself has: every 2-cell and 1-cell is flat at it, on every sampling. (The paper's surfaces
+// cannot be flat: strictly monotone 1-cells of a constant field rise by a spreading of 1e-11
+// of its magnitude, and a 2-cell's Sibson grid of over 500 steps, as at k = 30, leaves too few
+// ulps per step for its monotonicity conditions.)
+void FieldReconstruction::ReconstructConstant(
+  const PlanarScalarField& field, const MorseSmaleComplex& complex, FieldReconstructionReport& report) const
+{
+  const double value = complex.CriticalPoints.front().Value;
+  const Index n = static_cast<Index>(field.Values.size());
+  report.Values.assign(n, value);
+  report.Exact = report.Values;
+  report.Difference.resize(n);
+  for (Index v = 0; v < n; ++v)
+  {
+    report.Difference[v] = value - field.Values[v];
+  }
+  report.CellOfVertex.assign(n, 0);
+  if (complex.TwoCellId.size() == field.Values.size())
+  {
+    std::copy(complex.TwoCellId.begin(), complex.TwoCellId.end(), report.CellOfVertex.begin());
+  }
+  this->MeasureErrors(field, report);
+  if (this->OutputResolution > 1)
+  {
+    report.Finer = this->FinerGrid(field);
+    const std::size_t m = static_cast<std::size_t>(report.Finer.Dimensions[0]) * report.Finer.Dimensions[1];
+    report.Finer.Values.assign(m, value);
+    report.FinerValid.assign(m, 1);
+  }
+  if (this->VerifyTopology)
+  {
+    TriangleMeshTopology mesh;
+    std::string ignored; // the input's mesh was checked by stage 1
+    BuildMesh(field, mesh, this->Parallel, ignored);
+    OneCellSmoothingResult none;
+    this->Verify(field, mesh, complex, none, report);
+  }
+  this->Hooks.Report(1.0);
 }
 
 // F o Phi at every input vertex; the vertex's 2-cell of the jagged complex is the first guess.

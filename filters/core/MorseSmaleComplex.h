@@ -25,6 +25,19 @@ struct PlanarScalarField
   bool IsGrid() const { return this->GridDimensions[0] > 1 && this->GridDimensions[1] > 1; }
 };
 
+// Values that vary, but by less than this fraction of their magnitude (a field of 1 + 1e-13
+// noise), are too close for what stages 3 and 4 need: values that rise strictly along every
+// 1-cell with room between them in double precision (JunctionValueProgram's spreading, 1e-11
+// of the magnitude, would dwarf such a field's own variation and leave 2-cells whose sides do
+// not join). Stage 1 reads such a field as the constant it is within that precision.
+constexpr double NearConstantRange = 1e-9;
+// Whether values from `lowest` to `highest`, of largest magnitude `magnitude`, vary by less
+// than NearConstantRange of it (and vary at all).
+inline bool VariesByLessThanPrecision(double lowest, double highest, double magnitude)
+{
+  return highest > lowest && highest - lowest < NearConstantRange * magnitude;
+}
+
 struct CriticalPoint
 {
   Index Id = InvalidIndex;      // stable id, kept through simplification

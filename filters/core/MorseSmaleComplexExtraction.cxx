@@ -990,9 +990,24 @@ bool MorseSmaleComplexExtraction::Extract(
   const PlanarScalarField& field, MorseSmaleComplex& complex, std::string& error)
 {
   complex = MorseSmaleComplex();
+  this->ReadAsConstant = false;
   if (!this->CheckField(field, error))
   {
     return false;
+  }
+  if (this->NearConstantAsConstant && !field.Values.empty())
+  {
+    const auto [lowest, highest] = std::minmax_element(field.Values.begin(), field.Values.end());
+    if (VariesByLessThanPrecision(*lowest, *highest, std::max(std::abs(*lowest), std::abs(*highest))))
+    {
+      PlanarScalarField constant = field;
+      std::fill(constant.Values.begin(), constant.Values.end(), *lowest + 0.5 * (*highest - *lowest));
+      this->NearConstantAsConstant = false;
+      const bool extracted = this->Extract(constant, complex, error);
+      this->NearConstantAsConstant = true;
+      this->ReadAsConstant = extracted;
+      return extracted;
+    }
   }
   const TriangleMeshTopology* mesh = this->PrepareMesh(field, error);
   if (!mesh)

@@ -24,6 +24,12 @@ public:
   // in a fraction of the memory (samplings of tens of millions of vertices). field.Points may
   // then be empty.
   bool CriticalPointsOnly = false;
+  // A field that varies by less than NearConstantRange of its magnitude is read as the
+  // constant halfway between its extremes (its complex that of a constant field: ties ordered
+  // by vertex id), and ReadAsConstant says so. The filter asks for it; a topology check of a
+  // reconstruction must not (it judges the values as they are).
+  bool NearConstantAsConstant = false;
+  bool ReadAsConstant = false;
   // The field's mesh, if the caller has it already (it must be the mesh of field.Triangles or
   // of the grid, which may then be left empty); otherwise Mesh is built. Saves a second copy
   // of the largest structure.

@@ -1073,7 +1073,7 @@ bool MorseSmaleComplexSimplification::NearConstant() const
     highest = std::max(highest, point.Value);
     magnitude = std::max(magnitude, std::abs(point.Value));
   }
-  return highest > lowest && highest - lowest < NearConstantRange * magnitude;
+  return VariesByLessThanPrecision(lowest, highest, magnitude);
 }
 
 Index MorseSmaleComplexSimplification::NumberOfCancellations(double percent) const

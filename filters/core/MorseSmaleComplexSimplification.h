@@ -105,12 +105,10 @@ public:
   Index NumberOfCancellations(double percent) const;
 
   // Whether the critical values vary, but by less than NearConstantRange of their magnitude
-  // (a field of 1 + 1e-13 noise). Stages 3 and 4 need the values along every 1-cell to rise
-  // strictly with room between them in double precision (JunctionValueProgram's spreading,
-  // 1e-11 of the magnitude), which would dwarf such a field's own variation and leave 2-cells
-  // whose sides do not join. Such a field is best simplified completely (the filter does so,
-  // with a warning): the "flat or trivially monotone" reconstruction.
-  static constexpr double NearConstantRange = 1e-9;
+  // (VariesByLessThanPrecision). Stage 1's filter reads such fields as constant, so this holds
+  // only for complexes extracted without it (MorseSmaleComplexExtraction::
+  // NearConstantAsConstant); the filter then simplifies completely, with a warning.
+  static constexpr double NearConstantRange = topospline::NearConstantRange;
   bool NearConstant() const;
 
   ProgressHooks Hooks;

@@ -14,6 +14,7 @@
 #include <map>
 #include <set>
 #include <thread>
+#include <utility>
 
 using namespace topospline;
 
@@ -264,6 +265,58 @@ TEST_CASE(PlateausAreBrokenByVertexId)
   }
   const auto mesaField = MeshFieldOnGrid(mesa);
   CheckInvariants(mesaField, Extract(mesaField));
+}
+
+// A field varying by less than NearConstantRange of its magnitude is read as constant when
+// asked (the filter asks): ties by vertex id make it the ramp of ids, whose only critical
+// points on this grid are written out here: the minimum at vertex 0, and at the last vertex,
+// whose two boundary neighbours lie below it (the closed-boundary rule), a saddle and a
+// maximum. Every critical value is the midpoint of the field's extremes.
+TEST_CASE(NearConstantFieldsAreReadAsConstant)
+{
+  const int nx = 30, ny = 20;
+  DeterministicRandom random(7);
+  const auto noise = [&](double offset, double scale) {
+    GridField grid;
+    grid.Dimensions[0] = nx;
+    grid.Dimensions[1] = ny;
+    for (int v = 0; v < nx * ny; ++v)
+    {
+      grid.Values.push_back(offset + scale * random.Uniform());
+    }
+    return FieldOnGrid(grid);
+  };
+  for (const auto& [offset, scale] : { std::pair<double, double>{ 1.0, 1e-13 }, { -7.25e6, 1e-4 } })
+  {
+    const PlanarScalarField field = noise(offset, scale);
+    const auto [lowest, highest] = std::minmax_element(field.Values.begin(), field.Values.end());
+    MorseSmaleComplexExtraction asked;
+    asked.NearConstantAsConstant = true;
+    MorseSmaleComplex complex;
+    std::string error;
+    CHECK(asked.Extract(field, complex, error));
+    CHECK(asked.ReadAsConstant);
+    std::multiset<std::pair<Index, int>> found;
+    for (const CriticalPoint& point : complex.CriticalPoints)
+    {
+      found.insert({ point.Vertex, point.MorseIndex });
+      CHECK(point.Value == *lowest + 0.5 * (*highest - *lowest));
+    }
+    const Index last = nx * ny - 1;
+    CHECK(found == (std::multiset<std::pair<Index, int>>{ { 0, 0 }, { last, 1 }, { last, 2 } }));
+    // Unasked, or varying by more: the field's own complex.
+    MorseSmaleComplexExtraction plain;
+    MorseSmaleComplex own;
+    CHECK(plain.Extract(field, own, error) && !plain.ReadAsConstant);
+    CHECK(own.CriticalPoints.size() > 20);
+  }
+  const PlanarScalarField resolved = noise(1.0, 1e-8);
+  MorseSmaleComplexExtraction asked;
+  asked.NearConstantAsConstant = true;
+  MorseSmaleComplex complex;
+  std::string error;
+  CHECK(asked.Extract(resolved, complex, error) && !asked.ReadAsConstant);
+  CHECK(complex.CriticalPoints.size() > 20);
 }
 
 // Whether (x, y) lies inside the closed polyline `loop` (x, y per point), by crossings.

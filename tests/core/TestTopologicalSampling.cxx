@@ -3,8 +3,9 @@
 // ridge running between two rows of vertices is carved in, a cut leaves no pit on its plateau
 // of a triangle mesh, and wanted extrema taken away by
 // the floods of the other kind are restored; relaxing toward the values before keeps every
-// critical point; a corner saddle with no way up but through a wanted minimum is reported, and
-// one with a free neighbour along the boundary moves there; a saddle lowered off its vertex comes
+// critical point; a corner saddle with no way up but through a wanted minimum is reported, one
+// whose neighbour along the boundary can rise past it goes up there, and one with a free
+// neighbour along the boundary moves there; a saddle lowered off its vertex comes
 // back by the patterns of its link. Each sampled result is checked by
 // extracting its critical points again (stage 1) against the wanted complex. (The whole
 // sequence on real reconstructions is tested in TestFieldReconstruction.)
@@ -25,6 +26,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace topospline;
@@ -767,6 +769,73 @@ TEST_CASE(ACornerSaddleWithoutAWayUpIsReported)
       values[saddle]);
     CHECK(blocked == (pitWanted ? std::vector<Index>{ saddle } : std::vector<Index>{}));
   }
+}
+
+TEST_CASE(ACornerSaddleGoesUpAlongTheBoundaryWhereItCan)
+{
+  // The corner of the test above, on a ramp that rises faster along i: the boundary vertex
+  // (1, 0) lies between (0, 0) and (2, 0) along the boundary, and (2, 0) stands above the
+  // saddle, so raising (1, 0) past the saddle changes nothing along the boundary and gives it a
+  // way up that takes no wanted point (stress seed 29, #57: the interior search raised the
+  // minimum instead). The oracle: stage 1 run again on the result has a minimum at (1, 1), a
+  // saddle at (0, 1) and no maximum there, and the counts of the wanted complex.
+  constexpr int n = 5;
+  const PlanarScalarField field = UnitGrid(n, n, [](int i, int j) {
+    return i == 0 && j == 1 ? 5.0 : (i == 1 && j == 1 ? -1.0 : double(3 * i + j));
+  });
+  TriangleMeshTopology mesh;
+  mesh.BuildGrid(n, n, SequentialFor);
+  const Index corner = 0, saddle = n, pit = n + 1, top = n * n - 1, side = 2 * n, along = 1;
+  SamplingConstraints constraints;
+  constraints.Minima = { pit };
+  constraints.Maxima = { top };
+  constraints.BoundaryMinima = { corner, side };
+  constraints.BoundaryMaxima = { saddle, top };
+  MorseSmaleComplexExtraction extraction;
+  MorseSmaleComplex wanted, after;
+  std::string error;
+  CHECK(extraction.Extract(field, wanted, error)); // the input's, with the pair below
+  PlanarScalarField sampled = field;
+  std::vector<Index> blocked;
+  const auto report = EnforceCriticalVertices(mesh, constraints, sampled.Values, 6, &blocked);
+  CHECK(report.Converged);
+  CHECK(blocked.empty());
+  CHECK_EQ(sampled.Values[pit], -1.0);
+  CHECK(sampled.Values[along] > sampled.Values[saddle] && sampled.Values[along] < sampled.Values[2]);
+  CHECK(extraction.Extract(sampled, after, error));
+  std::vector<std::pair<Index, int>> atTheCorner;
+  for (const CriticalPoint& point : after.CriticalPoints)
+  {
+    if (point.Vertex == saddle || point.Vertex == pit || point.Vertex == along)
+    {
+      atTheCorner.emplace_back(point.Vertex, point.MorseIndex);
+    }
+  }
+  std::sort(atTheCorner.begin(), atTheCorner.end());
+  CHECK(atTheCorner == (std::vector<std::pair<Index, int>>{ { saddle, 1 }, { pit, 0 } }));
+  // The input's own complex less the pair the sampling takes out: the maximum at (0, 1) (its
+  // whole link lies below it) and the saddle at (1, 0) (the pit (1, 1) is a piece of its lower
+  // link that touches neither boundary neighbour).
+  const auto pointsOf = [](const MorseSmaleComplex& complex) {
+    std::vector<std::pair<Index, int>> points;
+    for (const CriticalPoint& point : complex.CriticalPoints)
+    {
+      points.emplace_back(point.Vertex, point.MorseIndex);
+    }
+    std::sort(points.begin(), points.end());
+    return points;
+  };
+  std::vector<std::pair<Index, int>> expected = pointsOf(wanted);
+  CHECK(std::count(expected.begin(), expected.end(), std::pair<Index, int>{ saddle, 2 }) == 1);
+  CHECK(std::count(expected.begin(), expected.end(), std::pair<Index, int>{ along, 1 }) == 1);
+  expected.erase(std::remove_if(expected.begin(), expected.end(),
+                   [&](const std::pair<Index, int>& p) {
+                     return p == std::pair<Index, int>{ saddle, 2 } || p == std::pair<Index, int>{ along, 1 };
+                   }),
+    expected.end());
+  CHECK(pointsOf(after) == expected);
+  std::printf("  (1, 0) raised from %g to %.6g past the saddle's %g; (1, 1) kept at %g\n", field.Values[along],
+    sampled.Values[along], sampled.Values[saddle], sampled.Values[pit]);
 }
 
 TEST_CASE(ABlockedBoundarySaddleMovesOneStepAlongTheBoundary)
