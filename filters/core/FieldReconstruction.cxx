@@ -359,16 +359,16 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
     this->Cells.SurfaceTolerance = this->SurfaceTolerance * (*highest - *lowest);
   }
   this->Cells.Parallel = this->Parallel;
-  if (IsConstantComplex(complex))
-  {
-    this->ReconstructConstant(field, complex, report);
-    return true;
-  }
   this->Cells.Hooks.Progress = [this](double f) { this->Hooks.Report(0.6 * f); };
   this->Cells.Hooks.AbortRequested = this->Hooks.AbortRequested;
   TriangleMeshTopology mesh;
   std::string ignored; // the input's mesh was checked by stage 1
   BuildMesh(field, mesh, this->Parallel, ignored);
+  if (IsConstantComplex(complex))
+  {
+    this->ReconstructConstant(field, mesh, complex, report);
+    return true;
+  }
   this->Cells.Mesh = &mesh; // for the stiffening rounds: which vertices are neighbours
   this->Cells.StiffeningRounds = this->StiffeningRounds;
   const bool reconstructed = this->Cells.Reconstruct(complex, smoothed, error, &field);
@@ -413,8 +413,8 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
 // cannot be flat: strictly monotone 1-cells of a constant field rise by a spreading of 1e-11
 // of its magnitude, and a 2-cell's Sibson grid of over 500 steps, as at k = 30, leaves too few
 // ulps per step for its monotonicity conditions.)
-void FieldReconstruction::ReconstructConstant(
-  const PlanarScalarField& field, const MorseSmaleComplex& complex, FieldReconstructionReport& report) const
+void FieldReconstruction::ReconstructConstant(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const MorseSmaleComplex& complex, FieldReconstructionReport& report) const
 {
   const double value = complex.CriticalPoints.front().Value;
   const Index n = static_cast<Index>(field.Values.size());
@@ -440,11 +440,7 @@ void FieldReconstruction::ReconstructConstant(
   }
   if (this->VerifyTopology)
   {
-    TriangleMeshTopology mesh;
-    std::string ignored; // the input's mesh was checked by stage 1
-    BuildMesh(field, mesh, this->Parallel, ignored);
-    OneCellSmoothingResult none;
-    this->Verify(field, mesh, complex, none, report);
+    this->Verify(field, mesh, complex, OneCellSmoothingResult(), report);
   }
   this->Hooks.Report(1.0);
 }

@@ -132,8 +132,8 @@ private:
   // Run in the coordinates given (Run maps everything into complex.Frame and back).
   bool RunInFrame(const PlanarScalarField& field, const MorseSmaleComplex& complex,
     const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report, std::string& error);
-  void ReconstructConstant(
-    const PlanarScalarField& field, const MorseSmaleComplex& complex, FieldReconstructionReport& report) const;
+  void ReconstructConstant(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+    const MorseSmaleComplex& complex, FieldReconstructionReport& report) const;
   void EvaluateAtVertices(const PlanarScalarField& field, const MorseSmaleComplex& complex,
     const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const;
   void SampleTopologicallyAtVertices(const PlanarScalarField& field, const TriangleMeshTopology& mesh,

@@ -1002,13 +1002,16 @@ bool MorseSmaleComplexExtraction::Extract(
     {
       PlanarScalarField constant = field;
       std::fill(constant.Values.begin(), constant.Values.end(), *lowest + 0.5 * (*highest - *lowest));
-      this->NearConstantAsConstant = false;
-      const bool extracted = this->Extract(constant, complex, error);
-      this->NearConstantAsConstant = true;
-      this->ReadAsConstant = extracted;
-      return extracted;
+      this->ReadAsConstant = this->ExtractChecked(constant, complex, error);
+      return this->ReadAsConstant;
     }
   }
+  return this->ExtractChecked(field, complex, error);
+}
+
+bool MorseSmaleComplexExtraction::ExtractChecked(
+  const PlanarScalarField& field, MorseSmaleComplex& complex, std::string& error)
+{
   const TriangleMeshTopology* mesh = this->PrepareMesh(field, error);
   if (!mesh)
   {

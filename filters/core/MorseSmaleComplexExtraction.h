@@ -51,6 +51,8 @@ public:
 
 private:
   bool CheckField(const PlanarScalarField& field, std::string& error) const;
+  // Extract after the checks and the near-constant reading: the field's complex as it is.
+  bool ExtractChecked(const PlanarScalarField& field, MorseSmaleComplex& complex, std::string& error);
   const TriangleMeshTopology* PrepareMesh(const PlanarScalarField& field, std::string& error);
 };
 } // namespace topospline

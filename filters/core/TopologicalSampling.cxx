@@ -491,41 +491,27 @@ bool FindWayUp(const Graph& g, const TriangleMeshTopology& mesh, const std::vect
   return true;
 }
 
-// Whether the boundary vertices of a raised `path` (their values before the raise in `before`)
-// kept their order along the boundary curve and are regular by stage 1's boundary rule: one
-// neighbour along the boundary below, one above, and a lower link in one piece (a piece
-// touching neither boundary neighbour would be a saddle). On a boundary vertex the link is a
-// path, so its lower link has as many pieces as vertices less edges.
-bool BoundaryVerticesStayRegular(const TriangleMeshTopology& mesh, const Graph& boundaryCurve,
-  const std::vector<double>& values, const std::vector<Index>& path, const std::vector<double>& before)
+// Whether boundary vertex w, raised from `before`, kept its order along the boundary curve (its
+// neighbours there are not on the raised path: only a way up's first vertex may lie on the
+// boundary) and is regular by stage 1's boundary rule: one neighbour along the boundary below,
+// one above, and a lower link in one piece (a piece touching neither boundary neighbour would be
+// a saddle). On a boundary vertex the link is a path, so its lower link has as many pieces as
+// vertices less edges.
+bool BoundaryVertexStaysRegular(
+  const TriangleMeshTopology& mesh, const Graph& boundaryCurve, const std::vector<double>& values, Index w, double before)
 {
-  for (std::size_t k = 0; k < path.size(); ++k)
+  const Key now{ values[w], w }, then{ before, w };
+  int lowerEnds = 0;
+  for (Index i = boundaryCurve.Start[w]; i < boundaryCurve.Start[w + 1]; ++i)
   {
-    const Index w = path[k];
-    if (!mesh.IsBoundaryVertex(w))
-    {
-      continue;
-    }
-    const Key now{ values[w], w }, then{ before[k], w };
-    int lowerEnds = 0;
-    for (Index i = boundaryCurve.Start[w]; i < boundaryCurve.Start[w + 1]; ++i)
-    {
-      const Index b = boundaryCurve.Adjacent[i];
-      const auto at = std::find(path.begin(), path.end(), b);
-      const double was = at == path.end() ? values[b] : before[static_cast<std::size_t>(at - path.begin())];
-      const bool lowerNow = Key{ values[b], b } < now;
-      if (lowerNow != (Key{ was, b } < then))
-      {
-        return false;
-      }
-      lowerEnds += lowerNow ? 1 : 0;
-    }
-    if (lowerEnds != 1 || LowerLinkKind(mesh, w, [&](Index a) { return Key{ values[a], a } < now; }) != 1)
+    const Key neighbour{ values[boundaryCurve.Adjacent[i]], boundaryCurve.Adjacent[i] };
+    if ((neighbour < now) != (neighbour < then))
     {
       return false;
     }
+    lowerEnds += neighbour < now ? 1 : 0;
   }
-  return true;
+  return lowerEnds == 1 && LowerLinkKind(mesh, w, [&](Index a) { return Key{ values[a], a } < now; }) == 1;
 }
 
 // A wanted boundary saddle (a maximum of the boundary curve) whose whole link is lower is a
@@ -552,8 +538,11 @@ Index RaiseWayUp(const Graph& g, const TriangleMeshTopology& mesh, std::vector<d
   {
     return 0;
   }
+  // Only a way up's first vertex can lie on the boundary (FindWayUp); its check below needs the
+  // path's values back if it fails.
+  const bool onBoundary = boundaryCurve && mesh.IsBoundaryVertex(path.front());
   std::vector<double> before;
-  if (boundaryCurve)
+  if (onBoundary)
   {
     for (Index w : path)
     {
@@ -572,7 +561,7 @@ Index RaiseWayUp(const Graph& g, const TriangleMeshTopology& mesh, std::vector<d
       std::nextafter(previous, std::numeric_limits<double>::infinity()));
     values[path[k]] = previous;
   }
-  if (boundaryCurve && !BoundaryVerticesStayRegular(mesh, *boundaryCurve, values, path, before))
+  if (onBoundary && !BoundaryVertexStaysRegular(mesh, *boundaryCurve, values, path.front(), before.front()))
   {
     for (std::size_t k = 0; k < path.size(); ++k)
     {

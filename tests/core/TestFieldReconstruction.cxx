@@ -217,18 +217,9 @@ TEST_CASE(ConstantFieldsAreReconstructedFlat)
         grid.Values.push_back(1.0 + scale * random.Uniform());
       }
       Pipeline p;
-      p.Field = FieldOnGrid(grid);
-      MorseSmaleComplexExtraction extraction;
-      extraction.NearConstantAsConstant = true;
-      MorseSmaleComplexSimplification simplification;
       std::string error;
-      CHECK(extraction.Extract(p.Field, p.Input, error) && simplification.ComputeHierarchy(p.Input, error) &&
-        simplification.Simplify(10, p.Simplified, error));
-      CHECK(extraction.ReadAsConstant == (scale > 0));
-      const double bounds[4] = { 0, 19, 0, 14 };
-      OneCellSmoothing smoothing;
-      smoothing.Segments = k;
-      CHECK(smoothing.Smooth(p.Simplified.Complex, p.Simplified.JunctionPoints, bounds, p.Smoothed, error));
+      CHECK(RunStages1To3(grid, 10, k, p, error, true));
+      CHECK(p.ReadAsConstant == (scale > 0));
       FieldReconstruction reconstruction;
       FieldReconstructionReport report;
       CHECK(reconstruction.Run(p.Field, p.Simplified.Complex, p.Smoothed, report, error));

@@ -118,14 +118,21 @@ struct Pipeline
   OneCellSmoothingResult Smoothed;
   double Bounds[4] = { 0, 0, 0, 0 };
   double Range = 0;
+  bool ReadAsConstant = false; // stage 1 read a near-constant field as constant
 };
 
-inline bool RunStages1To3(const GridField& grid, double percent, int k, Pipeline& p, std::string& error)
+// `nearConstantAsConstant`: stage 1 as the filter runs it (MorseSmaleComplexExtraction::
+// NearConstantAsConstant).
+inline bool RunStages1To3(const GridField& grid, double percent, int k, Pipeline& p, std::string& error,
+  bool nearConstantAsConstant = false)
 {
   p.Field = FieldOnGrid(grid);
   MorseSmaleComplexExtraction extraction;
+  extraction.NearConstantAsConstant = nearConstantAsConstant;
   MorseSmaleComplexSimplification simplification;
-  if (!extraction.Extract(p.Field, p.Input, error) || !simplification.ComputeHierarchy(p.Input, error) ||
+  const bool extracted = extraction.Extract(p.Field, p.Input, error);
+  p.ReadAsConstant = extraction.ReadAsConstant;
+  if (!extracted || !simplification.ComputeHierarchy(p.Input, error) ||
     !simplification.Simplify(percent, p.Simplified, error))
   {
     return false;
