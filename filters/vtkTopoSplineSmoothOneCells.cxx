@@ -6,10 +6,12 @@
 
 #include "JunctionPointDetection.h" // core
 #include "OneCellSmoothing.h"                // core
+#include "PiecewiseLinearField.h"            // core
 
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkCellType.h>
+#include <vtkDataArray.h>
 #include <vtkDataSet.h>
 #include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
@@ -58,6 +60,7 @@ void WriteSmoothingReport(const topospline::OneCellSmoothingResult& result, int 
   AddFieldNumbers(fd, names::DroppedCuts, { static_cast<double>(result.DroppedCuts) });
   AddFieldNumbers(fd, names::AdaptedPieces, { static_cast<double>(result.AdaptedPieces) });
   AddFieldNumbers(fd, names::RiseKnotPieces, { static_cast<double>(result.RiseKnotPieces) });
+  AddFieldNumbers(fd, names::CurveHeightPieces, { static_cast<double>(result.CurveHeightPieces) });
   AddFieldNumbers(fd, names::RefinedPieces, { static_cast<double>(result.RefinedPieces) });
   AddFieldNumbers(fd, names::PolylinePieces, { static_cast<double>(result.PolylinePieces) });
   AddFieldNumbers(fd, names::RemainingCrossings, { static_cast<double>(result.RemainingCrossings) });
@@ -115,6 +118,21 @@ int vtkTopoSplineSmoothOneCells::RequestData(
   if (vtkDataArray* threshold = input->GetFieldData()->GetArray(names::AbsolutePersistenceThreshold))
   {
     smoothing.HeightTolerance = threshold->GetNumberOfTuples() > 0 ? threshold->GetComponent(0, 0) : 0.0;
+  }
+  // The input field between its vertices, where the smoothed curves run.
+  topospline::PlanarScalarField field;
+  vtkDataArray* original = domain->GetPointData()->GetArray(vtkTopoSplineWireFormat::ScalarFieldNameOf(input).c_str());
+  std::string fieldError;
+  if (original && original->GetNumberOfComponents() == 1 &&
+    vtkTopoSplineDomainConversion::ToPlanarScalarField(domain, original, field, fieldError))
+  {
+    const topospline::PiecewiseLinearField between(field);
+    const topospline::PlanarFrame frame = complex.Frame;
+    smoothing.FieldAt = [between, frame](double x, double y, double& value) {
+      double xy[2] = { x, y };
+      frame.ToWorld(xy);
+      return between.ValueAt(xy[0], xy[1], value);
+    };
   }
   smoothing.Parallel = vtkTopoSplineDomainConversion::SMPParallelFor();
   smoothing.Hooks.Progress = [this](double f) { this->UpdateProgress(0.9 * f); };

@@ -16,7 +16,7 @@
  * per Bezier segment, control points in the plane of the input, point data "Height": the
  * height's Bezier ordinates) and "SampledOneCells" (every 1-cell densely sampled as a
  * polyline with "Height"). Field data: CurveSegments, ShortPieces, AdaptedPieces,
- * RiseKnotPieces, RefinedPieces, RemainingCrossings, PiecesOutsideDomain, L1Error and
+ * RiseKnotPieces, CurveHeightPieces, RefinedPieces, RemainingCrossings, PiecesOutsideDomain, L1Error and
  * UnconstrainedL1Error (sums over the pieces).
  */
 #pragma once

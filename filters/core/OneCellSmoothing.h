@@ -49,6 +49,7 @@ struct SmoothedPiece
   double LargestMiss = 0;          // monotone fit, the largest |height - sample|
   double UnconstrainedL1Error = 0; // the same fit without monotonicity, for comparison
   bool Clamped = false;            // control points were clamped into the domain's box
+  bool HeightAlongCurve = false;   // Height fits the field sampled along Curve, not Values (see FieldAt)
 };
 
 struct OneCellSmoothingResult
@@ -59,6 +60,7 @@ struct OneCellSmoothingResult
   int ShortPieces = 0;         // pieces of fewer edges than k, fitted with fewer segments (a divisor of k)
   int AdaptedPieces = 0;       // pieces whose k was raised to remove crossings
   int RiseKnotPieces = 0;      // pieces whose knots follow their rise (MonotoneBSplineFit::ArcLengthAndRise)
+  int CurveHeightPieces = 0;   // pieces whose height fits the field along their curve (FieldAt)
   int RefinedPieces = 0;       // pieces whose k was doubled because the height missed (HeightTolerance)
   int PolylinePieces = 0;      // of them, pieces that still crossed at their largest k and follow
                                // their jagged 1-cell in straight segments instead
@@ -117,6 +119,13 @@ public:
   // if the piece has more edges than segments. The fallback for pieces that still cross.
   static bool FollowPolyline(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes);
 
+  // The input field at a point (working-frame coordinates), false outside the domain. When
+  // set, a piece whose height, fitted to its jagged path, misses the field sampled along its
+  // smoothed curve by clearly more than it misses the path (by half HeightTolerance, or 5 % of
+  // the piece's rise without one) gets its height fitted to the field along the curve, if that
+  // misses it by less: the surface passes through the curve, not through the path.
+  std::function<bool(double x, double y, double& value)> FieldAt;
+
   ProgressHooks Hooks;
   // The per-piece fits are independent (GLPK keeps its state per thread): they run on this.
   ParallelFor Parallel = SequentialFor;
@@ -142,6 +151,10 @@ private:
   // One piece (its arc-length parameters are derived from its samples on the first fit).
   bool FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments, const double bounds[4],
     std::string& error) const;
+  // FieldAt at curve(t_i) for the piece's interior samples (its ends keep their values);
+  // false if a point lies outside the domain.
+  bool SampledAlongCurve(const SmoothedPiece& piece, const UniformQuadraticBSpline& curve,
+    std::vector<double>& values) const;
 };
 // Applies `map` (an (x, y) in place: a PlanarFrame's ToFrame or ToWorld) to every position of
 // a smoothing: its nodes, the pieces' samples and curves. Heights stay as they are.

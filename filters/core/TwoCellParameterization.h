@@ -15,6 +15,7 @@
 #pragma once
 
 #include "CoreTypes.h"
+#include "TriangleBucketGrid.h"
 
 #include <string>
 #include <vector>
@@ -106,19 +107,6 @@ public:
   // Phi(x, y): the piecewise linear parameterization at (x, y). False outside the cell.
   bool Evaluate(double x, double y, double uv[2]) const;
 
-private:
-  // Uniform grid over the bounding box of some vertex coordinates; cell c holds the triangles
-  // Triangles[Start[c] .. Start[c+1]) that come within Tolerance of it.
-  struct BucketGrid
-  {
-    double Origin[2] = { 0, 0 };
-    double CellSize[2] = { 1, 1 };
-    int Size[2] = { 0, 0 };
-    double Tolerance = 0;
-    std::vector<Index> Start;
-    std::vector<Index> Triangles;
-  };
-
 public:
   // Phi^-1, for as long as the parameterization it was made from lives unchanged. Only the
   // planar Bezier patches need it, and its grid over the square is as large as the one Phi
@@ -136,18 +124,12 @@ public:
     friend class TwoCellParameterization;
     explicit Inverse(const TwoCellMesh& mesh);
     const TwoCellMesh* Mesh;
-    BucketGrid Grid;
+    TriangleBucketGrid Grid;
   };
   Inverse MakeInverse() const { return Inverse(this->Mesh); }
 
 private:
-  static void BuildGrid(const std::vector<double>& coordinates, const std::vector<Index>& triangles, BucketGrid& grid);
-  // The triangle of `grid` in which (x, y) lies deepest; orientation is the sign of the
-  // triangles' areas in `coordinates`.
-  static bool LocateInGrid(const BucketGrid& grid, const std::vector<double>& coordinates,
-    const std::vector<Index>& triangles, int orientation, double x, double y, Index& triangle, double barycentric[3]);
-
   TwoCellMesh Mesh;
-  BucketGrid PointGrid; // over (x, y): Locate, Evaluate
+  TriangleBucketGrid PointGrid; // over (x, y): Locate, Evaluate
 };
 } // namespace topospline
