@@ -29,6 +29,7 @@
 
 #include <algorithm>
 #include <map>
+#include <memory>
 #include <string>
 
 namespace names = vtkTopoSplineArrayNames;
@@ -119,19 +120,20 @@ int vtkTopoSplineSmoothOneCells::RequestData(
   {
     smoothing.HeightTolerance = threshold->GetNumberOfTuples() > 0 ? threshold->GetComponent(0, 0) : 0.0;
   }
-  // The input field between its vertices, where the smoothed curves run.
+  // The input field between its vertices, where the smoothed curves run (kept for as long as
+  // the smoothing runs; without it the heights follow the jagged paths alone).
   topospline::PlanarScalarField field;
+  std::unique_ptr<topospline::PiecewiseLinearField> between;
   vtkDataArray* original = domain->GetPointData()->GetArray(vtkTopoSplineWireFormat::ScalarFieldNameOf(input).c_str());
   std::string fieldError;
   if (original && original->GetNumberOfComponents() == 1 &&
     vtkTopoSplineDomainConversion::ToPlanarScalarField(domain, original, field, fieldError))
   {
-    const topospline::PiecewiseLinearField between(field);
-    const topospline::PlanarFrame frame = complex.Frame;
-    smoothing.FieldAt = [between, frame](double x, double y, double& value) {
+    between = std::make_unique<topospline::PiecewiseLinearField>(field);
+    smoothing.FieldAt = [at = between.get(), frame = complex.Frame](double x, double y, double& value) {
       double xy[2] = { x, y };
       frame.ToWorld(xy);
-      return between.ValueAt(xy[0], xy[1], value);
+      return at->ValueAt(xy[0], xy[1], value);
     };
   }
   smoothing.Parallel = vtkTopoSplineDomainConversion::SMPParallelFor();
