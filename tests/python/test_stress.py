@@ -362,7 +362,11 @@ def worker(cases_file, first):
 
         @calldata_type(VTK_STRING)
         def on_warning(caller, event, text):
-            result["warnings"].append("%s: %s" % (caller.GetClassName(), text.strip()[-300:]))
+            # Without VTK's "Warning: In <file>, line <n> <class> (<address>): " prefix, and
+            # long enough for the verdict's list of spurious and missing points on large cases.
+            message = text.strip()
+            message = message[message.find("): ") + 3:] if "): " in message else message
+            result["warnings"].append("%s: %s" % (caller.GetClassName(), message[:4000]))
 
         for proxy in (ms, simplify, smooth, reconstruct):
             proxy.GetClientSideObject().AddObserver(vtkCommand.ErrorEvent, on_error)
@@ -578,7 +582,7 @@ def main():
                     (": " + "; ".join(problems)) if problems else ""), flush=True)
                 if DIAGNOSE and problems:
                     for warning in r.get("warnings", []):
-                        print("   warning: " + " ".join(warning.split())[-400:], flush=True)
+                        print("   warning: " + " ".join(warning.split()), flush=True)
                     print("   missing (vertex ids by index 0/1/2): %s; extra: %s" % (r.get("missing"), r.get("extra")),
                           flush=True)
             elif line.strip() and current is not None and ("ERR" in line or "rror" in line or "Segmentation" in line):
