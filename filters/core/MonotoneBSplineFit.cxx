@@ -504,18 +504,6 @@ bool StoreInFieldUnits(const std::vector<double>& alpha, double startValue, doub
   return true;
 }
 
-// The L1 and maximum error over the interior samples.
-void MeasureHeightErrors(const std::vector<double>& parameters, const std::vector<double>& values, HeightFit& fit)
-{
-  fit.L1Error = 0;
-  fit.MaximumError = 0;
-  for (std::size_t i = 1; i + 1 < parameters.size(); ++i)
-  {
-    const double e = std::abs(values[i] - fit.Spline.Value(parameters[i]));
-    fit.L1Error += e;
-    fit.MaximumError = std::max(fit.MaximumError, e);
-  }
-}
 // The normal equations of the planar curve fit for its free coefficients c_1..c_k (unknown
 // j - 1), in coordinates relative to `origin`; c_0 and c_k+1 are the end points.
 void AccumulateCurveNormalEquations(const std::vector<double>& parameters, const std::vector<double>& points,
@@ -587,6 +575,19 @@ void AddGrevilleRidge(const std::vector<double>& parameters, const std::vector<d
 }
 } // namespace
 
+//------------------------------------------------------------------------------
+void MonotoneBSplineFit::MeasureHeightErrors(
+  const std::vector<double>& parameters, const std::vector<double>& values, HeightFit& fit)
+{
+  fit.L1Error = 0;
+  fit.MaximumError = 0;
+  for (std::size_t i = 1; i + 1 < parameters.size(); ++i)
+  {
+    const double e = std::abs(values[i] - fit.Spline.Value(parameters[i]));
+    fit.L1Error += e;
+    fit.MaximumError = std::max(fit.MaximumError, e);
+  }
+}
 
 //------------------------------------------------------------------------------
 std::vector<double> MonotoneBSplineFit::NormalizedArcLength(const std::vector<double>& points)

@@ -90,6 +90,12 @@ public:
   bool FitPlanarCurve(const std::vector<double>& parameters, const std::vector<double>& points,
     PlanarCurveFit& fit, std::string& error) const;
 
+  // fit.L1Error and fit.MaximumError of fit.Spline against (parameters[i], values[i]) over the
+  // interior samples (FitHeight measures its fits so; another set of values measures a fit
+  // against them).
+  static void MeasureHeightErrors(const std::vector<double>& parameters, const std::vector<double>& values,
+    HeightFit& fit);
+
   // Normalized arc length of a polyline (x, y pairs): t_0 = 0, t_n = 1. A polyline of zero
   // length gets uniform parameters i / n.
   static std::vector<double> NormalizedArcLength(const std::vector<double>& points);

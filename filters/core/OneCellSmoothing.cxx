@@ -1722,20 +1722,6 @@ PathDeviation DeviationFromPath(const UniformQuadraticBSpline& curve, const std:
   }
   return deviation;
 }
-
-// The largest |g(t_i) - values[i]| over the interior samples.
-double LargestMiss(const UniformQuadraticBSpline& g, const std::vector<double>& parameters,
-  const std::vector<double>& values)
-{
-  double largest = 0;
-  for (std::size_t i = 1; i + 1 < values.size(); ++i)
-  {
-    double h;
-    g.Evaluate(parameters[i], &h);
-    largest = std::max(largest, std::abs(h - values[i]));
-  }
-  return largest;
-}
 } // namespace
 
 bool OneCellSmoothing::SampledAlongCurve(
@@ -1840,7 +1826,9 @@ bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<Smoothin
   if (this->FieldAt && this->SampledAlongCurve(piece, curve.Spline, alongCurve))
   {
     const double margin = this->HeightTolerance > 0 ? 0.5 * this->HeightTolerance : 0.05 * (b - a);
-    const double pathMiss = LargestMiss(height.Spline, piece.Parameters, alongCurve);
+    HeightFit pathHeight = height;
+    MonotoneBSplineFit::MeasureHeightErrors(piece.Parameters, alongCurve, pathHeight);
+    const double pathMiss = pathHeight.MaximumError;
     HeightFit curveHeight;
     std::string ignored;
     if (pathMiss > height.MaximumError + margin &&
