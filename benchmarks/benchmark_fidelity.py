@@ -20,11 +20,14 @@ Inputs: the Trigonometric Field at 0 %; Shepard fields (250^2, 50 sites) of seed
 25 %; every DEM shipped in tests/data at 2 and 5 %. k = 4, except the Rainier crop (k = 7, the
 paper's). STDThread on 2 threads.
 
-Usage: pvpython benchmarks/benchmark_fidelity.py [--quick] [--seeds FIRST-LAST] [--fitted-only] [--json FILE]
+Usage: pvpython benchmarks/benchmark_fidelity.py [--quick] [--seeds FIRST-LAST] [--fitted-only]
+                                                 [--alternative-map-strength S] [--json FILE]
   --quick: Shepard seeds 0-3 only.
   --seeds FIRST-LAST: the Shepard fields of these seeds only (no Trigonometric Field, no DEMs):
       the same measurements on fields the tests and the tables above never saw.
-  --fitted-only: the fitted interiors only (half the time)."""
+  --fitted-only: the fitted interiors only (half the time).
+  --alternative-map-strength S: stage 4's Alternative Map Strength (default: the filter's own;
+      0: the mean value map everywhere)."""
 import heapq
 import json
 import os
@@ -45,6 +48,8 @@ if "--seeds" in sys.argv:
     first, _, last = sys.argv[sys.argv.index("--seeds") + 1].partition("-")
     SEEDS = range(int(first), int(last or first) + 1)
 FITTED_ONLY = "--fitted-only" in sys.argv
+STRENGTH = (float(sys.argv[sys.argv.index("--alternative-map-strength") + 1])
+            if "--alternative-map-strength" in sys.argv else None)
 
 DEMS = ["r_volcano_maunga_whau.vti", "rainier_ned1_1970_crop458x306.vti", "sainthelens_usgs_dem_crop.vti",
         "msh_crater_2007_10m.vti", "ttk_happi_tas_anomaly.vti"]
@@ -136,6 +141,8 @@ def run(make_source, percent, k, interior, name):
     smooth.UpdatePipeline()
     stage4_start = time.perf_counter()
     reconstruct = Reconstruct2Cells(Input=smooth, Interior=interior)
+    if STRENGTH is not None:
+        reconstruct.AlternativeMapStrength = STRENGTH
     reconstruct.UpdatePipeline()
     end = time.perf_counter()
     out = sm.Fetch(reconstruct)

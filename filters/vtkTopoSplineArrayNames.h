@@ -141,6 +141,7 @@ constexpr const char* MaximumGridSize = "MaximumGridSize";
 constexpr const char* FittedCells = "FittedCells";
 constexpr const char* RefinedCells = "RefinedCells";
 constexpr const char* StiffenedCells = "StiffenedCells";
+constexpr const char* RemappedCells = "RemappedCells";
 constexpr const char* SnappedPoints = "SnappedPoints";
 constexpr const char* PointsOnOneCells = "PointsOnOneCells";
 constexpr const char* UnreconstructedPoints = "UnreconstructedPoints";

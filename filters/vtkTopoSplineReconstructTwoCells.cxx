@@ -281,6 +281,7 @@ void WriteReport(const topospline::FieldReconstructionReport& report, vtkFieldDa
   AddFieldNumbers(fd, names::FittedCells, { static_cast<double>(cells.FittedCells) });
   AddFieldNumbers(fd, names::RefinedCells, { static_cast<double>(cells.RefinedCells) });
   AddFieldNumbers(fd, names::StiffenedCells, { static_cast<double>(cells.StiffenedCells) });
+  AddFieldNumbers(fd, names::RemappedCells, { static_cast<double>(cells.RemappedCells) });
   AddFieldNumbers(fd, names::SnappedPoints, { static_cast<double>(report.SnappedPoints) });
   AddFieldNumbers(fd, names::PointsOnOneCells, { static_cast<double>(report.PointsOnOneCells) });
   AddFieldNumbers(fd, names::UnreconstructedPoints, { static_cast<double>(report.UnreconstructedPoints) });
@@ -415,6 +416,7 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
   reconstruction.BoundarySamples = this->BoundarySamples;
   reconstruction.Interior = this->Interior == INTERIOR_PAPER ? topospline::TwoCellInterior::Paper
                                                               : topospline::TwoCellInterior::Fitted;
+  reconstruction.AlternativeMapStrength = this->AlternativeMapStrength;
   reconstruction.SurfaceTolerance = this->SurfaceTolerance / 100.0;
   reconstruction.OutputResolution = this->OutputResolution;
   reconstruction.TopologicalSampling = this->TopologicalSampling != 0;
@@ -551,6 +553,7 @@ void vtkTopoSplineReconstructTwoCells::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "BoundarySamples: " << this->BoundarySamples << "\n"
      << indent << "Interior: " << (this->Interior == INTERIOR_PAPER ? "Paper" : "Fitted") << "\n"
      << indent << "SurfaceTolerance: " << this->SurfaceTolerance << "\n"
+     << indent << "AlternativeMapStrength: " << this->AlternativeMapStrength << "\n"
      << indent << "OutputResolution: " << this->OutputResolution << "\n"
      << indent << "TopologicalSampling: " << this->TopologicalSampling << "\n"
      << indent << "VerifyTopology: " << this->VerifyTopology << "\n";

@@ -75,6 +75,20 @@ public:
   //@}
 
   //@{
+  /**
+   * Fitted interiors: the cell whose fit misses the input most is fitted again on two other
+   * maps onto the square, the mean value weights reweighted by the input's gradient (edges
+   * along its gradient, then edges along its level sets, pulling up to this factor + 1 times
+   * harder than the others), and keeps a fit whose largest miss is at least 10 % smaller; then
+   * the next, while each is improved and misses by more than three times the surface
+   * tolerance. Field data "RemappedCells" counts them. 0: the mean value map everywhere (the
+   * paper's).
+   */
+  vtkSetClampMacro(AlternativeMapStrength, double, 0.0, 1000.0);
+  vtkGetMacro(AlternativeMapStrength, double);
+  //@}
+
+  //@{
   /** Refinement factor of the resampled image on output port 2; 1 produces no image. */
   vtkSetMacro(OutputResolution, int);
   vtkGetMacro(OutputResolution, int);
@@ -120,6 +134,7 @@ protected:
   int BoundarySamples = 5;
   int Interior = INTERIOR_FITTED;
   double SurfaceTolerance = 1.0;
+  double AlternativeMapStrength = 30.0;
   int OutputResolution = 1;
   bool VerifyTopology = true;
   bool TopologicalSampling = true;

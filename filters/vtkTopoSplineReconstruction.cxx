@@ -78,6 +78,7 @@ int vtkTopoSplineReconstruction::RequestData(
   this->Smooth->SetCurveSegments(this->CurveSegments);
   this->Reconstruct->SetInterior(this->Interior);
   this->Reconstruct->SetSurfaceTolerance(this->SurfaceTolerance);
+  this->Reconstruct->SetAlternativeMapStrength(this->AlternativeMapStrength);
   this->Reconstruct->SetVerifyTopology(this->VerifyTopology);
   this->UpdateProgress(0.0);
   this->Reconstruct->Update();
@@ -102,5 +103,6 @@ void vtkTopoSplineReconstruction::PrintSelf(ostream& os, vtkIndent indent)
      << indent << "CurveSegments: " << this->CurveSegments << "\n"
      << indent << "Interior: " << (this->Interior ? "Fitted" : "Paper") << "\n"
      << indent << "SurfaceTolerance: " << this->SurfaceTolerance << "\n"
+     << indent << "AlternativeMapStrength: " << this->AlternativeMapStrength << "\n"
      << indent << "VerifyTopology: " << this->VerifyTopology << "\n";
 }

@@ -54,6 +54,12 @@ public:
   //@}
 
   //@{
+  /** Stage 4: strength of the alternative maps of fitted interiors (0: none); see vtkTopoSplineReconstructTwoCells. */
+  vtkSetClampMacro(AlternativeMapStrength, double, 0.0, 1000.0);
+  vtkGetMacro(AlternativeMapStrength, double);
+  //@}
+
+  //@{
   /** The built-in topology check of stage 4. */
   vtkSetMacro(VerifyTopology, bool);
   vtkGetMacro(VerifyTopology, bool);
@@ -71,6 +77,7 @@ protected:
   int CurveSegments = 4;
   int Interior = 1;
   double SurfaceTolerance = 1.0;
+  double AlternativeMapStrength = 30.0;
   bool VerifyTopology = true;
 
 private:

@@ -352,6 +352,7 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
   this->Cells.MinimumMeshEdgeLength = 2 * edge;
   this->Cells.NegligibleArea = edge * edge;
   this->Cells.Interior = this->Interior;
+  this->Cells.AlternativeMapStrength = this->AlternativeMapStrength;
   this->Cells.MemoryBudget = this->MemoryBudget;
   if (!field.Values.empty())
   {

@@ -89,6 +89,9 @@ public:
   // The 2-cell interiors (TwoCellReconstruction::Interior): fitted to the input by default, the
   // paper's boundary-only construction on request (Table 1 as the paper defines it).
   TwoCellInterior Interior = TwoCellInterior::Fitted;
+  // Fitted interiors: the cells that miss the data most are fitted again on alternative maps
+  // onto the square (TwoCellReconstruction::AlternativeMapStrength); 0: the mean value map.
+  double AlternativeMapStrength = 30;
   // Fitted interiors: a cell's grid is refined while its largest residual exceeds this fraction
   // of the input's value range (<= 0: no refinement).
   double SurfaceTolerance = 0.01;

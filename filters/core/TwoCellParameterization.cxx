@@ -1,5 +1,6 @@
 #include "TwoCellParameterization.h"
 
+#include "PiecewiseLinearField.h"
 #include "PlanarGeometry.h"
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
@@ -1045,8 +1046,71 @@ struct MeanValueSystem
   Eigen::MatrixXd RightSide;                       // sum over boundary j of w_ij uv_j
 };
 
-// False if a weight is zero or not finite (a degenerate triangle).
-bool AssembleMeanValueSystem(const TwoCellMesh& mesh, MeanValueSystem& system)
+// The field's gradient at each interior vertex of the mesh: the area-weighted mean of the
+// gradients of the triangles around it (the field linear on each triangle through its values at
+// the mesh vertices; triangles with a NaN value are left out). (0, 0) where none is known.
+std::vector<double> InteriorGradients(const TwoCellMesh& mesh, const std::vector<double>& values)
+{
+  const Index boundaryCount = mesh.BoundaryCount;
+  const Index interiorCount = mesh.NumberOfPoints() - boundaryCount;
+  const std::vector<double>& p = mesh.Points;
+  std::vector<double> gradients(2 * static_cast<std::size_t>(interiorCount), 0.0), areas(interiorCount, 0.0);
+  for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
+  {
+    const Index* tri = &mesh.Triangles[3 * t];
+    const double f0 = values[tri[0]], f1 = values[tri[1]], f2 = values[tri[2]];
+    if (!std::isfinite(f0) || !std::isfinite(f1) || !std::isfinite(f2))
+    {
+      continue;
+    }
+    const double ax = p[2 * tri[1]] - p[2 * tri[0]], ay = p[2 * tri[1] + 1] - p[2 * tri[0] + 1];
+    const double bx = p[2 * tri[2]] - p[2 * tri[0]], by = p[2 * tri[2] + 1] - p[2 * tri[0] + 1];
+    const double cross = ax * by - ay * bx; // twice the signed area
+    if (cross == 0)
+    {
+      continue;
+    }
+    // Area times gradient: (df1 (by, -bx) + df2 (-ay, ax)) / 2, signed by the orientation (the
+    // gradient's 1 / cross cancels the area's cross).
+    const double sign = cross > 0 ? 1 : -1;
+    const double gx = 0.5 * sign * ((f1 - f0) * by - (f2 - f0) * ay);
+    const double gy = 0.5 * sign * ((f2 - f0) * ax - (f1 - f0) * bx);
+    for (int k = 0; k < 3; ++k)
+    {
+      if (tri[k] >= boundaryCount)
+      {
+        gradients[2 * (tri[k] - boundaryCount)] += gx;
+        gradients[2 * (tri[k] - boundaryCount) + 1] += gy;
+        areas[tri[k] - boundaryCount] += 0.5 * std::abs(cross);
+      }
+    }
+  }
+  for (Index i = 0; i < interiorCount; ++i)
+  {
+    if (areas[i] > 0)
+    {
+      gradients[2 * i] /= areas[i];
+      gradients[2 * i + 1] /= areas[i];
+    }
+  }
+  return gradients;
+}
+
+// The reweighting of TwoCellParameterization::WeightByFieldGradient: the field at every mesh
+// vertex (NaN: unknown), the strength (> 0) and which edges it strengthens.
+struct FieldGradientWeights
+{
+  const std::vector<double>* Values = nullptr;
+  double Strength = 0;
+  GradientWeighting Weighting = GradientWeighting::AlongLevelSets;
+};
+
+// False if a weight is zero or not finite (a degenerate triangle). With `reweighting`, each
+// weight w_ij of an interior vertex i is multiplied by 1 / (1 / strength + c^2), c the cosine
+// (or the sine) of the angle between edge ij and the field's gradient at i, damped where the
+// field is nearly flat (TwoCellParameterization::WeightByFieldGradient).
+bool AssembleMeanValueSystem(
+  const TwoCellMesh& mesh, MeanValueSystem& system, const FieldGradientWeights* reweighting = nullptr)
 {
   const Index boundaryCount = mesh.BoundaryCount;
   const Index interiorCount = mesh.NumberOfPoints() - boundaryCount;
@@ -1057,6 +1121,46 @@ bool AssembleMeanValueSystem(const TwoCellMesh& mesh, MeanValueSystem& system)
   diagonal.assign(interiorCount, 0);
   Eigen::MatrixXd& rhs = system.RightSide;
   rhs = Eigen::MatrixXd::Zero(interiorCount, 2);
+  const bool reweighted = reweighting != nullptr;
+  std::vector<double> gradients;
+  // The slope below which a vertex counts as flat: a tenth of the cell's mean one (its range
+  // over its size), so that the noise of a nearly flat stretch does not orient its weights.
+  double flatSlope = 0;
+  if (reweighted)
+  {
+    const std::vector<double>& values = *reweighting->Values;
+    gradients = InteriorGradients(mesh, values);
+    double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
+    double xmin = lowest, xmax = highest, ymin = lowest, ymax = highest;
+    for (Index v = 0; v < mesh.NumberOfPoints(); ++v)
+    {
+      if (std::isfinite(values[v]))
+      {
+        lowest = std::min(lowest, values[v]);
+        highest = std::max(highest, values[v]);
+      }
+      xmin = std::min(xmin, p[2 * v]);
+      xmax = std::max(xmax, p[2 * v]);
+      ymin = std::min(ymin, p[2 * v + 1]);
+      ymax = std::max(ymax, p[2 * v + 1]);
+    }
+    const double size = std::hypot(xmax - xmin, ymax - ymin);
+    flatSlope = highest > lowest && size > 0 ? 0.1 * (highest - lowest) / size : 0.0;
+  }
+  // The factor of edge (ex, ey) leaving interior vertex i.
+  auto factor = [&](Index i, double ex, double ey) {
+    const double gx = gradients[2 * (i - boundaryCount)], gy = gradients[2 * (i - boundaryCount) + 1];
+    const double length = std::hypot(ex, ey), slope = std::hypot(gx, gy);
+    if (!(length > 0) || !(slope + flatSlope > 0))
+    {
+      return 1.0;
+    }
+    const double cosine = std::abs(gx * ex + gy * ey) / (length * (slope + flatSlope));
+    const double c = reweighting->Weighting == GradientWeighting::AlongLevelSets
+      ? cosine
+      : std::sqrt(std::max(0.0, 1 - cosine * cosine));
+    return 1 / (1 / reweighting->Strength + c * c);
+  };
   bool finite = true;
   for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
   {
@@ -1072,7 +1176,12 @@ bool AssembleMeanValueSystem(const TwoCellMesh& mesh, MeanValueSystem& system)
       const double ax = p[2 * j] - p[2 * i], ay = p[2 * j + 1] - p[2 * i + 1];
       const double bx = p[2 * l] - p[2 * i], by = p[2 * l + 1] - p[2 * i + 1];
       const double tangent = HalfAngleTangent(ax, ay, bx, by);
-      const double weights[2] = { tangent / std::hypot(ax, ay), tangent / std::hypot(bx, by) };
+      double weights[2] = { tangent / std::hypot(ax, ay), tangent / std::hypot(bx, by) };
+      if (reweighted)
+      {
+        weights[0] *= factor(i, ax, ay);
+        weights[1] *= factor(i, bx, by);
+      }
       const Index neighbors[2] = { j, l };
       for (int s = 0; s < 2; ++s)
       {
@@ -1097,7 +1206,8 @@ bool AssembleMeanValueSystem(const TwoCellMesh& mesh, MeanValueSystem& system)
 }
 
 // (u, v) of the interior vertices from the mean value system.
-bool SolveMeanValueCoordinates(TwoCellMesh& mesh, std::string& error)
+bool SolveMeanValueCoordinates(
+  TwoCellMesh& mesh, std::string& error, const FieldGradientWeights* reweighting = nullptr)
 {
   const Index boundaryCount = mesh.BoundaryCount;
   const Index interiorCount = mesh.NumberOfPoints() - boundaryCount;
@@ -1106,7 +1216,7 @@ bool SolveMeanValueCoordinates(TwoCellMesh& mesh, std::string& error)
     return true;
   }
   MeanValueSystem system;
-  if (!AssembleMeanValueSystem(mesh, system))
+  if (!AssembleMeanValueSystem(mesh, system, reweighting))
   {
     error = "TwoCellParameterization: degenerate triangle (zero or non-finite mean value weight)";
     return false;
@@ -1310,6 +1420,30 @@ bool TwoCellParameterization::Parameterize(
   mesh.Triangles.shrink_to_fit();
   this->PointGrid.Build(mesh.Points, mesh.Triangles);
   return true;
+}
+
+bool TwoCellParameterization::WeightByFieldGradient(
+  const PiecewiseLinearField& field, double strength, GradientWeighting weighting, std::string& error)
+{
+  TwoCellMesh& mesh = this->Mesh;
+  if (mesh.NumberOfTriangles() == 0 || !(strength > 0))
+  {
+    error = "TwoCellParameterization: no mesh to map again, or a strength that is not positive";
+    return false;
+  }
+  std::vector<double> values(mesh.NumberOfPoints());
+  for (Index v = 0; v < mesh.NumberOfPoints(); ++v)
+  {
+    double value;
+    values[v] = field.ValueAt(mesh.Points[2 * v], mesh.Points[2 * v + 1], value)
+      ? value
+      : std::numeric_limits<double>::quiet_NaN();
+  }
+  FieldGradientWeights reweighting;
+  reweighting.Values = &values;
+  reweighting.Strength = strength;
+  reweighting.Weighting = weighting;
+  return SolveMeanValueCoordinates(mesh, error, &reweighting) && CheckOneToOne(mesh, error);
 }
 
 bool TwoCellParameterization::Locate(double x, double y, Index& triangle, double barycentric[3]) const

@@ -5,6 +5,8 @@
 // value coordinates with the boundary fixed on the border of the square. A point location
 // grid then evaluates Phi(x, y) anywhere in the cell, which is what F o Phi needs; Phi^-1(u, v)
 // is made on request (TwoCellParameterization::Inverse), with a second grid over the square.
+// Other maps on the same mesh, their weights reweighted by the input's gradient, are made on
+// request too (WeightByFieldGradient): stage 4 tries them where a fit misses the data most.
 //
 // Pouch cells: the boundary walk may run out along a slit (a tree of boundary edges hanging
 // from the outer loop into the cell) and straight back. The mesh is then cut open along the
@@ -22,6 +24,15 @@
 
 namespace topospline
 {
+class PiecewiseLinearField;
+
+// Which edges TwoCellParameterization::WeightByFieldGradient strengthens.
+enum class GradientWeighting
+{
+  AlongLevelSets,
+  AlongGradient
+};
+
 // The triangulated cell and its parameterization.
 struct TwoCellMesh
 {
@@ -95,6 +106,23 @@ public:
   // stretch, each sampled its own way, get each other's samples (a slit then); a loop that
   // touches itself at a point (a pinched cell) is opened there by 1e-3 of an edge.
   bool Parameterize(const std::vector<double>& boundaryPoints, const std::vector<double>& boundaryParameters,
+    std::string& error);
+
+  // Another map on the mesh of the last successful Parameterize (same triangles, same boundary
+  // (u, v)): each mean value weight w_ij of an interior vertex i is multiplied by
+  // 1 / (1 / strength + c^2), c the cosine (AlongGradient: the sine) of the angle between edge
+  // ij and the gradient of `field` at i (damped where the field is nearly flat). AlongLevelSets:
+  // edges along the field's level sets pull up to strength + 1 times harder than edges across
+  // them; AlongGradient the other way round. The weights stay positive, so Phi stays one-to-one
+  // (Floater). Along the gradient, the flow lines from a cell's minimum pull hardest: around a
+  // minimum the cell wraps 360 degrees (the tip of a slit), the round level sets then rise
+  // along (1, 1) of the square, with a sixth of the mean value map's falling pairs
+  // (TestTwoCellParameterization). Along the level sets does not straighten the level curves
+  // as one might hope (the weights' ratio is bounded by the mesh's angles, and a level curve
+  // dozens of edges long stays bent); it spreads the cell differently, which some fits follow
+  // better (TwoCellReconstruction::AlternativeMapStrength tries both). False, with the mesh's
+  // (u, v) unusable, if the map could not be made one-to-one (work on a copy).
+  bool WeightByFieldGradient(const PiecewiseLinearField& field, double strength, GradientWeighting weighting,
     std::string& error);
 
   // The result of the last successful Parameterize (empty otherwise).

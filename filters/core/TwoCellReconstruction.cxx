@@ -2,6 +2,8 @@
 
 #include "BezierSpline.h"
 
+#include "PiecewiseLinearField.h"
+
 #include "PlanarGeometry.h"
 
 #include <Eigen/Dense>
@@ -11,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <sstream>
@@ -683,7 +686,16 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
   {
     return false;
   }
-  std::vector<char> refined(n, 0), stiffened(n, 0);
+  std::vector<char> refined(n, 0), stiffened(n, 0), remapped(n, 0);
+  auto samplesOf = [&](Index c) {
+    std::vector<SurfaceSample> samples;
+    samples.reserve(firstVertex[c + 1] - firstVertex[c]);
+    for (Index k = firstVertex[c]; k < firstVertex[c + 1]; ++k)
+    {
+      samples.push_back({ parameters[2 * vertices[k]], parameters[2 * vertices[k] + 1], data->Values[vertices[k]] });
+    }
+    return samples;
+  };
   this->Parallel(0, n, [&](Index begin, Index end) {
     for (Index c = begin; c < end && !this->Hooks.Aborted(); ++c)
     {
@@ -691,17 +703,50 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
       BuildSurface(cell, boundaries[c]);
       if (fit && cell.Valid)
       {
-        std::vector<SurfaceSample> samples;
-        samples.reserve(firstVertex[c + 1] - firstVertex[c]);
-        for (Index k = firstVertex[c]; k < firstVertex[c + 1]; ++k)
-        {
-          samples.push_back({ parameters[2 * vertices[k]], parameters[2 * vertices[k] + 1], data->Values[vertices[k]] });
-        }
-        refined[c] = this->FitSurface(cell, boundaries[c], samples);
-        if (stiffen && cell.Surface.FitReport().Fitted)
-        {
-          stiffened[c] = this->StiffenWhereSamplingBreaks(cell, samples, vertices.data() + firstVertex[c], ringInCell);
-        }
+        refined[c] = this->FitSurface(cell, boundaries[c], samplesOf(c));
+      }
+    }
+  });
+  // The largest misses get their second chance on the alternative maps (AlternativeMapStrength):
+  // the cells from the one that misses most down, while each is improved (a cell that is not
+  // keeps the largest miss where it is) and misses by more than AlternativeMapTrigger times
+  // the tolerance. Then the stiffening, on the maps kept.
+  std::vector<std::vector<SurfaceSample>> remappedSamples(n);
+  if (fit && this->AlternativeMapStrength > 0)
+  {
+    const PiecewiseLinearField field(*data);
+    std::vector<std::pair<double, Index>> misses;
+    for (Index c = 0; c < n; ++c)
+    {
+      const ReconstructedTwoCell& cell = *this->Cells[c];
+      if (cell.Valid && cell.Surface.FitReport().Fitted &&
+        cell.Surface.FitReport().MaximumResidual > AlternativeMapTrigger * this->SurfaceTolerance)
+      {
+        misses.emplace_back(cell.Surface.FitReport().MaximumResidual, c);
+      }
+    }
+    std::sort(misses.begin(), misses.end(), std::greater<>());
+    for (const auto& miss : misses)
+    {
+      const Index c = miss.second;
+      std::vector<SurfaceSample> samples = samplesOf(c);
+      if (this->Hooks.Aborted() ||
+        !this->FitOnAlternativeMaps(*this->Cells[c], boundaries[c], field, *data, vertices.data() + firstVertex[c], samples))
+      {
+        break;
+      }
+      remapped[c] = 1;
+      remappedSamples[c] = std::move(samples);
+    }
+  }
+  this->Parallel(0, n, [&](Index begin, Index end) {
+    for (Index c = begin; c < end && !this->Hooks.Aborted(); ++c)
+    {
+      ReconstructedTwoCell& cell = *this->Cells[c];
+      if (stiffen && cell.Valid && cell.Surface.FitReport().Fitted)
+      {
+        const std::vector<SurfaceSample> samples = remapped[c] ? std::move(remappedSamples[c]) : samplesOf(c);
+        stiffened[c] = this->StiffenWhereSamplingBreaks(cell, samples, vertices.data() + firstVertex[c], ringInCell);
       }
     }
   });
@@ -712,6 +757,7 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
   }
   this->Summary.RefinedCells = std::count(refined.begin(), refined.end(), 1);
   this->Summary.StiffenedCells = std::count(stiffened.begin(), stiffened.end(), 1);
+  this->Summary.RemappedCells = std::count(remapped.begin(), remapped.end(), 1);
   this->Summary.SurfaceSeconds = Seconds(start);
   this->Summarize();
   this->BuildCellLocator();
@@ -910,6 +956,69 @@ bool TwoCellReconstruction::FitSurface(ReconstructedTwoCell& cell, const Monoton
     refined = true;
   }
   return refined;
+}
+
+bool TwoCellReconstruction::FitOnAlternativeMaps(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided,
+  const PiecewiseLinearField& field, const PlanarScalarField& data, const Index* vertices,
+  std::vector<SurfaceSample>& samples) const
+{
+  // Every alternative starts from the mean value map's mesh, and is fitted once at the grid
+  // the mean value map's fit ended with (its refinement already chose it: refining again for
+  // each map would cost more than the rest of the fit).
+  const TwoCellParameterization meanValue = cell.Parameterization;
+  MonotoneSurfaceBoundary atGrid = subdivided;
+  const int gridSize = cell.GridSize;
+  if (static_cast<int>(subdivided.Bottom.size()) != gridSize &&
+    (!SubdivideSide(subdivided.Bottom, gridSize, atGrid.Bottom) || !SubdivideSide(subdivided.Right, gridSize, atGrid.Right) ||
+      !SubdivideSide(subdivided.Top, gridSize, atGrid.Top) || !SubdivideSide(subdivided.Left, gridSize, atGrid.Left)))
+  {
+    return false;
+  }
+  // Both maps and fits at once (the cells come here one at a time), then kept in this order.
+  const GradientWeighting weightings[2] = { GradientWeighting::AlongGradient, GradientWeighting::AlongLevelSets };
+  ReconstructedTwoCell trials[2];
+  std::vector<SurfaceSample> moved[2] = { samples, samples };
+  bool fitted[2] = { false, false };
+  this->Parallel(0, 2, [&](Index begin, Index end) {
+    for (Index t = begin; t < end; ++t)
+    {
+      ReconstructedTwoCell& trial = trials[t];
+      trial.Parameterization = meanValue;
+      std::string message;
+      if (!trial.Parameterization.WeightByFieldGradient(field, this->AlternativeMapStrength, weightings[t], message))
+      {
+        continue;
+      }
+      bool located = true;
+      for (std::size_t k = 0; k < moved[t].size() && located; ++k)
+      {
+        double uv[2];
+        located = trial.Parameterization.Evaluate(data.Points[2 * vertices[k]], data.Points[2 * vertices[k] + 1], uv);
+        moved[t][k].U = uv[0];
+        moved[t][k].V = uv[1];
+      }
+      trial.Valid = located;
+      BuildSurface(trial, atGrid);
+      fitted[t] = trial.Valid && trial.Surface.FitToSamples(moved[t], message, this->Fit) &&
+        trial.Surface.FitReport().Fitted;
+    }
+  });
+  bool kept = false;
+  for (int t = 0; t < 2; ++t)
+  {
+    const MonotoneSurfaceFitReport& best = cell.Surface.FitReport();
+    const MonotoneSurfaceFitReport& after = trials[t].Surface.FitReport();
+    if (!fitted[t] || !(after.MaximumResidual < AlternativeMapGain * best.MaximumResidual) ||
+      after.RMSResidual > AlternativeMapRMSGrowth * best.RMSResidual)
+    {
+      continue;
+    }
+    cell.Parameterization = std::move(trials[t].Parameterization);
+    cell.Surface = std::move(trials[t].Surface);
+    samples = std::move(moved[t]);
+    kept = true;
+  }
+  return kept;
 }
 
 // A monotone F has no critical point, but sampled at the vertices, a ridge or a trough that

@@ -116,6 +116,7 @@ struct TwoCellReconstructionReport
   Index FittedCells = 0;       // interiors fitted to the input samples (Interior == Fitted)
   Index RefinedCells = 0;      // of them, cells whose grid was refined beyond the sides' need
   Index StiffenedCells = 0;    // of them, cells whose fit was stiffened (StiffeningRounds)
+  Index RemappedCells = 0;     // of them, cells fitted on an alternative map (AlternativeMapStrength)
   Index MeshTriangles = 0;     // triangles of all cell meshes
   Index CrowdedTriangles = 0;  // of them, flattened in (u, v) by rounding (TwoCellMesh::CrowdedTriangles)
   Index BezierTriangles = 0;   // 4 N^2 per cell
@@ -160,6 +161,19 @@ public:
   // the nearest cell boundary).
   double NegligibleArea = 0;
   TwoCellInterior Interior = TwoCellInterior::Paper;
+  // Fitted interiors: the mean value map is one choice among many, and where a fit misses the
+  // data most, another map often lets the same surface follow it better (the largest misses sit
+  // next to wide corners, an extremum the cell wraps around, where the mean value map spreads
+  // the data so that it falls along (1, 1)). The cell that misses most is fitted again on two
+  // maps whose mean value weights are reweighted by the input's gradient
+  // (TwoCellParameterization::WeightByFieldGradient with this strength, along its gradient and
+  // along its level sets) and keeps the best fit (FitOnAlternativeMaps); then the next, while
+  // each is improved and misses by more than AlternativeMapTrigger times SurfaceTolerance.
+  // 0: the mean value map everywhere (the paper's).
+  double AlternativeMapStrength = 0;
+  static constexpr double AlternativeMapTrigger = 3;
+  static constexpr double AlternativeMapGain = 0.9;
+  static constexpr double AlternativeMapRMSGrowth = 1.1;
   // Fitted interiors: a cell's grid is doubled (its boundary Beziers split exactly) while its
   // largest residual exceeds this (in the field's units; <= 0: never), up to
   // MaximumRefinedGridSize, while every grid cell keeps a few samples and each doubling gains
@@ -230,6 +244,13 @@ public:
 private:
   void ParameterizeCell(const TwoCell& twoCell, const OneCellSmoothingResult& smoothed, ReconstructedTwoCell& cell,
     MonotoneSurfaceBoundary& boundary) const;
+  // The cell's fit tried again on the alternative maps (AlternativeMapStrength), from the mean
+  // value map's mesh, at the grid size its fit chose; each is kept, with its map and its samples' (u, v), if its largest
+  // residual is below AlternativeMapGain times the best so far and its RMS residual at most
+  // AlternativeMapRMSGrowth times. Returns whether one was kept.
+  bool FitOnAlternativeMaps(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided,
+    const PiecewiseLinearField& field, const PlanarScalarField& data, const Index* vertices,
+    std::vector<SurfaceSample>& samples) const;
   static void BuildSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided);
   // The finest grid FitSurface's refinement may reach from `gridSize` with `samples` input
   // samples in the cell: doubling while every grid cell keeps 4 samples, up to

@@ -397,6 +397,80 @@ TEST_CASE(StiffeningTakesCrestsOutOfTheCells)
   CHECK(2 * after <= before);
 }
 
+TEST_CASE(AlternativeMapsLowerOnlyTheLargestMisses)
+{
+  // The cells that miss the data most get a second chance on maps reweighted by the input's
+  // gradient (FieldReconstruction::AlternativeMapStrength). Measured here from F o Phi at the
+  // vertices and the cell that gave each value (no stiffening, which would move both runs'
+  // fits apart): a cell either keeps its values bit for bit or misses less than before, the
+  // cells that changed are the ones reported, and no field's largest miss grows. On Shepard
+  // fields nothing was tuned on (seeds 60-71), at 5 %.
+  int remapped = 0, lowered = 0;
+  for (std::uint64_t seed = 60; seed < 72; ++seed)
+  {
+    const GridField shepard = ShepardField(40, 2.0, 200, seed);
+    Pipeline p;
+    std::string error;
+    CHECK(RunStages1To3(shepard, 5, 4, p, error));
+    FieldReconstructionReport reports[2];
+    for (int alternative = 0; alternative < 2; ++alternative)
+    {
+      FieldReconstruction reconstruction;
+      reconstruction.Parallel = ThreadedFor;
+      reconstruction.StiffeningRounds = 0;
+      reconstruction.AlternativeMapStrength = alternative ? 30 : 0;
+      CHECK(reconstruction.Run(p.Field, p.Simplified.Complex, p.Smoothed, reports[alternative], error));
+      CHECK(reports[alternative].Verified);
+    }
+    CHECK(reports[0].Cells.RemappedCells == 0);
+    CHECK(reports[0].CellOfVertex == reports[1].CellOfVertex);
+    // Per cell: the largest miss of F o Phi at its vertices, and whether any value changed.
+    const std::size_t cells = p.Simplified.Complex.TwoCells.size();
+    std::vector<double> miss[2] = { std::vector<double>(cells, 0.0), std::vector<double>(cells, 0.0) };
+    std::vector<char> changed(cells, 0);
+    double largest[2] = { 0, 0 }, reconstructed[2] = { 0, 0 };
+    for (std::size_t v = 0; v < p.Field.Values.size(); ++v)
+    {
+      const Index c = reports[0].CellOfVertex[v];
+      for (int a = 0; a < 2; ++a)
+      {
+        const double d = std::abs(reports[a].Exact[v] - p.Field.Values[v]);
+        largest[a] = std::max(largest[a], d);
+        reconstructed[a] = std::max(reconstructed[a], std::abs(reports[a].Values[v] - p.Field.Values[v]));
+        if (c != InvalidIndex)
+        {
+          miss[a][c] = std::max(miss[a][c], d);
+        }
+      }
+      if (c != InvalidIndex && reports[1].Exact[v] != reports[0].Exact[v])
+      {
+        changed[c] = 1;
+      }
+    }
+    int changedCells = 0;
+    bool onlyLower = true;
+    for (std::size_t c = 0; c < cells; ++c)
+    {
+      if (changed[c])
+      {
+        ++changedCells;
+        onlyLower = onlyLower && miss[1][c] < miss[0][c];
+      }
+    }
+    std::printf("  shepard 200^2 seed %d at 5 %%: %d cells remapped, largest miss of F o Phi %.2f -> %.2f %%, of "
+                "Reconstructed %.2f -> %.2f %% of the range\n",
+      static_cast<int>(seed), static_cast<int>(reports[1].Cells.RemappedCells), 100 * largest[0] / p.Range,
+      100 * largest[1] / p.Range, 100 * reconstructed[0] / p.Range, 100 * reconstructed[1] / p.Range);
+    CHECK(onlyLower);
+    CHECK_EQ(changedCells, static_cast<int>(reports[1].Cells.RemappedCells));
+    CHECK(largest[1] <= largest[0]);
+    remapped += changedCells;
+    lowered += largest[1] < largest[0] ? 1 : 0;
+  }
+  std::printf("  %d cells remapped, the largest miss lowered on %d of 12 fields\n", remapped, lowered);
+  CHECK(lowered > 0);
+}
+
 TEST_CASE(AnisotropicSpacingIsReconstructedInTheComplexsFrame)
 {
   // Spacing 0.01 x 3: in the image's own coordinates every 2-cell is 300 times longer than

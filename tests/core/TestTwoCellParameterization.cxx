@@ -1,13 +1,15 @@
 // Unit tests of the 2-cell parameterization (stage 4, paper section 5.1): triangulation of the
 // cell with the boundary samples as the only boundary vertices, mean value coordinates onto
 // the unit square, the one-to-one check with its dividing-edge fix, point location and its
-// inverse, pouch cells (boundaries with slits, cut open), and graceful failure on degenerate
-// input.
+// inverse, pouch cells (boundaries with slits, cut open), graceful failure on degenerate
+// input, and the maps reweighted by a field's gradient.
 #include "DeterministicRandom.h"
+#include "PiecewiseLinearField.h"
 #include "TestHarness.h"
 #include "TwoCellParameterization.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -1063,9 +1065,10 @@ Cell Rotated(const Cell& cell, int offset)
   return out;
 }
 
-double CellSize(const Cell& cell)
+// xmin, xmax, ymin, ymax of the cell's samples.
+std::array<double, 4> CellBounds(const Cell& cell)
 {
-  double bounds[4] = { 1e300, -1e300, 1e300, -1e300 };
+  std::array<double, 4> bounds = { 1e300, -1e300, 1e300, -1e300 };
   for (std::size_t i = 0; i < cell.Points.size() / 2; ++i)
   {
     bounds[0] = std::min(bounds[0], cell.Points[2 * i]);
@@ -1073,6 +1076,12 @@ double CellSize(const Cell& cell)
     bounds[2] = std::min(bounds[2], cell.Points[2 * i + 1]);
     bounds[3] = std::max(bounds[3], cell.Points[2 * i + 1]);
   }
+  return bounds;
+}
+
+double CellSize(const Cell& cell)
+{
+  const std::array<double, 4> bounds = CellBounds(cell);
   return std::max(bounds[1] - bounds[0], bounds[3] - bounds[2]);
 }
 
@@ -1642,6 +1651,177 @@ TEST_CASE(Timing)
   const double locateNs =
     std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - locateStart).count() / 100000;
   std::printf("  point location: %.0f ns per query (%d of 100000 inside)\n", locateNs, located);
+}
+
+// ---- The level-aligned map ---------------------------------------------------------------------
+
+namespace
+{
+// `f` sampled on a 241 x 241 grid over the cell's box grown by a tenth: the input field that
+// WeightByFieldGradient reads (linear on the grid's triangles).
+template <typename Function>
+PlanarScalarField GridAround(const Cell& cell, Function f)
+{
+  const std::array<double, 4> bounds = CellBounds(cell);
+  const double margin = 0.1 * std::max(bounds[1] - bounds[0], bounds[3] - bounds[2]);
+  const int n = 241;
+  PlanarScalarField field;
+  field.GridDimensions[0] = field.GridDimensions[1] = n;
+  field.GridSpacing[0] = (bounds[1] - bounds[0] + 2 * margin) / (n - 1);
+  field.GridSpacing[1] = (bounds[3] - bounds[2] + 2 * margin) / (n - 1);
+  for (int j = 0; j < n; ++j)
+  {
+    for (int i = 0; i < n; ++i)
+    {
+      const double x = bounds[0] - margin + i * field.GridSpacing[0];
+      const double y = bounds[2] - margin + j * field.GridSpacing[1];
+      field.Points.push_back(x);
+      field.Points.push_back(y);
+      field.Values.push_back(f(x, y));
+    }
+  }
+  return field;
+}
+
+// What a surface that rises along (1, 1) of the square cannot follow: of the pairs of points
+// p, q of the cell (here `count` random ones) with u_p <= u_q and v_p <= v_q, the share where
+// f(p) > f(q). Written here from the map's Evaluate alone.
+template <typename Function>
+double DiagonalViolations(const TwoCellParameterization& tcp, const Cell& cell, Function f, int count, Random& random)
+{
+  const std::array<double, 4> bounds = CellBounds(cell);
+  std::vector<std::array<double, 3>> points; // u, v, f
+  while (static_cast<int>(points.size()) < count)
+  {
+    const double x = random.Uniform(bounds[0], bounds[1]), y = random.Uniform(bounds[2], bounds[3]);
+    double uv[2];
+    if (InsidePolygon(cell.Points, x, y) && tcp.Evaluate(x, y, uv))
+    {
+      points.push_back({ uv[0], uv[1], f(x, y) });
+    }
+  }
+  long comparable = 0, violated = 0;
+  for (const auto& p : points)
+  {
+    for (const auto& q : points)
+    {
+      if (&p != &q && p[0] <= q[0] && p[1] <= q[1])
+      {
+        ++comparable;
+        violated += p[2] > q[2] ? 1 : 0;
+      }
+    }
+  }
+  return comparable > 0 ? static_cast<double>(violated) / comparable : 0.0;
+}
+
+// A smooth random field: a tilt plus a few Gaussian bumps and pits of the cell's size.
+struct RandomSmoothField
+{
+  double Tilt[2];
+  std::vector<std::array<double, 4>> Bumps; // x, y, width, height
+  RandomSmoothField(Random& random, double size)
+  {
+    this->Tilt[0] = random.Uniform(-1, 1);
+    this->Tilt[1] = random.Uniform(-1, 1);
+    for (int k = 0; k < 5; ++k)
+    {
+      this->Bumps.push_back({ random.Uniform(-size, size), random.Uniform(-size, size),
+        random.Uniform(0.1, 0.6) * size, random.Uniform(-1, 1) * size });
+    }
+  }
+  double operator()(double x, double y) const
+  {
+    double value = this->Tilt[0] * x + this->Tilt[1] * y;
+    for (const auto& b : this->Bumps)
+    {
+      value += b[3] * std::exp(-((x - b[0]) * (x - b[0]) + (y - b[1]) * (y - b[1])) / (b[2] * b[2]));
+    }
+    return value;
+  }
+};
+} // namespace
+
+// The maps reweighted by a field's gradient are valid parameterizations like the mean value
+// map: on random smooth cells and on the pouch cells (slits cut open), under random smooth
+// fields, both weightings and every strength, they pass every check of the mean value map
+// (one-to-one, the boundary (u, v) bit for bit, interior strictly inside, point location and
+// its inverse, the slits' two sides).
+TEST_CASE(FieldGradientWeightedMapsAreOneToOne)
+{
+  Random random(28);
+  int checked = 0, failed = 0;
+  auto run = [&](const Cell& cell, const char* name, int slitEdges) {
+    TwoCellParameterization tcp;
+    std::string error;
+    if (!tcp.Parameterize(cell.Points, cell.Parameters, error))
+    {
+      std::printf("  %s: mean value map failed: %s\n", name, error.c_str());
+      ++failed;
+      return;
+    }
+    const RandomSmoothField f(random, CellSize(cell));
+    const PlanarScalarField grid = GridAround(cell, f);
+    const PiecewiseLinearField field(grid);
+    for (const auto weighting : { GradientWeighting::AlongLevelSets, GradientWeighting::AlongGradient })
+    {
+      for (const double strength : { 3.0, 30.0, 300.0 })
+      {
+        TwoCellParameterization reweighted = tcp;
+        ++checked;
+        const bool ok = reweighted.WeightByFieldGradient(field, strength, weighting, error) &&
+          CheckParameterization(reweighted, cell, 1, random) == 0 &&
+          (slitEdges < 0 || CheckSlits(reweighted, cell) == slitEdges);
+        if (!ok)
+        {
+          std::printf("  %s, strength %g: %s\n", name, strength, error.c_str());
+          ++failed;
+        }
+      }
+    }
+  };
+  for (int trial = 0; trial < 30; ++trial)
+  {
+    run(MakeCell(PerturbedCirclePoints(8 + static_cast<int>(random.Uniform(0, 200)), random)), "perturbed circle", -1);
+  }
+  run(InnerPouch(), "inner slit", 5);
+  run(WrapPouch(), "slit wrapping around the start", 5);
+  run(MultiSlitPouch(), "three slits", 1 + 6 + 3);
+  run(TwoSlitsOneBase(), "two slits from one base", 4);
+  std::printf("  %d reweighted maps checked, %d failed\n", checked, failed);
+  CHECK_EQ(failed, 0);
+  CHECK_EQ(checked, 6 * 34);
+
+  // Why the reweighting helps: a cell that wraps 360 degrees around its minimum at the tip of a
+  // slit (WrapPouch: the minimum m = (0.05, 0), the slit out to s = (1, 0), the maximum
+  // opposite), under a field round about m (its distance from m). The mean value map bends the
+  // round level sets so that the field falls along (1, 1) of the square between some pairs of
+  // points, which no monotone surface can follow. Weighted along the gradient (the flow lines
+  // from the minimum pull hardest) far fewer pairs fall; weighted along the level sets, more
+  // (no mesh edge lies exactly along a level curve, so the weights' ratio stays bounded by the
+  // mesh's angles, and a level curve dozens of edges long is not straightened: it only spreads
+  // the cell differently).
+  const Cell wrap = WrapPouch();
+  auto distance = [](double x, double y) { return std::hypot(x - 0.05, y); };
+  TwoCellParameterization meanValue;
+  std::string error;
+  CHECK(meanValue.Parameterize(wrap.Points, wrap.Parameters, error));
+  const PlanarScalarField grid = GridAround(wrap, distance);
+  const PiecewiseLinearField field(grid);
+  Random points(7);
+  const double before = DiagonalViolations(meanValue, wrap, distance, 1500, points);
+  double after[2] = { 0, 0 };
+  for (const auto weighting : { GradientWeighting::AlongLevelSets, GradientWeighting::AlongGradient })
+  {
+    TwoCellParameterization reweighted = meanValue;
+    CHECK(reweighted.WeightByFieldGradient(field, 30, weighting, error));
+    Random same(7); // the same points
+    after[weighting == GradientWeighting::AlongGradient ? 1 : 0] = DiagonalViolations(reweighted, wrap, distance, 1500, same);
+  }
+  std::printf("  slit around the minimum, field round about it: share of pairs falling along (1, 1): mean value "
+              "map %.4f, along the level sets %.4f, along the gradient %.4f\n",
+    before, after[0], after[1]);
+  CHECK(after[1] < 0.5 * before);
 }
 
 int main()
