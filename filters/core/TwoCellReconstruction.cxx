@@ -714,7 +714,6 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
   std::vector<std::vector<SurfaceSample>> remappedSamples(n);
   if (fit && this->AlternativeMapStrength > 0)
   {
-    const PiecewiseLinearField field(*data);
     std::vector<std::pair<double, Index>> misses;
     for (Index c = 0; c < n; ++c)
     {
@@ -726,12 +725,18 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
       }
     }
     std::sort(misses.begin(), misses.end(), std::greater<>());
+    // Built only when some cell qualifies (on a mesh it is a bucket grid over the triangles).
+    std::unique_ptr<PiecewiseLinearField> field;
+    if (!misses.empty())
+    {
+      field = std::make_unique<PiecewiseLinearField>(*data);
+    }
     for (const auto& miss : misses)
     {
       const Index c = miss.second;
       std::vector<SurfaceSample> samples = samplesOf(c);
       if (this->Hooks.Aborted() ||
-        !this->FitOnAlternativeMaps(*this->Cells[c], boundaries[c], field, *data, vertices.data() + firstVertex[c], samples))
+        !this->FitOnAlternativeMaps(*this->Cells[c], boundaries[c], *field, *data, vertices.data() + firstVertex[c], samples))
       {
         break;
       }
