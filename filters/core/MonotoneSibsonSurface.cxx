@@ -43,6 +43,13 @@ bool SubdivideSide(const BezierSide& side, int targetCount, BezierSide& result)
   return true;
 }
 
+bool SubdivideBoundary(const MonotoneSurfaceBoundary& boundary, int targetCount, MonotoneSurfaceBoundary& result)
+{
+  return SubdivideSide(boundary.Bottom, targetCount, result.Bottom) &&
+    SubdivideSide(boundary.Right, targetCount, result.Right) && SubdivideSide(boundary.Top, targetCount, result.Top) &&
+    SubdivideSide(boundary.Left, targetCount, result.Left);
+}
+
 int CommonSegmentCount(const BezierSide& bottom, const BezierSide& right, const BezierSide& top, const BezierSide& left)
 {
   long long common = 1;

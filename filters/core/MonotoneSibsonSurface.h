@@ -46,6 +46,9 @@ struct MonotoneSurfaceBoundary
   BezierSide Left;
 };
 
+// SubdivideSide on all four sides (a side already at targetCount is copied as it is).
+bool SubdivideBoundary(const MonotoneSurfaceBoundary& boundary, int targetCount, MonotoneSurfaceBoundary& result);
+
 struct MonotoneSurfaceOptions
 {
   // Mismatches between the sides at shared points (values and scaled derivatives) up to this

@@ -940,8 +940,7 @@ bool TwoCellReconstruction::FitSurface(ReconstructedTwoCell& cell, const Monoton
        n *= 2)
   {
     MonotoneSurfaceBoundary finer;
-    if (!SubdivideSide(boundary.Bottom, n, finer.Bottom) || !SubdivideSide(boundary.Right, n, finer.Right) ||
-      !SubdivideSide(boundary.Top, n, finer.Top) || !SubdivideSide(boundary.Left, n, finer.Left))
+    if (!SubdivideBoundary(boundary, n, finer))
     {
       break;
     }
@@ -971,11 +970,8 @@ bool TwoCellReconstruction::FitOnAlternativeMaps(ReconstructedTwoCell& cell, con
   // the mean value map's fit ended with (its refinement already chose it: refining again for
   // each map would cost more than the rest of the fit).
   const TwoCellParameterization meanValue = cell.Parameterization;
-  MonotoneSurfaceBoundary atGrid = subdivided;
-  const int gridSize = cell.GridSize;
-  if (static_cast<int>(subdivided.Bottom.size()) != gridSize &&
-    (!SubdivideSide(subdivided.Bottom, gridSize, atGrid.Bottom) || !SubdivideSide(subdivided.Right, gridSize, atGrid.Right) ||
-      !SubdivideSide(subdivided.Top, gridSize, atGrid.Top) || !SubdivideSide(subdivided.Left, gridSize, atGrid.Left)))
+  MonotoneSurfaceBoundary atGrid;
+  if (!SubdivideBoundary(subdivided, cell.GridSize, atGrid))
   {
     return false;
   }

@@ -245,9 +245,9 @@ private:
   void ParameterizeCell(const TwoCell& twoCell, const OneCellSmoothingResult& smoothed, ReconstructedTwoCell& cell,
     MonotoneSurfaceBoundary& boundary) const;
   // The cell's fit tried again on the alternative maps (AlternativeMapStrength), from the mean
-  // value map's mesh, at the grid size its fit chose; each is kept, with its map and its samples' (u, v), if its largest
-  // residual is below AlternativeMapGain times the best so far and its RMS residual at most
-  // AlternativeMapRMSGrowth times. Returns whether one was kept.
+  // value map's mesh, at the grid size its fit chose; each is kept, with its map and its
+  // samples' (u, v), if its largest residual is below AlternativeMapGain times the best so far
+  // and its RMS residual at most AlternativeMapRMSGrowth times. Returns whether one was kept.
   bool FitOnAlternativeMaps(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided,
     const PiecewiseLinearField& field, const PlanarScalarField& data, const Index* vertices,
     std::vector<SurfaceSample>& samples) const;
