@@ -136,6 +136,7 @@ constexpr const char* BezierTriangles = "BezierTriangles";
 constexpr const char* MeshTriangles = "MeshTriangles";
 constexpr const char* CrowdedTriangles = "CrowdedTriangles";
 constexpr const char* PinchedTwoCells = "PinchedTwoCells";
+constexpr const char* ResampledTwoCells = "ResampledTwoCells";
 constexpr const char* OutsideSlitTwoCells = "OutsideSlitTwoCells";
 constexpr const char* MaximumGridSize = "MaximumGridSize";
 constexpr const char* FittedCells = "FittedCells";

@@ -276,6 +276,7 @@ void WriteReport(const topospline::FieldReconstructionReport& report, vtkFieldDa
   AddFieldNumbers(fd, names::MeshTriangles, { static_cast<double>(cells.MeshTriangles) });
   AddFieldNumbers(fd, names::CrowdedTriangles, { static_cast<double>(cells.CrowdedTriangles) });
   AddFieldNumbers(fd, names::PinchedTwoCells, { static_cast<double>(cells.PinchedCells) });
+  AddFieldNumbers(fd, names::ResampledTwoCells, { static_cast<double>(cells.ResampledCells) });
   AddFieldNumbers(fd, names::OutsideSlitTwoCells, { static_cast<double>(cells.OutsideSlitCells) });
   AddFieldNumbers(fd, names::MaximumGridSize, { static_cast<double>(cells.MaximumGridSize) });
   AddFieldNumbers(fd, names::FittedCells, { static_cast<double>(cells.FittedCells) });

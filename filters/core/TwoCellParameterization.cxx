@@ -731,8 +731,6 @@ bool CheckBorderParameters(CellBoundary& cell, std::string& error)
   const double* uv = cell.UV;
   cell.SideMasks.resize(n);
   std::vector<int>& sideMasks = cell.SideMasks;
-  double winding = 0;
-  int steps[2] = { 0, 0 }; // forward, backward
   for (std::size_t i = 0; i < n; ++i)
   {
     const double u = uv[2 * i], v = uv[2 * i + 1];
@@ -747,19 +745,16 @@ bool CheckBorderParameters(CellBoundary& cell, std::string& error)
       return false;
     }
   }
+  // Once around, monotonically: the steps taken forward (each in [0, 4)) add up to one turn, or
+  // those taken backward do. A walk without a slit outside its loop (DropSlitsOutsideTheLoop)
+  // may jump over more than half of the border in one step, so a step's direction cannot be
+  // told from its length alone.
+  double forward = 0, backward = 0;
   for (std::size_t i = 0; i < n; ++i)
   {
     const std::size_t j = (i + 1) % n;
     double step = PerimeterCoordinate(uv[2 * j], uv[2 * j + 1], sideMasks[j]) -
       PerimeterCoordinate(uv[2 * i], uv[2 * i + 1], sideMasks[i]);
-    if (step > 2)
-    {
-      step -= 4;
-    }
-    else if (step <= -2)
-    {
-      step += 4;
-    }
     if (step == 0)
     {
       std::ostringstream message;
@@ -767,15 +762,17 @@ bool CheckBorderParameters(CellBoundary& cell, std::string& error)
       error = message.str();
       return false;
     }
-    ++steps[step > 0 ? 0 : 1];
-    winding += step;
+    step = step < 0 ? step + 4 : step;
+    forward += step;
+    backward += 4 - step;
   }
-  if ((steps[0] != 0 && steps[1] != 0) || std::abs(std::abs(winding) - 4) > 1e-9)
+  const bool once = std::abs(forward - 4) <= 1e-9;
+  if (!once && std::abs(backward - 4) > 1e-9)
   {
     error = "TwoCellParameterization: the parameters do not go monotonically once around the unit square";
     return false;
   }
-  cell.ParameterOrientation = winding > 0 ? 1 : -1;
+  cell.ParameterOrientation = once ? 1 : -1;
   return true;
 }
 

@@ -30,8 +30,8 @@ double Seconds(Clock::time_point start)
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Samples one side, forward from its lower corner: c points per Bezier segment plus the end
-// point, with the side parameter tau of each: segment j of piece i covers m_i grid segments of
+// Samples one side, forward from its lower corner: c points per Bezier segment (the piece's
+// own count, SideSegments::Samples, when given) plus the end point, with the side parameter tau of each: segment j of piece i covers m_i grid segments of
 // the N along the side (ChooseGridLayout).
 void SampleSide(const SideSegments& side, const std::vector<int>& multipliers, int n, int c, std::vector<double>& xy,
   std::vector<double>& tau)
@@ -40,12 +40,13 @@ void SampleSide(const SideSegments& side, const std::vector<int>& multipliers, i
   int segment = 0, offset = 0;
   for (std::size_t i = 0; i < side.Pieces.size(); ++i)
   {
+    const int samples = side.Samples.empty() ? c : side.Samples[i];
     for (int j = 0; j < side.Pieces[i]; ++j, ++segment)
     {
       const double* curve = side.Curve[segment].data();
-      for (int k = 0; k < c; ++k)
+      for (int k = 0; k < samples; ++k)
       {
-        const double t = static_cast<double>(k) / c;
+        const double t = static_cast<double>(k) / samples;
         // t = 0 is the control point itself, bit for bit: neighbouring cells and the two
         // sides of a slit then share their samples exactly.
         if (k == 0)
@@ -403,8 +404,8 @@ int ChooseGridLayout(const std::array<SideSegments, 4>& sides, int maximum, std:
   return 0;
 }
 
-std::array<SideSegments, 4> TwoCellSideSegments(
-  const TwoCellSides& sides, const OneCellSmoothingResult& smoothed, bool exactHalves, int cutOffset)
+std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed,
+  bool exactHalves, int cutOffset, const std::vector<int>* samplesPerPiece)
 {
   std::array<SideSegments, 4> result;
   for (int s = 0; s < 4; ++s)
@@ -413,6 +414,10 @@ std::array<SideSegments, 4> TwoCellSideSegments(
     {
       const SmoothedPiece& piece = smoothed.Pieces[p];
       result[s].Pieces.push_back(piece.Curve.Segments);
+      if (samplesPerPiece != nullptr)
+      {
+        result[s].Samples.push_back((*samplesPerPiece)[p]);
+      }
       for (int j = 0; j < piece.Curve.Segments; ++j)
       {
         std::array<double, 8> curve;
@@ -455,6 +460,7 @@ std::array<SideSegments, 4> TwoCellSideSegments(
       {
         halved.Pieces.push_back(2 * k);
       }
+      halved.Samples = whole.Samples;
       whole = std::move(halved);
     }
     const int count = static_cast<int>(whole.Curve.size());
@@ -467,16 +473,25 @@ std::array<SideSegments, 4> TwoCellSideSegments(
     upper.Height.assign(whole.Height.begin() + half, whole.Height.end());
     // The piece counts of both halves (the piece cut at `half` goes partly to each).
     int seen = 0;
-    for (int k : whole.Pieces)
+    for (std::size_t i = 0; i < whole.Pieces.size(); ++i)
     {
+      const int k = whole.Pieces[i];
       const int below = std::clamp(static_cast<int>(half) - seen, 0, k);
       if (below > 0)
       {
         lower.Pieces.push_back(below);
+        if (!whole.Samples.empty())
+        {
+          lower.Samples.push_back(whole.Samples[i]);
+        }
       }
       if (k - below > 0)
       {
         upper.Pieces.push_back(k - below);
+        if (!whole.Samples.empty())
+        {
+          upper.Samples.push_back(whole.Samples[i]);
+        }
       }
       seen += k;
     }
@@ -650,12 +665,14 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
 
   // Pass 1 (the paper's "time II"): sides, boundary samples, triangulation, parameterization.
   auto start = Clock::now();
+  const std::vector<int> samplesPerPiece(smoothed.Pieces.size(), this->BoundarySamples);
   this->Parallel(0, n, [&](Index begin, Index end) {
     for (Index c = begin; c < end && !this->Hooks.Aborted(); ++c)
     {
-      this->ParameterizeCell(complex.TwoCells[c], smoothed, *this->Cells[c], boundaries[c]);
+      this->ParameterizeCell(complex.TwoCells[c], smoothed, samplesPerPiece, *this->Cells[c], boundaries[c]);
     }
   });
+  this->DensifyFailedBoundaries(complex, smoothed, boundaries);
   if (this->Hooks.Aborted())
   {
     error = "aborted";
@@ -770,10 +787,82 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
   return true;
 }
 
+void TwoCellReconstruction::DensifyFailedBoundaries(const MorseSmaleComplex& complex,
+  const OneCellSmoothingResult& smoothed, std::vector<MonotoneSurfaceBoundary>& boundaries)
+{
+  const Index n = static_cast<Index>(this->Cells.size());
+  std::vector<int> samplesPerPiece(smoothed.Pieces.size(), this->BoundarySamples);
+  const int mostSamples = this->BoundarySamples << std::max(this->BoundaryDensifications, 0);
+  for (int round = 0; round < this->BoundaryDensifications && !this->Hooks.Aborted(); ++round)
+  {
+    // The pieces of the failed cells, each sampled twice as densely as before.
+    std::vector<char> densified(smoothed.Pieces.size(), 0);
+    bool any = false;
+    for (Index c = 0; c < n; ++c)
+    {
+      const ReconstructedTwoCell& cell = *this->Cells[c];
+      if (!cell.MapFailed)
+      {
+        continue;
+      }
+      for (const auto& side : cell.Sides.Pieces)
+      {
+        for (Index p : side)
+        {
+          if (p >= 0 && p < static_cast<Index>(smoothed.Pieces.size()) && !densified[p] &&
+            samplesPerPiece[p] < mostSamples)
+          {
+            densified[p] = 1;
+            samplesPerPiece[p] *= 2;
+            any = true;
+          }
+        }
+      }
+    }
+    if (!any)
+    {
+      break;
+    }
+    // Every cell on those pieces, parameterized again; one that was valid and now fails keeps
+    // its earlier map and boundary.
+    std::vector<Index> again;
+    for (Index c = 0; c < n; ++c)
+    {
+      bool touched = false;
+      for (const auto& side : this->Cells[c]->Sides.Pieces)
+      {
+        for (Index p : side)
+        {
+          touched = touched || (p >= 0 && p < static_cast<Index>(densified.size()) && densified[p]);
+        }
+      }
+      if (touched)
+      {
+        again.push_back(c);
+      }
+    }
+    this->Parallel(0, static_cast<Index>(again.size()), [&](Index begin, Index end) {
+      for (Index k = begin; k < end && !this->Hooks.Aborted(); ++k)
+      {
+        const Index c = again[k];
+        auto cell = std::make_unique<ReconstructedTwoCell>();
+        MonotoneSurfaceBoundary boundary;
+        this->ParameterizeCell(complex.TwoCells[c], smoothed, samplesPerPiece, *cell, boundary);
+        if (cell->Valid || !this->Cells[c]->Valid)
+        {
+          cell->Resampled = true;
+          this->Cells[c] = std::move(cell);
+          boundaries[c] = std::move(boundary);
+        }
+      }
+    });
+  }
+}
+
 // The cell's sides assembled, sampled into a closed walk, triangulated and mapped onto the
 // unit square; `boundary` receives its sides' Bezier segments at the grid layout.
 void TwoCellReconstruction::ParameterizeCell(const TwoCell& twoCell, const OneCellSmoothingResult& smoothed,
-  ReconstructedTwoCell& cell, MonotoneSurfaceBoundary& boundary) const
+  const std::vector<int>& samplesPerPiece, ReconstructedTwoCell& cell, MonotoneSurfaceBoundary& boundary) const
 {
   std::string message;
   std::vector<double> walk, parameters;
@@ -785,11 +874,11 @@ void TwoCellReconstruction::ParameterizeCell(const TwoCell& twoCell, const OneCe
     // Halves cut at a segment boundary keep the samples of the neighbouring cell that shares
     // the split 1-cell; when their counts (k and k + 1) make the grid too fine, they are cut at
     // the exact middle instead, and the two cells' boundaries differ by slivers between samples.
-    if (!BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed, false), this->BoundarySamples,
-          this->MaximumGridSize, walk, parameters, boundary) &&
-      !BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed, true), this->BoundarySamples,
-        this->MaximumGridSize, walk, parameters, boundary) &&
-      !this->BuildBoundaryWalkCutOffMiddle(cell.Sides, smoothed, walk, parameters, boundary))
+    if (!BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed, false, 0, &samplesPerPiece),
+          this->BoundarySamples, this->MaximumGridSize, walk, parameters, boundary) &&
+      !BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed, true, 0, &samplesPerPiece),
+        this->BoundarySamples, this->MaximumGridSize, walk, parameters, boundary) &&
+      !this->BuildBoundaryWalkCutOffMiddle(cell.Sides, smoothed, samplesPerPiece, walk, parameters, boundary))
     {
       message = "its sides need more than " + std::to_string(this->MaximumGridSize) + " segments each (pieces";
       for (const SideSegments& side : TwoCellSideSegments(cell.Sides, smoothed))
@@ -855,6 +944,7 @@ void TwoCellReconstruction::ParameterizeCell(const TwoCell& twoCell, const OneCe
   else if (!cell.Valid)
   {
     cell.Error = firstError;
+    cell.MapFailed = firstError.rfind("parameterization: ", 0) == 0;
   }
 }
 
@@ -887,7 +977,7 @@ void TwoCellReconstruction::LocateSamples(const PlanarScalarField& data, const s
 // anywhere along the split side, so cuts ever farther from the middle (up to a quarter of the
 // side's segments either way) are tried, the nearest one whose layout fits is taken.
 bool TwoCellReconstruction::BuildBoundaryWalkCutOffMiddle(const TwoCellSides& sides,
-  const OneCellSmoothingResult& smoothed, std::vector<double>& walk, std::vector<double>& parameters,
+  const OneCellSmoothingResult& smoothed, const std::vector<int>& samplesPerPiece, std::vector<double>& walk, std::vector<double>& parameters,
   MonotoneSurfaceBoundary& boundary) const
 {
   int longest = 0;
@@ -907,7 +997,7 @@ bool TwoCellReconstruction::BuildBoundaryWalkCutOffMiddle(const TwoCellSides& si
   {
     for (int offset : { -distance, distance })
     {
-      if (BuildBoundaryWalk(TwoCellSideSegments(sides, smoothed, false, offset), this->BoundarySamples,
+      if (BuildBoundaryWalk(TwoCellSideSegments(sides, smoothed, false, offset, &samplesPerPiece), this->BoundarySamples,
             this->MaximumGridSize, walk, parameters, boundary))
       {
         return true;
@@ -1177,6 +1267,10 @@ void TwoCellReconstruction::BuildSurface(ReconstructedTwoCell& cell, const Monot
   // mismatch of 1.2e-12.
   options.ConsistencyTolerance = 1e-7;
   options.RoundingTolerance = 1e-10;
+  // A cell whose whole range is at that rounding level (a Delaunay mesh at 2 %: values 0.211
+  // within 2.6e-11) has sides that differ by a fifth of it (4.8e-12, from a junction's zero
+  // end slope); still 1e-10 of the values at most, so rounding: half of the range is allowed.
+  options.RoundingShareOfRange = 0.5;
   // A flat valley floor or ridge top along the 1-cells (see MonotoneSurfaceOptions).
   options.FlatAcrossBoundary = true;
   // False also when the conditions are infeasible somewhere: the surface is then built anyway
@@ -1205,6 +1299,7 @@ void TwoCellReconstruction::Summarize()
     }
     s.SlitCells += cell->Sides.Slit ? 1 : 0;
     s.PinchedCells += cell->Parameterization.GetMesh().OpenedPinches > 0 ? 1 : 0;
+    s.ResampledCells += cell->Resampled ? 1 : 0;
     s.OutsideSlitCells += cell->Parameterization.GetMesh().OutsideSlits > 0 ? 1 : 0;
     s.ShiftedCorners += (cell->Sides.MinimumShifted ? 1 : 0) + (cell->Sides.MaximumShifted ? 1 : 0);
     const MonotoneSurfaceReport& r = cell->Surface.Report();

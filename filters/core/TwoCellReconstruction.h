@@ -70,6 +70,7 @@ struct SideSegments
   std::vector<std::array<double, 8>> Curve;
   BezierSide Height;
   std::vector<int> Pieces; // segments of each piece along the side, in order (sum: Curve.size())
+  std::vector<int> Samples; // boundary samples per Bezier segment of each piece (empty: the walk's default)
 };
 
 // The grid size N of a cell's surface and, per side and piece, how many grid segments each of
@@ -84,9 +85,10 @@ int ChooseGridLayout(const std::array<SideSegments, 4>& sides, int maximum, std:
 // The segments of the four sides (Bottom, Right, Top, Left), with an empty side made up from
 // half of its partner (TwoCellSides::SplitSides), cut at the segment boundary nearest the middle
 // (`cutOffset` segments past it, within the side), or with `exactHalves` at the exact middle of a
-// partner of an odd count (every segment then cut in two).
+// partner of an odd count (every segment then cut in two). `samplesPerPiece` (indexed by smoothed
+// piece; null: none) gives each piece its own boundary samples per Bezier segment.
 std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed,
-  bool exactHalves = false, int cutOffset = 0);
+  bool exactHalves = false, int cutOffset = 0, const std::vector<int>* samplesPerPiece = nullptr);
 
 // One reconstructed 2-cell.
 struct ReconstructedTwoCell
@@ -94,6 +96,8 @@ struct ReconstructedTwoCell
   bool Valid = false;  // parameterized and surface built (possibly with violations, see Surface)
   std::string Error;   // why not, when !Valid
   bool Negligible = false; // skipped: its boundary encloses no more than NegligibleArea
+  bool MapFailed = false;  // not valid because no walk of it could be parameterized (not for its grid)
+  bool Resampled = false;  // some of its pieces were sampled more densely (BoundaryDensifications)
   TwoCellSides Sides;
   int GridSize = 0;    // N: cubic segments per side of the square after subdivision
   double Bounds[4] = { 0, 0, 0, 0 }; // xmin, xmax, ymin, ymax of the boundary samples
@@ -109,6 +113,7 @@ struct TwoCellReconstructionReport
   Index SlitCells = 0;         // pouch cells parameterized with a slit
   Index OutsideSlitCells = 0;  // cells with slits outside their outer loop, left out of the walk
   Index PinchedCells = 0;      // cells whose boundary touches itself, opened there (TwoCellParameterization)
+  Index ResampledCells = 0;    // cells whose boundary pieces were sampled more densely (DensifyFailedBoundaries)
   Index ShiftedCorners = 0;    // corners taken by junction points
   Index ViolatingPatches = 0;  // Sibson grid cells failing the monotonicity conditions (0 is the goal)
   Index LinearizedDiagonals = 0; // the paper's fallback for non-increasing Laplace values
@@ -146,6 +151,11 @@ class TwoCellReconstruction
 public:
   // c in the paper: samples per boundary Bezier segment.
   int BoundarySamples = 5;
+  // A cell whose walk cannot be parameterized (its polygon crosses or touches itself, mostly
+  // where two curves leave a node almost tangentially and one is sampled coarsely across the
+  // other's bend) is tried again with its pieces sampled twice as densely, and so are the cells
+  // that share those pieces (their common boundary stays one polyline), up to this many times.
+  int BoundaryDensifications = 3;
   // Cells whose sides need more grid segments than this (ChooseGridLayout) are not
   // reconstructed.
   int MaximumGridSize = 512;
@@ -242,8 +252,15 @@ public:
   std::vector<PlanarBezierTriangle> PlanarBezierTriangles(Index c) const;
 
 private:
-  void ParameterizeCell(const TwoCell& twoCell, const OneCellSmoothingResult& smoothed, ReconstructedTwoCell& cell,
-    MonotoneSurfaceBoundary& boundary) const;
+  // samplesPerPiece: boundary samples per Bezier segment of each smoothed piece.
+  void ParameterizeCell(const TwoCell& twoCell, const OneCellSmoothingResult& smoothed,
+    const std::vector<int>& samplesPerPiece, ReconstructedTwoCell& cell, MonotoneSurfaceBoundary& boundary) const;
+  // BoundaryDensifications: the pieces of every cell whose walk failed to parameterize get twice
+  // the samples, and every cell on those pieces is parameterized again; a cell that was valid
+  // and fails with the denser samples keeps its earlier map (its side of the shared piece then
+  // differs from its neighbour's by slivers between samples).
+  void DensifyFailedBoundaries(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
+    std::vector<MonotoneSurfaceBoundary>& boundaries);
   // The cell's fit tried again on the alternative maps (AlternativeMapStrength), from the mean
   // value map's mesh, at the grid size its fit chose; each is kept, with its map and its
   // samples' (u, v), if its largest residual is below AlternativeMapGain times the best so far
@@ -267,7 +284,7 @@ private:
   // The boundary walk with the split sides cut off their middle, where the cut at the middle
   // leaves no grid layout within MaximumGridSize; false if no cut does better.
   bool BuildBoundaryWalkCutOffMiddle(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed,
-    std::vector<double>& walk, std::vector<double>& parameters, MonotoneSurfaceBoundary& boundary) const;
+    const std::vector<int>& samplesPerPiece, std::vector<double>& walk, std::vector<double>& parameters, MonotoneSurfaceBoundary& boundary) const;
   // Fits the cell's interior, refining its grid (see SurfaceTolerance); returns whether refined.
   bool FitSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided,
     const std::vector<SurfaceSample>& samples) const;

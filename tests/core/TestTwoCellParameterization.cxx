@@ -1490,6 +1490,61 @@ TEST_CASE(SlitRefusals)
     std::printf("  slit outside the outer loop -> left out (%d of %zu samples kept)\n",
       static_cast<int>(mesh.BoundaryCount), outside.Points.size() / 2);
   }
+  // A long slit outside the loop (a merged 1-cell out to a cancelled extremum and back): its
+  // 30 + 29 samples and its base's second visit are 60 of the walk's 100, so the kept walk's
+  // (u, v) jump over more than half of the square's border in one step (2.4 of its 4 units).
+  // The remaining (u, v) still go once around monotonically, onto a convex polygon: Phi must be
+  // one to one on it (the version before took that step's direction from its length, as 1.6
+  // units backwards, and refused).
+  std::vector<std::pair<double, double>> longSlit;
+  for (int j = 1; j <= 30; ++j)
+  {
+    longSlit.emplace_back(0, 1 + 0.02 * j);
+  }
+  const Cell outsideLong = withSlit(longSlit);
+  {
+    TwoCellParameterization tcp;
+    std::string error;
+    const bool parameterized = tcp.Parameterize(outsideLong.Points, outsideLong.Parameters, error);
+    CHECK(parameterized);
+    const TwoCellMesh& mesh = tcp.GetMesh();
+    CHECK_EQ(mesh.OutsideSlits, 1);
+    CHECK_EQ(static_cast<std::size_t>(mesh.BoundaryCount), outsideLong.Points.size() / 2 - 60);
+    // The oracle: every triangle keeps its orientation in (u, v), and their (u, v) areas add
+    // up to the area of the boundary's (u, v) polygon (the map covers it once).
+    double uvArea = 0, boundaryArea = 0;
+    int flipped = 0, firstTurn = 0;
+    for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
+    {
+      const Index* v = &mesh.Triangles[3 * t];
+      const double* a = &mesh.Parameters[2 * v[0]];
+      const double* b = &mesh.Parameters[2 * v[1]];
+      const double* c = &mesh.Parameters[2 * v[2]];
+      const double area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
+      const double* p = &mesh.Points[2 * v[0]];
+      const double* q = &mesh.Points[2 * v[1]];
+      const double* r = &mesh.Points[2 * v[2]];
+      const double xyArea = 0.5 * ((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]));
+      // The same turn in (x, y) and in (u, v) for every triangle, or the opposite for every one.
+      const int turn = (area > 0) == (xyArea > 0) ? 1 : -1;
+      firstTurn = firstTurn == 0 ? turn : firstTurn;
+      flipped += (area == 0 || xyArea == 0 || turn != firstTurn) ? 1 : 0;
+      uvArea += std::abs(area);
+    }
+    for (Index i = 0; i < mesh.BoundaryCount; ++i)
+    {
+      const Index j = (i + 1) % mesh.BoundaryCount;
+      boundaryArea += 0.5 *
+        (mesh.Parameters[2 * i] * mesh.Parameters[2 * j + 1] - mesh.Parameters[2 * j] * mesh.Parameters[2 * i + 1]);
+    }
+    CHECK_EQ(flipped, 0);
+    CHECK(std::abs(uvArea - std::abs(boundaryArea)) <= 1e-9);
+    CHECK(std::abs(boundaryArea) < 0.9); // the slit's stretch of the border is cut off
+    double uv[2];
+    CHECK(tcp.Evaluate(0, 0.5, uv) && !tcp.Evaluate(0, 1.3, uv));
+    std::printf("  long slit outside the outer loop (%s): (u, v) polygon area %.3f, %d flipped triangles\n",
+      parameterized ? "left out" : error.c_str(), std::abs(boundaryArea), flipped);
+  }
   const std::pair<double, double> c30 = CirclePoint(30, 40);
   const Cell touchingVertex = withSlit({ { 0, 0.5 }, { c30.first, c30.second } });
   CHECK(Fails(touchingVertex.Points, touchingVertex.Parameters, "slit tip on an outer loop sample"));

@@ -22,7 +22,8 @@ It also checks that the 1-cells lie within the input's bounds (images whose exte
 start at 0, or at z != 0). It fails on a crash or time-out, on 1-cells outside the input, on
 boundary junction lists that differ, and on a dishonest verdict (1 while the counter disagrees
 or 2-cells failed); the CI subset also fails when the counter's counts differ from the
-complex's.
+complex's. Both sets end with the REQUIRED cases (synthetic inputs that once failed a 2-cell):
+the run fails unless each of them reconstructs every 2-cell and (all but one) verifies.
 Errors and verdicts of 0 on valid input are printed with their totals: they are still open
 (docs/StressTest.md); TOPOSPLINE_STRESS_STRICT=1 fails on those too. A run the filters refuse
 because it would not fit in memory (their error gives the estimate) is counted apart from the
@@ -74,6 +75,19 @@ REGRESSIONS = [
     dict(file="rainier_ned1_1970_full.vti", i0=270, j0=352, w=136, h=48, percent=10.0, k=16),
     dict(file="msh_crater_2007_10m.vti", i0=25, j0=0, w=230, h=153, percent=5.0, k=21),
 ]
+# Synthetic cases that once failed a 2-cell, in both sets (after the regression crops): each must
+# reconstruct every 2-cell and (unless only="cells") verify, by the independent counter too, or
+# the run fails. Full set seed 29: #248, whose boundary polygon cut across a neighbouring curve
+# at 5 samples per segment (TwoCellReconstruction::BoundaryDensifications), and #246 and #291,
+# where leaving out a slit outside the outer loop made the walk's (u, v) jump over more than half
+# of the square's border; seed 13: #279, a nearly flat cell (2.6e-11 of range) whose sides
+# differed by 4.8e-12 (its verdict is still 0: one saddle a few vertices off its node).
+REQUIRED = [
+    dict(kind="mesh_grid", nx=83, ny=92, percent=2.0, k=2, seed=1004966290),
+    dict(kind="mesh_grid", nx=113, ny=132, percent=0.5, k=10, seed=301360000),
+    dict(kind="delaunay", points=5560, percent=5.0, k=4, seed=1393753101),
+    dict(kind="delaunay", points=3213, percent=2.0, k=22, seed=1298341836, only="cells"),
+]
 
 
 # --- the cases ----------------------------------------------------------------------------------
@@ -123,6 +137,11 @@ def make_cases(catalog_entries, full, seed):
     for spec in REGRESSIONS:
         if any(entry["file"] == spec["file"] for entry in catalog_entries):
             add("crop", **spec)
+    for spec in REQUIRED:
+        spec = dict(spec)
+        kind, seed, only = spec.pop("kind"), spec.pop("seed"), spec.pop("only", "verify")
+        add(kind, **spec)
+        cases[-1].update(seed=seed, required=only)
     return cases
 
 
@@ -624,6 +643,16 @@ def main():
         # The CI subset also holds the counts: the sampled field has exactly the simplified
         # complex's critical points on every case (the full set does not yet: StressTest.md).
         hard += totals["count mismatches"]
+    def required_failed(case):
+        r = results.get(case["id"], {"crash": "no result"})
+        if case["required"] == "cells":
+            return "crash" in r or r["errors"] or r["failed_cells"] != 0
+        return bool(judge(r, dict.fromkeys(PROBLEMS, 0)))
+    required_failures = [c["id"] for c in cases if c.get("required") and required_failed(c)]
+    if required_failures:
+        print("required cases that failed (they must reconstruct every 2-cell, most also verify): %s"
+              % required_failures, flush=True)
+    hard += len(required_failures)
     if os.environ.get("TOPOSPLINE_STRESS_STRICT") == "1":
         hard += (totals["errors"] + totals["refused for memory"] + totals["verdict 0"] + totals["count mismatches"] +
                  totals["far critical points"])
