@@ -367,7 +367,7 @@ bool MonotoneSibsonSurface::SetBoundaryNodes(
 
 // Every node lies on one diagonal, which runs from the bottom or left side to the right or top
 // one: its boundary values must increase, or no monotone surface exists.
-bool MonotoneSibsonSurface::ComputeDiagonalRises(Construction& construction, std::string& error) const
+bool MonotoneSibsonSurface::ComputeDiagonalRises(Construction& construction, std::string& error)
 {
   const int n = this->N;
   for (int d = -(n - 1); d <= n - 1; ++d)
@@ -382,7 +382,21 @@ bool MonotoneSibsonSurface::ComputeDiagonalRises(Construction& construction, std
   for (std::size_t d = 0; d < construction.Diagonals.size(); ++d)
   {
     const GridDiagonal& g = construction.Diagonals[d];
-    construction.Rise[d] = this->Z[this->Node(g.I0 + g.Length, g.J0 + g.Length)] - this->Z[this->Node(g.I0, g.J0)];
+    const double start = this->Z[this->Node(g.I0, g.J0)];
+    const double end = this->Z[this->Node(g.I0 + g.Length, g.J0 + g.Length)];
+    construction.Rise[d] = end - start;
+    // Sides that rise by less than their values' rounding over a few grid steps (a DEM's
+    // plateau broken by 1e-9 of its integer heights, a grid of 299 along it) can tie at a
+    // corner: such a diagonal is flat, and its cells are built as well as they can be and
+    // counted as violating, rather than the whole 2-cell left out.
+    if (!(construction.Rise[d] > 0) &&
+      construction.Rise[d] >= -64 * std::numeric_limits<double>::epsilon() * std::max(std::abs(start), std::abs(end)))
+    {
+      construction.Rise[d] = 0;
+      construction.Feasible = false;
+      ++this->BuildReport.FlatDiagonals;
+      continue;
+    }
     if (!(construction.Rise[d] > 0))
     {
       error = "the boundary values do not increase along the grid diagonal from node (" + std::to_string(g.I0) +

@@ -85,6 +85,7 @@ struct MonotoneSurfaceOptions
 struct MonotoneSurfaceReport
 {
   int LinearizedDiagonals = 0;  // the paper's fallback: Laplace values not increasing
+  int FlatDiagonals = 0;        // diagonals whose boundary ends tie within rounding (infeasible, built flat)
   int LimitedNodes = 0;         // nodes whose estimated derivatives were scaled down
   int AdjustedDiagonals = 0;    // diagonals whose interior values were moved
   int GlobalFallback = 0;       // 1 when all free derivatives had to take the minimal choice
@@ -215,7 +216,7 @@ private:
 
   // The steps of Build, in the order they run (paper, section 5.2).
   bool SetBoundaryNodes(const MonotoneSurfaceBoundary& boundary, double allowedMismatch, std::string& error);
-  bool ComputeDiagonalRises(Construction& construction, std::string& error) const;
+  bool ComputeDiagonalRises(Construction& construction, std::string& error);
   void SolveLaplaceValues();
   void LinearizeNonIncreasingDiagonals(const Construction& construction);
   void ClassifyNodes(Construction& construction) const;

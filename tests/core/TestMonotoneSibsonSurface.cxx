@@ -372,6 +372,58 @@ TEST_CASE(RoundingOfANearlyFlatCellIsAveragedAway)
   CHECK(error.find("join") != std::string::npos);
 }
 
+TEST_CASE(SidesTiedByRoundingAtACornerAreBuiltFlat)
+{
+  // A DEM's plateau broken by 1e-9 of its integer heights: the sides meeting at the corner
+  // (1, 0) rise by less than their values' rounding over a grid step, so the diagonal from
+  // (n - 1, 0) to (n, 1) joins two equal values. No strictly monotone surface exists there,
+  // but refusing the whole 2-cell left its region at the input's values (a Maunga Whau crop at
+  // 2 %, grid 299): the surface is built, that diagonal flat, and the cell is reported
+  // infeasible with its violating cells counted.
+  const double s = 97 - 7.5e-10;
+  // Sides through these node values, zero slopes at every node (C1, non-decreasing).
+  auto side = [](const std::vector<double>& values) {
+    BezierSide result;
+    for (std::size_t k = 0; k + 1 < values.size(); ++k)
+    {
+      result.push_back({ { values[k], values[k], values[k + 1], values[k + 1] } });
+    }
+    return result;
+  };
+  MonotoneSurfaceBoundary b;
+  b.Bottom = side({ 96, s, s, s, s });
+  b.Right = side({ s, s, 96.9999999996, 96.9999999999, 97 });
+  b.Left = side({ 96, 96.4, 96.9, 96.99, 96.9995 });
+  b.Top = side({ 96.9995, 96.9998, 96.99999, 96.999999, 97 });
+  MonotoneSibsonSurface surface;
+  std::string error;
+  const bool feasible = surface.Build(b, error);
+  std::printf("  tied corner: %s; grid %d, flat diagonals %d, violating cells %d\n", error.c_str(), surface.GetGridSize(),
+    surface.Report().FlatDiagonals, surface.Report().ViolatingCells);
+  CHECK(!feasible);
+  CHECK_EQ(surface.GetGridSize(), 4);
+  CHECK_EQ(surface.Report().FlatDiagonals, 1);
+  CHECK(MaximumBoundaryError(surface, b) <= 1e-9);
+  // Bounded by the boundary's values (an oracle that needs no monotonicity: a Sibson patch is
+  // a convex combination of its control values, which the construction keeps within them).
+  double lowest = 1e300, highest = -1e300;
+  for (int a = 0; a <= 200; ++a)
+  {
+    for (int c = 0; c <= 200; ++c)
+    {
+      const double value = surface.Evaluate(a / 200.0, c / 200.0);
+      lowest = std::min(lowest, value);
+      highest = std::max(highest, value);
+    }
+  }
+  CHECK(std::isfinite(lowest) && std::isfinite(highest));
+  CHECK(lowest >= 96 - 1e-6 && highest <= 97 + 1e-6);
+  // A real fall (1e-6, far above rounding) is still refused.
+  MonotoneSurfaceBoundary falling = b;
+  falling.Right = side({ s, s - 1e-6, 96.9999999996, 96.9999999999, 97 });
+  CHECK(!surface.Build(falling, error) && surface.GetGridSize() == 0);
+}
+
 TEST_CASE(SurfaceOfLinearDataIsLinear)
 {
   // Boundary of F = x + y: the Laplace values and difference derivatives are exact, nothing
