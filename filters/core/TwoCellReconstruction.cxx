@@ -31,8 +31,9 @@ double Seconds(Clock::time_point start)
 }
 
 // Samples one side, forward from its lower corner: c points per Bezier segment (the piece's
-// own count, SideSegments::Samples, when given) plus the end point, with the side parameter tau of each: segment j of piece i covers m_i grid segments of
-// the N along the side (ChooseGridLayout).
+// own count, SideSegments::Samples, when given) plus the end point, with the side parameter
+// tau of each: segment j of piece i covers m_i grid segments of the N along the side
+// (ChooseGridLayout).
 void SampleSide(const SideSegments& side, const std::vector<int>& multipliers, int n, int c, std::vector<double>& xy,
   std::vector<double>& tau)
 {
@@ -792,7 +793,11 @@ void TwoCellReconstruction::DensifyFailedBoundaries(const MorseSmaleComplex& com
 {
   const Index n = static_cast<Index>(this->Cells.size());
   std::vector<int> samplesPerPiece(smoothed.Pieces.size(), this->BoundarySamples);
-  const int mostSamples = this->BoundarySamples << std::max(this->BoundaryDensifications, 0);
+  // Up to 2^BoundaryDensifications times the samples, but no denser than 64 per segment (a
+  // failing cell with hundreds of segments would otherwise get millions of samples when c is
+  // already large).
+  const int mostSamples = std::max(this->BoundarySamples,
+    std::min(this->BoundarySamples << std::clamp(this->BoundaryDensifications, 0, 8), MostDensifiedSamples));
   for (int round = 0; round < this->BoundaryDensifications && !this->Hooks.Aborted(); ++round)
   {
     // The pieces of the failed cells, each sampled twice as densely as before.

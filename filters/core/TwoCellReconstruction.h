@@ -154,8 +154,10 @@ public:
   // A cell whose walk cannot be parameterized (its polygon crosses or touches itself, mostly
   // where two curves leave a node almost tangentially and one is sampled coarsely across the
   // other's bend) is tried again with its pieces sampled twice as densely, and so are the cells
-  // that share those pieces (their common boundary stays one polyline), up to this many times.
+  // that share those pieces (their common boundary stays one polyline), up to this many times
+  // and up to MostDensifiedSamples per segment (never below BoundarySamples).
   int BoundaryDensifications = 3;
+  static constexpr int MostDensifiedSamples = 64;
   // Cells whose sides need more grid segments than this (ChooseGridLayout) are not
   // reconstructed.
   int MaximumGridSize = 512;
