@@ -798,6 +798,19 @@ void TwoCellReconstruction::DensifyFailedBoundaries(const MorseSmaleComplex& com
   // already large).
   const int mostSamples = std::max(this->BoundarySamples,
     std::min(this->BoundarySamples << std::clamp(this->BoundaryDensifications, 0, 8), MostDensifiedSamples));
+  // The smoothed pieces on the sides of cell c (known ones only).
+  auto forEachPiece = [&](Index c, auto&& visit) {
+    for (const auto& side : this->Cells[c]->Sides.Pieces)
+    {
+      for (Index p : side)
+      {
+        if (p >= 0 && p < static_cast<Index>(smoothed.Pieces.size()))
+        {
+          visit(p);
+        }
+      }
+    }
+  };
   for (int round = 0; round < this->BoundaryDensifications && !this->Hooks.Aborted(); ++round)
   {
     // The pieces of the failed cells, each sampled twice as densely as before.
@@ -805,23 +818,16 @@ void TwoCellReconstruction::DensifyFailedBoundaries(const MorseSmaleComplex& com
     bool any = false;
     for (Index c = 0; c < n; ++c)
     {
-      const ReconstructedTwoCell& cell = *this->Cells[c];
-      if (!cell.MapFailed)
+      if (this->Cells[c]->MapFailed)
       {
-        continue;
-      }
-      for (const auto& side : cell.Sides.Pieces)
-      {
-        for (Index p : side)
-        {
-          if (p >= 0 && p < static_cast<Index>(smoothed.Pieces.size()) && !densified[p] &&
-            samplesPerPiece[p] < mostSamples)
+        forEachPiece(c, [&](Index p) {
+          if (!densified[p] && samplesPerPiece[p] < mostSamples)
           {
             densified[p] = 1;
             samplesPerPiece[p] *= 2;
             any = true;
           }
-        }
+        });
       }
     }
     if (!any)
@@ -834,13 +840,7 @@ void TwoCellReconstruction::DensifyFailedBoundaries(const MorseSmaleComplex& com
     for (Index c = 0; c < n; ++c)
     {
       bool touched = false;
-      for (const auto& side : this->Cells[c]->Sides.Pieces)
-      {
-        for (Index p : side)
-        {
-          touched = touched || (p >= 0 && p < static_cast<Index>(densified.size()) && densified[p]);
-        }
-      }
+      forEachPiece(c, [&](Index p) { touched = touched || densified[p]; });
       if (touched)
       {
         again.push_back(c);
@@ -908,6 +908,7 @@ void TwoCellReconstruction::ParameterizeCell(const TwoCell& twoCell, const OneCe
     return;
   }
   std::string firstError;
+  bool firstErrorIsMap = false; // the error reported comes from Parameterize (not the grid)
   for (const auto& choice : StemChoices(twoCell, cell.Sides, smoothed, walk))
   {
     if (!assemble(choice[0], choice[1]))
@@ -940,7 +941,11 @@ void TwoCellReconstruction::ParameterizeCell(const TwoCell& twoCell, const OneCe
       cell.Valid = true;
       break;
     }
-    firstError = firstError.empty() ? "parameterization: " + message : firstError;
+    if (firstError.empty())
+    {
+      firstError = "parameterization: " + message;
+      firstErrorIsMap = true;
+    }
   }
   if (cell.Negligible)
   {
@@ -949,7 +954,7 @@ void TwoCellReconstruction::ParameterizeCell(const TwoCell& twoCell, const OneCe
   else if (!cell.Valid)
   {
     cell.Error = firstError;
-    cell.MapFailed = firstError.rfind("parameterization: ", 0) == 0;
+    cell.MapFailed = firstErrorIsMap;
   }
 }
 
@@ -982,8 +987,8 @@ void TwoCellReconstruction::LocateSamples(const PlanarScalarField& data, const s
 // anywhere along the split side, so cuts ever farther from the middle (up to a quarter of the
 // side's segments either way) are tried, the nearest one whose layout fits is taken.
 bool TwoCellReconstruction::BuildBoundaryWalkCutOffMiddle(const TwoCellSides& sides,
-  const OneCellSmoothingResult& smoothed, const std::vector<int>& samplesPerPiece, std::vector<double>& walk, std::vector<double>& parameters,
-  MonotoneSurfaceBoundary& boundary) const
+  const OneCellSmoothingResult& smoothed, const std::vector<int>& samplesPerPiece, std::vector<double>& walk,
+  std::vector<double>& parameters, MonotoneSurfaceBoundary& boundary) const
 {
   int longest = 0;
   for (int split : sides.SplitSides)
@@ -1002,8 +1007,8 @@ bool TwoCellReconstruction::BuildBoundaryWalkCutOffMiddle(const TwoCellSides& si
   {
     for (int offset : { -distance, distance })
     {
-      if (BuildBoundaryWalk(TwoCellSideSegments(sides, smoothed, false, offset, &samplesPerPiece), this->BoundarySamples,
-            this->MaximumGridSize, walk, parameters, boundary))
+      if (BuildBoundaryWalk(TwoCellSideSegments(sides, smoothed, false, offset, &samplesPerPiece),
+            this->BoundarySamples, this->MaximumGridSize, walk, parameters, boundary))
       {
         return true;
       }

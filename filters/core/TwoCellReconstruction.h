@@ -286,7 +286,8 @@ private:
   // The boundary walk with the split sides cut off their middle, where the cut at the middle
   // leaves no grid layout within MaximumGridSize; false if no cut does better.
   bool BuildBoundaryWalkCutOffMiddle(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed,
-    const std::vector<int>& samplesPerPiece, std::vector<double>& walk, std::vector<double>& parameters, MonotoneSurfaceBoundary& boundary) const;
+    const std::vector<int>& samplesPerPiece, std::vector<double>& walk, std::vector<double>& parameters,
+    MonotoneSurfaceBoundary& boundary) const;
   // Fits the cell's interior, refining its grid (see SurfaceTolerance); returns whether refined.
   bool FitSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided,
     const std::vector<SurfaceSample>& samples) const;
