@@ -1643,7 +1643,10 @@ public:
       match.Missing = this->WantedSaddles;
       return match;
     }
-    // Matched as the verdict matches them (MatchCriticalPoints: one to one, as many as can be).
+    // Matched as the verdict matches them (MatchCriticalPoints: one to one, as many as can be,
+    // within the tolerance and within two edges of the mesh). Without the mesh, on a Delaunay
+    // mesh of scattered points whose hull edges span the domain (the tolerance is the longest
+    // edge), a saddle several edges from its node counted as on it, and nothing moved it back.
     auto locations = [this](const std::vector<Index>& vertices) {
       std::vector<CriticalPointLocation> result(vertices.size());
       for (std::size_t i = 0; i < vertices.size(); ++i)
@@ -1651,11 +1654,12 @@ public:
         result[i].MorseIndex = 1;
         result[i].Position[0] = this->Points[2 * vertices[i]];
         result[i].Position[1] = this->Points[2 * vertices[i] + 1];
+        result[i].Vertex = vertices[i];
       }
       return result;
     };
     const std::vector<std::size_t> partner =
-      MatchCriticalPoints(locations(this->WantedSaddles), locations(saddles), this->Tolerance);
+      MatchCriticalPoints(locations(this->WantedSaddles), locations(saddles), this->Tolerance, &this->Mesh);
     std::vector<char> used(saddles.size(), 0);
     for (std::size_t i = 0; i < this->WantedSaddles.size(); ++i)
     {

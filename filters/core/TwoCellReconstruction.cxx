@@ -230,10 +230,13 @@ void CutMergedStemAtMaximum(std::vector<Index>& right, std::vector<Index>& top, 
 }
 
 // A side of zero length (a 1-cell of one point: a saddle on its extremum's vertex) is no side:
-// the cell has 3 corners. Likewise a side that ends where it starts: on the domain boundary, a
-// maximum can sit on its saddle's vertex, and the ascending 1-cell between them is a loop
-// through a few triangles around that vertex (well below a grid cell).
-bool IsPointLike(const std::vector<Index>& side, const OneCellSmoothingResult& smoothed)
+// the cell has 3 corners. Likewise a side that ends where it starts and encloses at most
+// `loopArea`: on the domain boundary, a maximum can sit on its saddle's vertex, and the
+// ascending 1-cell between them is a loop through a few triangles around that vertex (well
+// below a grid cell). A larger loop is a side: a descending 1-cell merged by cancellations can
+// run round the whole domain boundary and back through its own saddle (a boundary saddle left
+// as the boundary curve's only critical point), and the cell it bounds is the whole domain.
+bool IsPointLike(const std::vector<Index>& side, const OneCellSmoothingResult& smoothed, double loopArea)
 {
   const Index pieces = static_cast<Index>(smoothed.Pieces.size());
   if (!side.empty() && side.front() >= 0 && side.back() >= 0 && side.front() < pieces && side.back() < pieces)
@@ -242,7 +245,24 @@ bool IsPointLike(const std::vector<Index>& side, const OneCellSmoothingResult& s
     const auto& last = smoothed.Pieces[side.back()].Curve.ControlPoints;
     if (!first.empty() && !last.empty() && first[0] == last[last.size() - 2] && first[1] == last.back())
     {
-      return true;
+      // The area of the loop's control polygon (the curve's, closely enough for this).
+      double twiceArea = 0;
+      for (Index p : side)
+      {
+        if (p < 0 || p >= pieces)
+        {
+          return false;
+        }
+        const auto& points = smoothed.Pieces[p].Curve.ControlPoints;
+        for (std::size_t i = 0; i + 3 < points.size(); i += 2)
+        {
+          twiceArea += points[i] * points[i + 3] - points[i + 2] * points[i + 1];
+        }
+      }
+      if (std::abs(0.5 * twiceArea) <= loopArea)
+      {
+        return true;
+      }
     }
   }
   bool degenerate = !side.empty();
@@ -299,7 +319,7 @@ bool PiecesHaveCurves(const TwoCellSides& sides, const OneCellSmoothingResult& s
 } // namespace
 
 bool AssembleTwoCellSides(const TwoCell& cell, const OneCellSmoothingResult& smoothed, TwoCellSides& sides,
-  std::string& error, bool mergeAtMinimum, bool mergeAtMaximum)
+  std::string& error, bool mergeAtMinimum, bool mergeAtMaximum, double pointLikeLoopArea)
 {
   sides = TwoCellSides();
   const Index oneCells = static_cast<Index>(smoothed.PiecesOfOneCell.size());
@@ -345,7 +365,7 @@ bool AssembleTwoCellSides(const TwoCell& cell, const OneCellSmoothingResult& smo
   }
   for (auto& side : sides.Pieces)
   {
-    if (IsPointLike(side, smoothed))
+    if (IsPointLike(side, smoothed, pointLikeLoopArea))
     {
       side.clear();
     }
@@ -872,7 +892,10 @@ void TwoCellReconstruction::ParameterizeCell(const TwoCell& twoCell, const OneCe
   std::string message;
   std::vector<double> walk, parameters;
   auto assemble = [&](bool mergeAtMinimum, bool mergeAtMaximum) {
-    if (!AssembleTwoCellSides(twoCell, smoothed, cell.Sides, message, mergeAtMinimum, mergeAtMaximum))
+    const double pointLikeLoopArea =
+      this->NegligibleArea > 0 ? this->NegligibleArea : std::numeric_limits<double>::infinity();
+    if (!AssembleTwoCellSides(
+          twoCell, smoothed, cell.Sides, message, mergeAtMinimum, mergeAtMaximum, pointLikeLoopArea))
     {
       return false;
     }

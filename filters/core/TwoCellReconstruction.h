@@ -24,6 +24,7 @@
 #include "TwoCellParameterization.h"
 
 #include <array>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -58,10 +59,13 @@ struct TwoCellSides
 // stem is either outside the cell, which then starts at the junction (mergeAtMinimum, the
 // paper's rule), or inside it, with the minimum at the stem's tip: the cell then wraps around
 // the stem, which stays on its boundary as a slit (mergeAtMinimum = false). Likewise at the
-// maximum. Returns false with a message when the cell cannot be mapped to a square (both
-// sides of a pair empty, unknown pieces).
+// maximum. A side that ends where it starts is no side (the cell has 3 corners) if it encloses
+// at most `pointLikeLoopArea` (a loop through a few triangles round a boundary vertex), and a
+// side otherwise (a 1-cell round the whole domain boundary). Returns false with a message when
+// the cell cannot be mapped to a square (both sides of a pair empty, unknown pieces).
 bool AssembleTwoCellSides(const TwoCell& cell, const OneCellSmoothingResult& smoothed, TwoCellSides& sides,
-  std::string& error, bool mergeAtMinimum = true, bool mergeAtMaximum = true);
+  std::string& error, bool mergeAtMinimum = true, bool mergeAtMaximum = true,
+  double pointLikeLoopArea = std::numeric_limits<double>::infinity());
 
 // The Bezier segments along one side, in order: planar control points (x0 y0 ... x3 y3) and
 // height control values.

@@ -31,6 +31,8 @@
 #include <functional>
 #include <iterator>
 #include <limits>
+#include <map>
+#include <set>
 #include <random>
 #include <string>
 #include <vector>
@@ -803,6 +805,223 @@ TEST_CASE(SaddlesStayOnTheirNodesOnWeakNoise)
   std::printf("  %d of %d noise fields with every interior saddle on its node; %d monkey saddles sampled\n", kept,
     cases, monkeys);
   CHECK(monkeys > 0); // the case exercises what it tests
+}
+
+namespace
+{
+// The vertices of a triangle mesh next to each vertex (written here, from the triangles).
+std::vector<std::vector<Index>> NeighboursOnMesh(const PlanarScalarField& field)
+{
+  std::vector<std::vector<Index>> neighbours(field.Values.size());
+  for (std::size_t t = 0; t + 2 < field.Triangles.size(); t += 3)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      for (int b = 0; b < 3; ++b)
+      {
+        const Index u = field.Triangles[t + a], w = field.Triangles[t + b];
+        if (u != w && std::find(neighbours[u].begin(), neighbours[u].end(), w) == neighbours[u].end())
+        {
+          neighbours[u].push_back(w);
+        }
+      }
+    }
+  }
+  return neighbours;
+}
+
+// The PL saddle multiplicity of every interior vertex of a triangle mesh: the vertex's link is
+// walked as a cycle (the edges opposite it in its triangles), and the pieces of the link
+// below it, minus one, are its multiplicity; ties by vertex id. Vertices whose link is not
+// one cycle (the domain boundary) get 0.
+std::vector<int> SaddleMultiplicityOnMesh(const PlanarScalarField& field, const std::vector<double>& values)
+{
+  const std::size_t n = values.size();
+  std::vector<std::vector<std::pair<Index, Index>>> opposite(n);
+  for (std::size_t t = 0; t + 2 < field.Triangles.size(); t += 3)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      opposite[field.Triangles[t + a]].emplace_back(field.Triangles[t + (a + 1) % 3], field.Triangles[t + (a + 2) % 3]);
+    }
+  }
+  std::vector<int> multiplicity(n, 0);
+  for (std::size_t v = 0; v < n; ++v)
+  {
+    std::map<Index, std::vector<Index>> next;
+    for (const auto& [a, b] : opposite[v])
+    {
+      next[a].push_back(b);
+      next[b].push_back(a);
+    }
+    if (next.empty() || std::any_of(next.begin(), next.end(), [](const auto& e) { return e.second.size() != 2; }))
+    {
+      continue;
+    }
+    std::vector<Index> cycle{ next.begin()->first };
+    Index previous = InvalidIndex;
+    while (cycle.size() <= next.size())
+    {
+      const std::vector<Index>& two = next[cycle.back()];
+      const Index following = two[0] != previous ? two[0] : two[1];
+      previous = cycle.back();
+      if (following == cycle.front())
+      {
+        break;
+      }
+      cycle.push_back(following);
+    }
+    if (cycle.size() != next.size())
+    {
+      continue; // two cycles: not a disk around v
+    }
+    const auto below = [&](Index w) {
+      return values[w] < values[v] || (values[w] == values[v] && w < static_cast<Index>(v));
+    };
+    int changes = 0;
+    for (std::size_t i = 0; i < cycle.size(); ++i)
+    {
+      changes += below(cycle[i]) != below(cycle[(i + 1) % cycle.size()]) ? 1 : 0;
+    }
+    multiplicity[v] = std::max(0, changes / 2 - 1);
+  }
+  return multiplicity;
+}
+
+// Pairs vertices of `a` with vertices of `b` (each listed once per multiplicity) within `hops`
+// mesh edges, one to one, as many as can be (augmenting paths). Returns the partner index in b
+// of each of a (-1: none).
+std::vector<int> PairWithinHops(const std::vector<Index>& a, const std::vector<Index>& b,
+  const std::vector<std::vector<Index>>& neighbours, int hops)
+{
+  std::vector<std::vector<int>> near(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i)
+  {
+    std::set<Index> reached{ a[i] };
+    std::vector<Index> ring{ a[i] };
+    for (int h = 0; h < hops; ++h)
+    {
+      std::vector<Index> outer;
+      for (Index u : ring)
+      {
+        for (Index w : neighbours[u])
+        {
+          if (reached.insert(w).second)
+          {
+            outer.push_back(w);
+          }
+        }
+      }
+      ring.swap(outer);
+    }
+    for (std::size_t j = 0; j < b.size(); ++j)
+    {
+      if (reached.count(b[j]))
+      {
+        near[i].push_back(static_cast<int>(j));
+      }
+    }
+  }
+  std::vector<int> partnerOfA(a.size(), -1), partnerOfB(b.size(), -1);
+  std::function<bool(int, std::vector<char>&)> augment = [&](int i, std::vector<char>& seen) {
+    for (int j : near[i])
+    {
+      if (!seen[j])
+      {
+        seen[j] = 1;
+        if (partnerOfB[j] < 0 || augment(partnerOfB[j], seen))
+        {
+          partnerOfA[i] = j;
+          partnerOfB[j] = i;
+          return true;
+        }
+      }
+    }
+    return false;
+  };
+  for (std::size_t i = 0; i < a.size(); ++i)
+  {
+    std::vector<char> seen(b.size(), 0);
+    augment(static_cast<int>(i), seen);
+  }
+  return partnerOfA;
+}
+} // namespace
+
+// Scattered points with the domain's corners among them, as the stress test's "delaunay"
+// kind: the hull's edges run from corner to corner, so the longest edge (the verdict's
+// distance tolerance) spans the whole domain and only the mesh's edges say what "next to its
+// node" is. Every interior saddle of the complex must have one of the sampling's within two
+// edges and the other way round (multiplicities and one-to-one pairings written here), and the
+// verdict must be 1. Before topological sampling matched its saddles by the mesh's edges too
+// (it took a saddle anywhere within the longest edge as on its node), 5 of the 8 Delaunay
+// meshes of a stress seed with verdict 0 had a saddle 3-6 edges off (here: seed 4 at 25 %).
+// Not at 50 %: there seed 1 fails for another reason, open (docs/StressTest.md): stage 2
+// leaves a boundary saddle as the boundary curve's only critical point, with one descending
+// 1-cell that runs round the whole domain boundary and back through the saddle's own vertex;
+// no monotone height can follow it, and stage 4 reports the one 2-cell as failed.
+TEST_CASE(SaddlesStayWithinTwoEdgesOnScatteredPointMeshes)
+{
+  int cases = 0, paired = 0, saddles = 0;
+  for (std::uint64_t seed : { 1, 2, 3, 4, 5, 6, 7, 8 })
+  {
+    for (double percent : { 5.0, 25.0 })
+    {
+      PlanarScalarField field = RandomDelaunayField(700 + seed, 600);
+      const std::vector<double> corners{ 0, 0, 1, 0, 0, 1, 1, 1 };
+      field.Points.insert(field.Points.end(), corners.begin(), corners.end());
+      for (int c = 0; c < 4; ++c)
+      {
+        field.Values.push_back(std::sin(6 * corners[2 * c]) * std::cos(5 * corners[2 * c + 1]));
+      }
+      field.Triangles = DelaunayTriangles(field.Points);
+      Pipeline p;
+      std::string error;
+      CHECK(RunStages1To3(field, percent, 6, p, error));
+      FieldReconstruction reconstruction;
+      FieldReconstructionReport report;
+      CHECK(reconstruction.Run(p.Field, p.Simplified.Complex, p.Smoothed, report, error));
+      const std::vector<std::vector<Index>> neighbours = NeighboursOnMesh(field);
+      const std::vector<int> multiplicity = SaddleMultiplicityOnMesh(field, report.Values);
+      std::vector<Index> wanted, found;
+      for (const CriticalPoint& cp : p.Simplified.Complex.CriticalPoints)
+      {
+        if (cp.MorseIndex == 1 && !cp.OnBoundary)
+        {
+          wanted.push_back(cp.Vertex);
+        }
+      }
+      for (std::size_t v = 0; v < multiplicity.size(); ++v)
+      {
+        found.insert(found.end(), multiplicity[v], static_cast<Index>(v));
+      }
+      const std::vector<int> partner = PairWithinHops(wanted, found, neighbours, 2);
+      const int matched = static_cast<int>(std::count_if(partner.begin(), partner.end(), [](int j) { return j >= 0; }));
+      const int unpaired = static_cast<int>(wanted.size() + found.size()) - 2 * matched;
+      ++cases;
+      saddles += static_cast<int>(wanted.size());
+      paired += unpaired == 0 ? 1 : 0;
+      if (unpaired > 0 || !report.Verified)
+      {
+        std::printf("  seed %d at %g %%: %d complex and %d sampled interior saddles, %d unpaired within two edges, "
+                    "verdict %d\n",
+          static_cast<int>(seed), percent, static_cast<int>(wanted.size()), static_cast<int>(found.size()), unpaired,
+          report.Verified ? 1 : 0);
+        for (const auto* list : { &report.Spurious, &report.Missing })
+        {
+          for (const CriticalPointLocation& c : *list)
+          {
+            std::printf("    %s index %d at (%g, %g) vertex %d\n", list == &report.Spurious ? "spurious" : "missing",
+              c.MorseIndex, c.Position[0], c.Position[1], static_cast<int>(c.Vertex));
+          }
+        }
+      }
+      CHECK_EQ(unpaired, 0);
+      CHECK(report.Verified);
+    }
+  }
+  std::printf("  %d of %d scattered-point meshes with every interior saddle within two edges of its node "
+              "(%d saddles)\n", paired, cases, saddles);
 }
 
 int main()

@@ -1,7 +1,7 @@
 // What several core tests share: grid fields as triangle meshes, Delaunay meshes of random
 // points, a segment-crossing predicate and the crossing segment pairs of polylines, a
-// ParallelFor over real threads, and the real stages 1-3 run on a synthetic grid (what the
-// stage-4 tests start from).
+// ParallelFor over real threads, and the real stages 1-3 run on a synthetic grid or mesh (what
+// the stage-4 tests start from).
 #pragma once
 
 #include "CoreTypes.h"
@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 #include <string>
@@ -121,12 +122,13 @@ struct Pipeline
   bool ReadAsConstant = false; // stage 1 read a near-constant field as constant
 };
 
-// `nearConstantAsConstant`: stage 1 as the filter runs it (MorseSmaleComplexExtraction::
-// NearConstantAsConstant).
-inline bool RunStages1To3(const GridField& grid, double percent, int k, Pipeline& p, std::string& error,
+// Stages 1-3 on any planar field (a grid's or a triangle mesh's): the domain's bounds are
+// the points' bounding box. `nearConstantAsConstant`: stage 1 as the filter runs it
+// (MorseSmaleComplexExtraction::NearConstantAsConstant).
+inline bool RunStages1To3(const PlanarScalarField& field, double percent, int k, Pipeline& p, std::string& error,
   bool nearConstantAsConstant = false)
 {
-  p.Field = FieldOnGrid(grid);
+  p.Field = field;
   MorseSmaleComplexExtraction extraction;
   extraction.NearConstantAsConstant = nearConstantAsConstant;
   MorseSmaleComplexSimplification simplification;
@@ -137,16 +139,29 @@ inline bool RunStages1To3(const GridField& grid, double percent, int k, Pipeline
   {
     return false;
   }
-  const auto [lo, hi] = std::minmax_element(grid.Values.begin(), grid.Values.end());
+  const auto [lo, hi] = std::minmax_element(field.Values.begin(), field.Values.end());
   p.Range = *hi - *lo;
-  p.Bounds[0] = grid.Origin[0];
-  p.Bounds[1] = grid.Origin[0] + (grid.Dimensions[0] - 1) * grid.Spacing[0];
-  p.Bounds[2] = grid.Origin[1];
-  p.Bounds[3] = grid.Origin[1] + (grid.Dimensions[1] - 1) * grid.Spacing[1];
+  p.Bounds[0] = p.Bounds[2] = std::numeric_limits<double>::infinity();
+  p.Bounds[1] = p.Bounds[3] = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i + 1 < field.Points.size(); i += 2)
+  {
+    for (int axis = 0; axis < 2; ++axis)
+    {
+      p.Bounds[2 * axis] = std::min(p.Bounds[2 * axis], field.Points[i + axis]);
+      p.Bounds[2 * axis + 1] = std::max(p.Bounds[2 * axis + 1], field.Points[i + axis]);
+    }
+  }
   OneCellSmoothing smoothing;
   smoothing.Segments = k;
   return smoothing.Smooth(p.Simplified.Complex, p.Simplified.JunctionPoints, p.Bounds, p.Smoothed, error);
 }
+
+inline bool RunStages1To3(const GridField& grid, double percent, int k, Pipeline& p, std::string& error,
+  bool nearConstantAsConstant = false)
+{
+  return RunStages1To3(FieldOnGrid(grid), percent, k, p, error, nearConstantAsConstant);
+}
+
 // The Delaunay triangulation of `points` (x, y pairs, in general position), counter-clockwise
 // (Bowyer-Watson, quadratic: for test meshes of a few hundred points).
 inline std::vector<Index> DelaunayTriangles(const std::vector<double>& points)

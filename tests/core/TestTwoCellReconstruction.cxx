@@ -331,6 +331,45 @@ TEST_CASE(SideAssembly)
   CHECK(!AssembleTwoCellSides(cell, smoothed, sides, error));
 }
 
+// A side that ends where it starts: a loop through a few triangles round one vertex (the
+// ascending 1-cell of a maximum on its saddle's boundary vertex) is no side, but a descending
+// 1-cell that runs round the whole domain boundary back through its own saddle (the boundary
+// curve's last critical point a saddle) bounds the whole domain: it stays a side. Before sides
+// were told apart by the area they enclose, both were dropped, and such a cell was skipped as
+// having no area (its vertices took the nearest 1-cell's height, no failed cell reported).
+TEST_CASE(ALoopRoundTheDomainIsASide)
+{
+  for (const double size : { 1.0, 0.01 })
+  {
+    OneCellSmoothingResult smoothed;
+    // d0: a square loop of 4 pieces from (0, 0) round and back; a0, a1, d1: one piece each.
+    const double corners[5][2] = { { 0, 0 }, { size, 0 }, { size, size }, { 0, size }, { 0, 0 } };
+    smoothed.Pieces.resize(7);
+    for (int p = 0; p < 7; ++p)
+    {
+      auto& piece = smoothed.Pieces[p];
+      piece.Curve.Segments = piece.Height.Segments = 1;
+      piece.Curve.Dimension = 2;
+      const double* a = p < 4 ? corners[p] : corners[0];
+      const double b[2] = { p < 4 ? corners[p + 1][0] : 0.5 * p, p < 4 ? corners[p + 1][1] : -1.0 };
+      piece.Curve.ControlPoints = { a[0], a[1], (2 * a[0] + b[0]) / 3, (2 * a[1] + b[1]) / 3,
+        (a[0] + 2 * b[0]) / 3, (a[1] + 2 * b[1]) / 3, b[0], b[1] };
+      piece.Height.ControlPoints = { 0, 1, 2, 3 };
+    }
+    smoothed.PiecesOfOneCell = { { 0, 1, 2, 3 }, { 4 }, { 5 }, { 6 } };
+    TwoCell cell;
+    cell.BoundaryOneCells = { 0, 1, 2, 3 };
+    TwoCellSides sides;
+    std::string error;
+    // The filter's NegligibleArea: the square of a mean edge of 0.1.
+    CHECK(AssembleTwoCellSides(cell, smoothed, sides, error, true, true, 0.01));
+    const bool kept = sides.Pieces[TwoCellSides::Bottom] == std::vector<Index>({ 0, 1, 2, 3 });
+    std::printf("  a loop of area %g: %s\n", size * size, kept ? "a side" : "no side");
+    CHECK_EQ(kept, size == 1.0);
+    CHECK(size == 1.0 || sides.Pieces[TwoCellSides::Bottom].empty());
+  }
+}
+
 TEST_CASE(GridLayoutOfOddSplitSides)
 {
   // A cell of three 1-cells of 19 segments each: the empty side takes half of its partner.
