@@ -126,31 +126,31 @@ std::vector<std::size_t> MatchAsManyAsPossible(
   return partnerOfExpected;
 }
 
-// The vertices within `hops` edges of v (v included), sorted.
-std::vector<Index> VerticesWithin(const TriangleMeshTopology& mesh, Index v, int hops)
+// Whether b is within `hops` edges of a: a walk over the triangles around each vertex, with
+// nothing allocated. The topological sampling matches its saddles many times per run with the
+// mesh: a sorted neighbourhood per expected point made stage 4 take 2 s of 16 more on 300 x 300
+// noise.
+bool WithinHops(const TriangleMeshTopology& mesh, Index a, Index b, int hops)
 {
-  std::vector<Index> reached{ v }, frontier{ v };
-  for (int h = 0; h < hops; ++h)
+  if (a == b)
   {
-    std::vector<Index> next;
-    for (Index u : frontier)
+    return true;
+  }
+  if (hops <= 0)
+  {
+    return false;
+  }
+  for (Index i = mesh.VertexTriangleBegin(a); i < mesh.VertexTriangleEnd(a); ++i)
+  {
+    for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
     {
-      for (Index i = mesh.VertexTriangleBegin(u); i < mesh.VertexTriangleEnd(u); ++i)
+      if (w != a && WithinHops(mesh, w, b, hops - 1))
       {
-        for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
-        {
-          if (std::find(reached.begin(), reached.end(), w) == reached.end())
-          {
-            reached.push_back(w);
-            next.push_back(w);
-          }
-        }
+        return true;
       }
     }
-    frontier = std::move(next);
   }
-  std::sort(reached.begin(), reached.end());
-  return reached;
+  return false;
 }
 } // namespace
 
@@ -188,8 +188,6 @@ std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLoca
   };
   for (std::size_t e = 0; e < expected.size(); ++e)
   {
-    const std::vector<Index> near =
-      onMesh(expected[e]) ? VerticesWithin(*mesh, expected[e].Vertex, expected[e].Hops) : std::vector<Index>();
     const auto home = bucketOf(expected[e].Position[0], expected[e].Position[1]);
     // The three buckets of a row follow each other in the sorted array: one search per row.
     for (long long i = home.first - 1; i <= home.first + 1; ++i)
@@ -207,7 +205,8 @@ std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLoca
         const double d = std::hypot(
           expected[e].Position[0] - found[f].Position[0], expected[e].Position[1] - found[f].Position[1]);
         if (d <= tolerance * expected[e].Reach &&
-          (near.empty() || !onMesh(found[f]) || std::binary_search(near.begin(), near.end(), found[f].Vertex)))
+          (!onMesh(expected[e]) || !onMesh(found[f]) ||
+            WithinHops(*mesh, expected[e].Vertex, found[f].Vertex, expected[e].Hops)))
         {
           pairs.emplace_back(d, e, f);
         }
