@@ -36,7 +36,8 @@ struct TopologicalSamplingReport
   bool Converged = false;
   Index ChangedVertices = 0;
   double MaximumChange = 0;
-  int DisplacedSaddles = 0; // wanted saddles with no sampled saddle within the spacing
+  int DisplacedSaddles = 0; // wanted saddles with no sampled saddle within the spacing and two
+                            // mesh edges (the verdict's pairing, MatchCriticalPoints)
   // x, y of each wanted boundary saddle that stood above its whole link and whose only way into
   // the domain ran through a wanted minimum or saddle: its way up raised one (the sampling's
   // vertices are too few there for the complex).
@@ -117,12 +118,13 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
 
 // The whole topological sampling of a reconstruction: the complex's critical points as
 // constraints, its smoothed 1-cells carved in (CarveOneCells), the floods
-// (EnforceCriticalVertices) and the saddles moved back onto their nodes (within Spacing,
-// looked for within 8 spacings), and the changed vertices relaxed back toward F o Phi
-// (RelaxTowardTargets). The 1-cells are carved gently first (OneCellCarving); while
-// saddles are left off their nodes, the whole sequence runs again with the next carving (on
-// samplings of at most MaximumVerticesForMorePasses vertices), and the sampling with the fewest
-// displaced saddles is kept, the gentler one of equals. Boundary saddles whose way up the floods
+// (EnforceCriticalVertices) and the saddles moved back onto their nodes (within Spacing and
+// two mesh edges, as the verdict pairs them; looked for within 8 spacings), and the changed
+// vertices relaxed back toward F o Phi (RelaxTowardTargets). The 1-cells are carved gently
+// first (OneCellCarving); while saddles are left off their nodes, the whole sequence runs
+// again with the next carving (on samplings of at most MaximumVerticesForMorePasses
+// vertices), and the sampling with the fewest displaced saddles is kept, the gentler one of
+// equals. Boundary saddles whose way up the floods
 // forced through a wanted point are then wanted one step along the boundary where that has a
 // way (MoveBlockedBoundarySaddles), and the kept carving runs once more (kept if it leaves fewer
 // saddles off, or as many and fewer blocked). The complex side is fixed at
