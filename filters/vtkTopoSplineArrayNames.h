@@ -159,6 +159,7 @@ constexpr const char* SamplingConverged = "SamplingConverged";
 constexpr const char* SamplingDisplacedSaddles = "SamplingDisplacedSaddles";
 constexpr const char* SamplingBlockedWaysUp = "SamplingBlockedWaysUp";
 constexpr const char* SamplingMovedBoundarySaddles = "SamplingMovedBoundarySaddles";
+constexpr const char* SamplingMovedInteriorSaddles = "SamplingMovedInteriorSaddles";
 // Spurious critical points of F o Phi at the input vertices, within two grid spacings of a
 // smoothed 1-cell and farther.
 constexpr const char* RawSpuriousNearOneCells = "RawSpuriousNearOneCells";

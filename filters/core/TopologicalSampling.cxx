@@ -592,6 +592,10 @@ void AddOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult&
 // Adds to `report` how many of `after` differ from `before`, and by how much at most.
 void CountChanges(const std::vector<double>& before, const std::vector<double>& after,
   TopologicalSamplingReport& report);
+// The wanted saddles (`saddles`, vertices of `mesh`) with no saddle of `values` paired with them
+// as the verdict pairs them (within `tolerance` and two mesh edges).
+std::vector<Index> UnmatchedSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const std::vector<Index>& saddles, double tolerance, const ParallelFor& parallel, const std::vector<double>& values);
 
 // RelocateSaddles tries the patterns of the links (PlaceMissingSaddlesByTheirLinks) of at most
 // this many saddles left off their nodes by the carving, and this many patterns per saddle: each
@@ -1506,14 +1510,84 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
       }
     }
   }
+  const int movedInteriorSaddles =
+    morePasses && mesh.NumberOfVertices() <= this->MaximumVerticesForSaddleMoves
+    ? this->MoveDisplacedSaddles(sampling, mesh, vertexAt, kept, constraints, prepared, values, report)
+    : 0;
   // What the carving, the floods and the relocations changed beyond what the critical points
   // need goes back toward F o Phi (the nodes' vertices toward their critical values).
   RelaxTowardTargets(mesh, prepared, values);
   report.ChangedVertices = 0;
   report.MaximumChange = 0;
   report.MovedBoundarySaddles = movedSaddles;
+  report.MovedInteriorSaddles = movedInteriorSaddles;
   CountChanges(before, values, report);
   return report;
+}
+
+// Interior saddles the sequence left off their nodes, each wanted in turn on a neighbour of its
+// node instead (one edge away: a saddle found there or next to it is still within the verdict's
+// two edges of the node). Where two wanted points sit side by side near the boundary, a boundary
+// saddle's way up and an interior saddle compete for the same few vertices (stress seed 41,
+// #253: the way up has to pass the vertex that must stay below the saddle), and one vertex
+// along, the saddle leaves the way free. Each try runs the kept carving's pass again (Settle)
+// from the prepared values, the node's critical value on the neighbour; a try is kept if fewer
+// wanted points are missing, judged against the nodes themselves as the verdict judges them.
+int TopologicalSampling::MoveDisplacedSaddles(const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
+  const std::function<Index(Index)>& vertexAt, OneCellCarving carving, SamplingConstraints& constraints,
+  std::vector<double>& prepared, std::vector<double>& values, TopologicalSamplingReport& report) const
+{
+  if (report.DisplacedSaddles <= 0 || report.DisplacedSaddles > this->MaximumSaddlesToMove)
+  {
+    return 0;
+  }
+  const double tolerance = this->Spacing * (1 + 1e-9);
+  const std::vector<Index> nodes = constraints.Saddles; // the verdict's saddles, never moved here
+  const auto missing = [&](const std::vector<double>& sampled) {
+    return static_cast<Index>(UnmatchedSaddles(sampling, mesh, nodes, tolerance, this->Parallel, sampled).size()) +
+      CountMissingWantedExtrema(mesh, constraints, sampled);
+  };
+  Index current = missing(values);
+  const std::vector<unsigned char> wanted = WantedFlags(mesh.NumberOfVertices(), constraints);
+  int moved = 0, tries = 0;
+  for (Index w : UnmatchedSaddles(sampling, mesh, nodes, tolerance, this->Parallel, values))
+  {
+    if (mesh.IsBoundaryVertex(w) || std::count(constraints.Saddles.begin(), constraints.Saddles.end(), w) != 1)
+    {
+      continue; // boundary saddles have their own moves; a monkey saddle stays whole
+    }
+    const VertexLink link(mesh, w);
+    for (Index u : link)
+    {
+      if (wanted[u] || mesh.IsBoundaryVertex(u) || tries >= this->MaximumSaddleMoveTries)
+      {
+        continue;
+      }
+      ++tries;
+      SamplingConstraints trial = constraints;
+      std::replace(trial.Saddles.begin(), trial.Saddles.end(), w, u);
+      for (SaddleOneCell& cell : trial.SaddleOneCells)
+      {
+        cell.Saddle = cell.Saddle == w ? u : cell.Saddle;
+      }
+      std::vector<double> start = prepared;
+      start[u] = prepared[w];
+      std::vector<double> settled = start;
+      const TopologicalSamplingReport next = this->Settle(sampling, mesh, vertexAt, trial, carving, settled);
+      const Index after = missing(settled);
+      if (after < current)
+      {
+        current = after;
+        constraints = std::move(trial);
+        prepared = std::move(start);
+        values = std::move(settled);
+        report = next;
+        ++moved;
+        break;
+      }
+    }
+  }
+  return moved;
 }
 
 // The steps of Apply after the nodes' values: the 1-cells carved in, the boundary junctions
@@ -1934,6 +2008,16 @@ int PlaceMissingSaddlesByTheirLinks(const PlanarScalarField& field, const Triang
   relocation.TryLinkPatterns(maximumMissing, maximumPatterns);
   return static_cast<int>(relocation.Current.Missing.size());
 }
+
+namespace
+{
+std::vector<Index> UnmatchedSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const std::vector<Index>& saddles, double tolerance, const ParallelFor& parallel, const std::vector<double>& values)
+{
+  SaddleMatcher matcher(field, mesh, saddles, tolerance, parallel);
+  return matcher.Match(values).Missing;
+}
+} // namespace
 
 namespace
 {

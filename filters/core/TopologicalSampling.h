@@ -46,6 +46,9 @@ struct TopologicalSamplingReport
   // Wanted boundary saddles with no way up that the sampling wants one step along the boundary
   // instead, where there is one.
   int MovedBoundarySaddles = 0;
+  // Interior saddles left off their nodes that the sampling wants one edge away instead
+  // (TopologicalSampling::MoveDisplacedSaddles).
+  int MovedInteriorSaddles = 0;
 };
 
 // One smoothed 1-cell of a wanted saddle, sampled from the saddle outwards: x, y and height per
@@ -124,10 +127,11 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
 // first (OneCellCarving); while saddles are left off their nodes, the whole sequence runs
 // again with the next carving (on samplings of at most MaximumVerticesForMorePasses
 // vertices), and the sampling with the fewest displaced saddles is kept, the gentler one of
-// equals. Boundary saddles whose way up the floods
-// forced through a wanted point are then wanted one step along the boundary where that has a
-// way (MoveBlockedBoundarySaddles), and the kept carving runs once more (kept if it leaves fewer
-// saddles off, or as many and fewer blocked). The complex side is fixed at
+// equals. Boundary saddles whose way up the floods forced through a wanted point are then
+// wanted one step along the boundary where that has a way (MoveBlockedBoundarySaddles), and the
+// kept carving runs once more (kept if it leaves fewer saddles off, or as many and fewer
+// blocked). Interior saddles still off their nodes are then wanted one edge away in turn
+// (MoveDisplacedSaddles; kept if fewer wanted points are missing). The complex side is fixed at
 // construction; Apply samples one sampling of the reconstruction (the input vertices, a finer
 // grid).
 // `complexPoints` (x, y per vertex of `complexMesh`) tells where the nodes are: on a sampling
@@ -157,6 +161,12 @@ public:
   // Samplings with more vertices keep the first pass (the gentlest carving) even with saddles
   // off their nodes (see Apply).
   Index MaximumVerticesForMorePasses = Index(1) << 20;
+  // MoveDisplacedSaddles runs on samplings of at most this many vertices, while at most
+  // MaximumSaddlesToMove saddles are off, and tries at most MaximumSaddleMoveTries neighbours
+  // (each try is a whole pass).
+  Index MaximumVerticesForSaddleMoves = Index(1) << 16;
+  int MaximumSaddlesToMove = 4;
+  int MaximumSaddleMoveTries = 24;
 
   // `values` (one per vertex of `mesh`, at sampling.Points) is modified in place; `vertexAt`
   // gives the sampling's vertex for a vertex of the complex's mesh (InvalidIndex: none). The
@@ -165,6 +175,9 @@ public:
     const std::function<Index(Index)>& vertexAt, std::vector<double>& values) const;
 
 private:
+  int MoveDisplacedSaddles(const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
+    const std::function<Index(Index)>& vertexAt, OneCellCarving carving, SamplingConstraints& constraints,
+    std::vector<double>& prepared, std::vector<double>& values, TopologicalSamplingReport& report) const;
   // How far from its node a saddle is looked for and carved back.
   double SaddleReach() const { return 8 * this->Spacing; }
   // One pass: carves the 1-cells, places the boundary junctions (added to `constraints` for the

@@ -94,6 +94,9 @@ REQUIRED = [
     # counted as on it while topological sampling matched saddles by distance alone (seed 41).
     dict(kind="delaunay", points=1407, percent=50.0, k=17, seed=281372017),
     dict(kind="delaunay", points=2172, percent=50.0, k=6, seed=750220743),
+    # A saddle left off its node that verifies only when wanted one edge away (seed 41).
+    dict(kind="noise", nx=24, ny=24, percent=25.0, k=30, seed=1935319987),
+    dict(kind="mesh_grid", nx=87, ny=71, percent=1.0, k=20, seed=518899382),
 ]
 
 
