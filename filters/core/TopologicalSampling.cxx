@@ -1543,14 +1543,14 @@ int TopologicalSampling::MoveDisplacedSaddles(const PlanarScalarField& sampling,
   }
   const double tolerance = this->Spacing * (1 + 1e-9);
   const std::vector<Index> nodes = constraints.Saddles; // the verdict's saddles, never moved here
-  const auto missing = [&](const std::vector<double>& sampled) {
-    return static_cast<Index>(UnmatchedSaddles(sampling, mesh, nodes, tolerance, this->Parallel, sampled).size()) +
-      CountMissingWantedExtrema(mesh, constraints, sampled);
+  const auto missing = [&](const std::vector<Index>& unmatched, const std::vector<double>& sampled) {
+    return static_cast<Index>(unmatched.size()) + CountMissingWantedExtrema(mesh, constraints, sampled);
   };
-  Index current = missing(values);
+  const std::vector<Index> unmatched = UnmatchedSaddles(sampling, mesh, nodes, tolerance, this->Parallel, values);
+  Index current = missing(unmatched, values);
   const std::vector<unsigned char> wanted = WantedFlags(mesh.NumberOfVertices(), constraints);
   int moved = 0, tries = 0;
-  for (Index w : UnmatchedSaddles(sampling, mesh, nodes, tolerance, this->Parallel, values))
+  for (Index w : unmatched)
   {
     if (mesh.IsBoundaryVertex(w) || std::count(constraints.Saddles.begin(), constraints.Saddles.end(), w) != 1)
     {
@@ -1574,7 +1574,8 @@ int TopologicalSampling::MoveDisplacedSaddles(const PlanarScalarField& sampling,
       start[u] = prepared[w];
       std::vector<double> settled = start;
       const TopologicalSamplingReport next = this->Settle(sampling, mesh, vertexAt, trial, carving, settled);
-      const Index after = missing(settled);
+      const Index after =
+        missing(UnmatchedSaddles(sampling, mesh, nodes, tolerance, this->Parallel, settled), settled);
       if (after < current)
       {
         current = after;

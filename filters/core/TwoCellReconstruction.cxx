@@ -246,7 +246,7 @@ bool IsPointLike(const std::vector<Index>& side, const OneCellSmoothingResult& s
     if (!first.empty() && !last.empty() && first[0] == last[last.size() - 2] && first[1] == last.back())
     {
       // The area of the loop's control polygon (the curve's, closely enough for this).
-      double twiceArea = 0;
+      std::vector<double> polygon;
       for (Index p : side)
       {
         if (p < 0 || p >= pieces)
@@ -254,12 +254,9 @@ bool IsPointLike(const std::vector<Index>& side, const OneCellSmoothingResult& s
           return false;
         }
         const auto& points = smoothed.Pieces[p].Curve.ControlPoints;
-        for (std::size_t i = 0; i + 3 < points.size(); i += 2)
-        {
-          twiceArea += points[i] * points[i + 3] - points[i + 2] * points[i + 1];
-        }
+        polygon.insert(polygon.end(), points.begin(), points.end());
       }
-      if (std::abs(0.5 * twiceArea) <= loopArea)
+      if (std::abs(0.5 * DoubleSignedArea(polygon)) <= loopArea)
       {
         return true;
       }
@@ -891,9 +888,9 @@ void TwoCellReconstruction::ParameterizeCell(const TwoCell& twoCell, const OneCe
 {
   std::string message;
   std::vector<double> walk, parameters;
+  const double pointLikeLoopArea =
+    this->NegligibleArea > 0 ? this->NegligibleArea : std::numeric_limits<double>::infinity();
   auto assemble = [&](bool mergeAtMinimum, bool mergeAtMaximum) {
-    const double pointLikeLoopArea =
-      this->NegligibleArea > 0 ? this->NegligibleArea : std::numeric_limits<double>::infinity();
     if (!AssembleTwoCellSides(
           twoCell, smoothed, cell.Sides, message, mergeAtMinimum, mergeAtMaximum, pointLikeLoopArea))
     {

@@ -831,71 +831,15 @@ std::vector<std::vector<Index>> NeighboursOnMesh(const PlanarScalarField& field)
   return neighbours;
 }
 
-// The PL saddle multiplicity of every interior vertex of a triangle mesh: the vertex's link is
-// walked as a cycle (the edges opposite it in its triangles), and the pieces of the link
-// below it, minus one, are its multiplicity; ties by vertex id. Vertices whose link is not
-// one cycle (the domain boundary) get 0.
-std::vector<int> SaddleMultiplicityOnMesh(const PlanarScalarField& field, const std::vector<double>& values)
-{
-  const std::size_t n = values.size();
-  std::vector<std::vector<std::pair<Index, Index>>> opposite(n);
-  for (std::size_t t = 0; t + 2 < field.Triangles.size(); t += 3)
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      opposite[field.Triangles[t + a]].emplace_back(field.Triangles[t + (a + 1) % 3], field.Triangles[t + (a + 2) % 3]);
-    }
-  }
-  std::vector<int> multiplicity(n, 0);
-  for (std::size_t v = 0; v < n; ++v)
-  {
-    std::map<Index, std::vector<Index>> next;
-    for (const auto& [a, b] : opposite[v])
-    {
-      next[a].push_back(b);
-      next[b].push_back(a);
-    }
-    if (next.empty() || std::any_of(next.begin(), next.end(), [](const auto& e) { return e.second.size() != 2; }))
-    {
-      continue;
-    }
-    std::vector<Index> cycle{ next.begin()->first };
-    Index previous = InvalidIndex;
-    while (cycle.size() <= next.size())
-    {
-      const std::vector<Index>& two = next[cycle.back()];
-      const Index following = two[0] != previous ? two[0] : two[1];
-      previous = cycle.back();
-      if (following == cycle.front())
-      {
-        break;
-      }
-      cycle.push_back(following);
-    }
-    if (cycle.size() != next.size())
-    {
-      continue; // two cycles: not a disk around v
-    }
-    const auto below = [&](Index w) {
-      return values[w] < values[v] || (values[w] == values[v] && w < static_cast<Index>(v));
-    };
-    int changes = 0;
-    for (std::size_t i = 0; i < cycle.size(); ++i)
-    {
-      changes += below(cycle[i]) != below(cycle[(i + 1) % cycle.size()]) ? 1 : 0;
-    }
-    multiplicity[v] = std::max(0, changes / 2 - 1);
-  }
-  return multiplicity;
-}
-
 // The saddles of a sampling on a triangle mesh by the complex's closed-boundary rule
 // (docs/MorseSmaleComplex.md; the stress test counts the same way): an interior vertex is a
 // saddle of multiplicity (lower-link pieces round its link cycle) - 1; a boundary vertex, whose
 // link is a path, is a saddle once when both ends of the path are lower (a maximum of the
 // boundary curve), and once more per piece of its lower link that touches neither end. Ties by
-// vertex id. Each saddle is listed once per multiplicity.
-std::vector<Index> SaddlesByTheBoundaryRule(const PlanarScalarField& field, const std::vector<double>& values)
+// vertex id. Each saddle is listed once per multiplicity; `withBoundary` false leaves out the
+// boundary vertices.
+std::vector<Index> SaddlesByTheBoundaryRule(
+  const PlanarScalarField& field, const std::vector<double>& values, bool withBoundary = true)
 {
   const std::size_t n = values.size();
   std::vector<std::map<Index, Index>> successor(n);
@@ -928,6 +872,10 @@ std::vector<Index> SaddlesByTheBoundaryRule(const PlanarScalarField& field, cons
         first = from; // the start of the link path
         boundary = true;
       }
+    }
+    if (boundary && !withBoundary)
+    {
+      continue;
     }
     std::vector<Index> walk{ first };
     for (auto it = next.find(first); it != next.end() && it->second != first && walk.size() <= next.size();
@@ -1072,18 +1020,14 @@ TEST_CASE(SaddlesStayWithinTwoEdgesOnScatteredPointMeshes)
       FieldReconstructionReport report;
       CHECK(reconstruction.Run(p.Field, p.Simplified.Complex, p.Smoothed, report, error));
       const std::vector<std::vector<Index>> neighbours = NeighboursOnMesh(field);
-      const std::vector<int> multiplicity = SaddleMultiplicityOnMesh(field, report.Values);
-      std::vector<Index> wanted, found;
+      const std::vector<Index> found = SaddlesByTheBoundaryRule(field, report.Values, false);
+      std::vector<Index> wanted;
       for (const CriticalPoint& cp : p.Simplified.Complex.CriticalPoints)
       {
         if (cp.MorseIndex == 1 && !cp.OnBoundary)
         {
           wanted.push_back(cp.Vertex);
         }
-      }
-      for (std::size_t v = 0; v < multiplicity.size(); ++v)
-      {
-        found.insert(found.end(), multiplicity[v], static_cast<Index>(v));
       }
       const std::vector<int> partner = PairWithinHops(wanted, found, neighbours, 2);
       const int matched = static_cast<int>(std::count_if(partner.begin(), partner.end(), [](int j) { return j >= 0; }));
