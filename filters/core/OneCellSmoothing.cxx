@@ -1507,6 +1507,29 @@ int SegmentsOfPiece(const SmoothedPiece& piece, int asked)
   }
   return asked;
 }
+
+// The count a piece's k rises to where it crosses another piece or misses its heights: the
+// next divisor of k at least twice the current count (k if none), beyond k twice the count.
+// Every count then divides k 2^j, so the pieces of one 2-cell's sides reach a common grid
+// count (ChooseGridLayout) within a few multiples of the largest. Doubling the divisors as
+// well gave counts like 32 (2 doubled four times) beside 44 and 88 at k = 22, which need a
+// grid of 704, beyond stage 4's limit: the stress test's failed 2-cells on noise at 50 %
+// and on Delaunay meshes with k 22, 26 and 30.
+int RaisedSegments(int current, int asked)
+{
+  if (current >= asked)
+  {
+    return 2 * current;
+  }
+  for (int d = 2 * current; d < asked; ++d)
+  {
+    if (asked % d == 0)
+    {
+      return d;
+    }
+  }
+  return asked;
+}
 } // namespace
 
 namespace
@@ -1935,8 +1958,9 @@ bool OneCellSmoothing::FitAllPieces(
     for (Index p = 0; p < count; ++p)
     {
       const SmoothedPiece& piece = result.Pieces[p];
-      if (piece.LargestMiss > this->HeightTolerance && 2 * piece.Segments <= this->MaximumHeightSegments &&
-        static_cast<int>(piece.Values.size()) > 3 * 2 * piece.Segments)
+      const int raised = RaisedSegments(piece.Segments, this->Segments);
+      if (piece.LargestMiss > this->HeightTolerance && raised <= this->MaximumHeightSegments &&
+        static_cast<int>(piece.Values.size()) > 3 * raised)
       {
         missing.push_back(p);
       }
@@ -1946,7 +1970,8 @@ bool OneCellSmoothing::FitAllPieces(
       break;
     }
     if (!this->FitInParallel(
-          result, missing, [](const SmoothedPiece& piece) { return 2 * piece.Segments; }, domainBounds, error))
+          result, missing, [this](const SmoothedPiece& piece) { return RaisedSegments(piece.Segments, this->Segments); },
+          domainBounds, error))
     {
       return false;
     }
@@ -2017,21 +2042,23 @@ bool OneCellSmoothing::RepairCrossings(
       pairs = detector.UpdateCrossings(even, crossing);
       continue;
     }
-    // k doubles, and only doubles (a cap between would leave counts like 25 and 37, whose
-    // common multiples exceed stage 4's grid limit): stage 4 subdivides each piece of the
-    // four sides of a cell by a whole factor to one common count.
+    // k rises to the next divisor of k or doubles beyond it (RaisedSegments; a cap between
+    // would leave counts like 25 and 37, whose common multiples exceed stage 4's grid limit):
+    // stage 4 subdivides each piece of the four sides of a cell by a whole factor to one
+    // common count.
     std::vector<Index> raise;
     for (Index p : crossing)
     {
       const SmoothedPiece& piece = result.Pieces[p];
       const int cap = std::max(this->MaximumSegments, static_cast<int>(piece.Values.size()) - 1);
-      if (piece.Segments < cap && 2 * piece.Segments <= MonotoneBSplineFit::MaximumSegments)
+      if (piece.Segments < cap && RaisedSegments(piece.Segments, this->Segments) <= MonotoneBSplineFit::MaximumSegments)
       {
         raise.push_back(p);
       }
     }
     if (!this->FitInParallel(
-          result, raise, [](const SmoothedPiece& piece) { return 2 * piece.Segments; }, domainBounds, error))
+          result, raise, [this](const SmoothedPiece& piece) { return RaisedSegments(piece.Segments, this->Segments); },
+          domainBounds, error))
     {
       return false;
     }

@@ -16,6 +16,7 @@
 #include "SyntheticFields.h"
 #include "TestHarness.h"
 #include "TestSupport.h"
+#include "TwoCellReconstruction.h"
 
 #include <array>
 #include <set>
@@ -261,6 +262,113 @@ TEST_CASE(ShortPiecesGetNoMoreSegmentsThanEdges)
   CHECK(segments < 21L * static_cast<long>(result.Pieces.size()) / 3);
   std::printf("  40^2 noise, 2%%, k 21: %zu pieces, %d short, %ld segments (k each: %zu), %d adapted\n",
     result.Pieces.size(), result.ShortPieces, segments, 21 * result.Pieces.size(), result.AdaptedPieces);
+}
+
+//------------------------------------------------------------------------------
+// Counts raised by crossings or height misses still give every 2-cell a common grid. Stage 4
+// subdivides each piece of a cell's four sides by a whole factor to one count N per side (at
+// most 512, TwoCellReconstruction::MaximumGridSize). Short pieces start at a divisor of k; when
+// raising doubled them too, k = 22 gave pieces of 32 (2 doubled four times) beside 44 and 88
+// on one cell, and the first N they all reach is 704: the stress test's failed 2-cells on noise
+// at 50 % and Delaunay meshes with k 22, 26 and 30. Oracle in the test: per cell, the smallest N
+// that every non-empty side reaches as a sum of its pieces' counts, each used at least once
+// (a coin problem solved here by a table over N).
+namespace
+{
+bool SidesReachOneGrid(const std::array<std::vector<int>, 4>& sides, int limit, int& reached)
+{
+  std::array<std::vector<char>, 4> sums;
+  for (int s = 0; s < 4; ++s)
+  {
+    sums[s].assign(limit + 1, 0);
+    int base = 0;
+    for (int count : sides[s])
+    {
+      base += count;
+    }
+    if (sides[s].empty() || base > limit)
+    {
+      sums[s].assign(limit + 1, sides[s].empty() ? 1 : 0);
+      continue;
+    }
+    sums[s][base] = 1;
+    for (int n = base + 1; n <= limit; ++n)
+    {
+      for (int count : sides[s])
+      {
+        sums[s][n] = sums[s][n] || (n - count >= base && sums[s][n - count]);
+      }
+    }
+  }
+  for (int n = 1; n <= limit; ++n)
+  {
+    if (sums[0][n] && sums[1][n] && sums[2][n] && sums[3][n])
+    {
+      reached = n;
+      return true;
+    }
+  }
+  return false;
+}
+} // namespace
+
+TEST_CASE(RaisedCountsKeepACommonGridPerCell)
+{
+  const int limit = TwoCellReconstruction().MaximumGridSize;
+  int runs = 0, cells = 0, beyond = 0, largest = 0;
+  for (int k : { 22, 26, 30 })
+  {
+    for (double percent : { 25.0, 50.0 })
+    {
+      for (std::uint64_t seed = 1; seed <= 4; ++seed)
+      {
+        GridField noise;
+        noise.Dimensions[0] = noise.Dimensions[1] = 64;
+        DeterministicRandom random(1000 * seed + k);
+        for (int i = 0; i < 64 * 64; ++i)
+        {
+          noise.Values.push_back(random.Uniform());
+        }
+        Stage3Input input;
+        std::string error;
+        CHECK(RunStages1And2(noise, percent, input, error));
+        OneCellSmoothing smoothing;
+        smoothing.Segments = k;
+        smoothing.HeightTolerance = percent / 100 * input.Range; // as the filter
+        OneCellSmoothingResult result;
+        CHECK(smoothing.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, result, error));
+        ++runs;
+        for (const TwoCell& cell : input.Simplified.Complex.TwoCells)
+        {
+          TwoCellSides sides;
+          if (!AssembleTwoCellSides(cell, result, sides, error))
+          {
+            continue;
+          }
+          std::array<std::vector<int>, 4> counts;
+          for (int s = 0; s < 4; ++s)
+          {
+            for (Index p : sides.Pieces[s])
+            {
+              counts[s].push_back(result.Pieces[p].Segments);
+            }
+          }
+          int reached = 0;
+          ++cells;
+          if (!SidesReachOneGrid(counts, limit, reached))
+          {
+            ++beyond;
+            std::printf("  k %d, %.0f %%, seed %llu: a cell's sides reach no common grid up to %d\n", k, percent,
+              static_cast<unsigned long long>(seed), limit);
+          }
+          largest = std::max(largest, reached);
+        }
+      }
+    }
+  }
+  std::printf("  64^2 noise, k 22/26/30, 25/50 %%: %d runs, %d cells, %d beyond %d, largest grid %d\n", runs, cells,
+    beyond, limit, largest);
+  CHECK(beyond == 0);
 }
 
 //------------------------------------------------------------------------------
