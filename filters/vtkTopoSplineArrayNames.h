@@ -35,6 +35,7 @@ constexpr const char* VertexId = "VertexId";
 constexpr const char* IsOnBoundary = "IsOnBoundary";
 constexpr const char* CriticalCellId = "CriticalCellId"; // the critical vertex, edge or triangle
 constexpr const char* SaddleEdgeVertexId = "SaddleEdgeVertexId"; // a saddle's other edge vertex; -1 else
+constexpr const char* IsCornerTriangle = "IsCornerTriangle"; // a maximum whose triangle is its vertex's only one
 
 // 1-cells (cell data of the "OneCells" block; point data: the scalar along the 1-cell).
 constexpr const char* SeparatrixId = "SeparatrixId";

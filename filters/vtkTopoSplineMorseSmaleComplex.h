@@ -10,7 +10,8 @@
  * input. Blocks (names and arrays in vtkTopoSplineArrayNames.h):
  *  0 "CriticalPoints"   vertices: CriticalPointId (stable), CriticalIndex (0/1/2),
  *                       CriticalValue, VertexId, IsOnBoundary, CriticalCellId,
- *                       SaddleEdgeVertexId (a saddle's other edge vertex, -1 for extrema)
+ *                       SaddleEdgeVertexId (a saddle's other edge vertex, -1 for extrema),
+ *                       IsCornerTriangle (a maximum whose triangle is its vertex's only one)
  *  1 "OneCells"         polylines (the 1-cells) from the lower to the higher critical point: cell data
  *                       SeparatrixId, SourceId, DestinationId, SeparatrixType (0 descending
  *                       minimum-saddle, 1 ascending saddle-maximum); point data ScalarValue

@@ -65,6 +65,7 @@ vtkSmartPointer<vtkPolyData> CriticalPointsBlock(const topospline::MorseSmaleCom
   auto cell = conversion::NewArray<vtkIdTypeArray>(names::CriticalCellId, 1, n);
   auto boundary = conversion::NewArray<vtkCharArray>(names::IsOnBoundary, 1, n);
   auto edgeVertex = conversion::NewArray<vtkIdTypeArray>(names::SaddleEdgeVertexId, 1, n);
+  auto corner = conversion::NewArray<vtkCharArray>(names::IsCornerTriangle, 1, n);
   for (vtkIdType i = 0; i < n; ++i)
   {
     points->SetPoint(i, domain->GetPoint(cps[i].Vertex));
@@ -76,10 +77,11 @@ vtkSmartPointer<vtkPolyData> CriticalPointsBlock(const topospline::MorseSmaleCom
     cell->SetValue(i, cps[i].Cell);
     boundary->SetValue(i, cps[i].OnBoundary ? 1 : 0);
     edgeVertex->SetValue(i, cps[i].EdgeVertex);
+    corner->SetValue(i, cps[i].CornerTriangle ? 1 : 0);
   }
   critical->SetPoints(points);
   critical->SetVerts(verts);
-  conversion::AddArrays(critical->GetPointData(), { id, index, value, vertex, cell, boundary, edgeVertex });
+  conversion::AddArrays(critical->GetPointData(), { id, index, value, vertex, cell, boundary, edgeVertex, corner });
   critical->GetPointData()->SetActiveScalars(names::CriticalIndex);
   return critical;
 }
@@ -266,6 +268,7 @@ struct ComplexArrays
   vtkDataSet* Segmentation = nullptr;
   vtkDataArray *Id, *Index, *Value, *Vertex, *Cell, *Boundary;       // critical points
   vtkDataArray* EdgeVertex = nullptr; // optional: complexes written before it existed
+  vtkDataArray* CornerTriangle = nullptr; // optional, as EdgeVertex
   vtkDataArray *Source, *Destination, *Type, *Along, *MeshCell;       // 1-cells
   vtkDataArray *Ascending, *Descending, *TwoCellOfVertex;             // segmentation
   vtkDataArray *Minimum, *Maximum, *Saddles, *Sides, *Pouch, *Size;   // 2-cells
@@ -280,6 +283,7 @@ struct ComplexArrays
     this->Cell = RequireArray(pd, names::CriticalCellId, error);
     this->Boundary = RequireArray(pd, names::IsOnBoundary, error);
     this->EdgeVertex = pd->GetArray(names::SaddleEdgeVertexId);
+    this->CornerTriangle = pd->GetArray(names::IsCornerTriangle);
     auto* cd = this->OneCells->GetCellData();
     this->Source = RequireArray(cd, names::SourceId, error);
     this->Destination = RequireArray(cd, names::DestinationId, error);
@@ -342,6 +346,7 @@ bool ReadCriticalPoints(const ComplexArrays& in, topospline::MorseSmaleComplex& 
     cp.Cell = static_cast<Index>(in.Cell->GetComponent(i, 0));
     cp.OnBoundary = in.Boundary->GetComponent(i, 0) != 0;
     cp.EdgeVertex = in.EdgeVertex ? static_cast<Index>(in.EdgeVertex->GetComponent(i, 0)) : topospline::InvalidIndex;
+    cp.CornerTriangle = in.CornerTriangle && in.CornerTriangle->GetComponent(i, 0) != 0;
     if (!local.Add(cp.Id, static_cast<Index>(i)))
     {
       error = "the input is not a Morse-Smale complex: negative critical point id";

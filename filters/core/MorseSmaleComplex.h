@@ -49,6 +49,11 @@ struct CriticalPoint
   // A saddle's: the other (lower) vertex of its critical edge. Stage 2 draws a merged ascending
   // 1-cell across the edge of a cancelled saddle through the edge's midpoint (triangle meshes).
   Index EdgeVertex = InvalidIndex;
+  // A maximum's: its triangle is the only one at its vertex (two corners of a grid, an ear of a
+  // mesh's hull). Such a vertex above both of its neighbours is a boundary saddle and this
+  // maximum at once in any sampling, so stage 2 keeps the maximum while that saddle lies
+  // between two minima (MorseSmaleComplexSimplification::KeepsCornerMaximum).
+  bool CornerTriangle = false;
 };
 
 // A 1-cell between a lower-index source and a higher-index destination critical point.

@@ -238,7 +238,8 @@ void CollectCriticalPoints(ExtractionState& state)
     if (grad.IsCriticalTriangle(t))
     {
       const Index o = DiscreteGradient::TriangleOwner(mesh, order, t);
-      cps.push_back({ InvalidIndex, 2, o, t, f[o], mesh.IsBoundaryVertex(o) });
+      cps.push_back({ InvalidIndex, 2, o, t, f[o], mesh.IsBoundaryVertex(o), InvalidIndex,
+        mesh.VertexTriangleEnd(o) - mesh.VertexTriangleBegin(o) == 1 });
     }
   }
   std::sort(cps.begin(), cps.end(), [](const CriticalPoint& a, const CriticalPoint& b) {

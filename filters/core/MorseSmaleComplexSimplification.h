@@ -60,7 +60,9 @@ enum class BlockReason : unsigned char
   BoundaryInterior,     // one of the two is a critical point of the boundary curve
   TwoCellPinched,       // a 2-cell would lose all its corners (not planar-consistent input)
   InvertedOneCell,      // a new 1-cell would join a saddle to a higher minimum (lower maximum)
-  BoundaryMinimumPinned // a boundary minimum held by a living interior saddle on the boundary
+  BoundaryMinimumPinned, // a boundary minimum held by a living interior saddle on the boundary
+  CornerSaddle           // the triangle of a one-triangle boundary vertex holding a boundary saddle
+                         // between two minima
 };
 
 // A short name for field data and messages ("boundary-interior", ...).
@@ -167,6 +169,8 @@ private:
   void OfferAllPairs(GreedyState& state) const;
   bool PlanCancellation(GreedyState& state, const Candidate& candidate, CancellationPlan& plan);
   bool WouldPinchTwoCell(GreedyState& state, Index saddle, CancellationPlan& plan) const;
+  bool KeepsCornerMaximum(GreedyState& state, Index maximum) const;
+  bool IsBoundaryCurveEdge(Index a, Index b) const;
   void Cancel(GreedyState& state, const Candidate& candidate, const CancellationPlan& plan);
   int CellMerges(Index saddle, bool minimum, int side, std::array<std::array<Index, 2>, 2>& pairs) const;
 
