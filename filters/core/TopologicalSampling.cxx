@@ -1284,7 +1284,7 @@ namespace
 // junction.
 std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, const PlanarScalarField& sampling,
   const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, double reach,
-  std::vector<double>& values)
+  bool pitsOnJunctionVertices, std::vector<double>& values)
 {
   std::vector<Index> placed;
   const auto& p = sampling.Points;
@@ -1325,6 +1325,40 @@ std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, cons
         break;
       }
       chosen = next;
+    }
+    // The descent can stop beside a node it may not take (a wanted boundary minimum lower than
+    // the vertex it reached): that vertex is then no pit of the curve, and the check finds no
+    // pair for the junction (stress seed 41 #54: a ridge carved to a corner's maximum had
+    // raised the junction's vertex, and its descent ran onto the vertex beside a wanted
+    // minimum). The junction's own vertex is made the pit instead, just below its lower
+    // boundary neighbour; its descending 1-cells still fall through it into the domain.
+    if (pitsOnJunctionVertices)
+    {
+      const auto boundaryLow = [&](Index u) {
+        Index low = InvalidIndex;
+        for (Index w : VertexLink(mesh, u))
+        {
+          if (mesh.IsBoundaryVertex(w) && (low == InvalidIndex || Key{ values[w], w } < Key{ values[low], low }))
+          {
+            low = w;
+          }
+        }
+        return low;
+      };
+      const Index below = boundaryLow(chosen);
+      if (below != InvalidIndex && Key{ values[below], below } < Key{ values[chosen], chosen })
+      {
+        // Not below a node beside it (that would take the node's own pit away).
+        const Index low = boundaryLow(v);
+        if (low != InvalidIndex && !taken.count(low) && std::find(placed.begin(), placed.end(), v) == placed.end())
+        {
+          chosen = v;
+          if (Key{ values[low], low } < Key{ values[v], v })
+          {
+            values[v] = values[low] - 1e-9 * std::max(1.0, std::abs(values[low]));
+          }
+        }
+      }
     }
     Index lowest = InvalidIndex;
     for (Index w : VertexLink(mesh, chosen))
@@ -1430,7 +1464,9 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   // A boundary saddle at a domain corner cannot be sampled there: a corner above both its
   // boundary neighbours makes the corner triangle a maximum of stage 1 as well. The peak of
   // the boundary curve is wanted on the higher of the two neighbours instead, one step along
-  // the curve (within the verdict's one spacing).
+  // the curve (within the verdict's one spacing). Where both neighbours hold minima, which
+  // cannot take it, stage 2 keeps the corner triangle's maximum with the saddle
+  // (MorseSmaleComplexSimplification::KeepsCornerMaximum), and the saddle stays on the corner.
   const std::unordered_set<Index> wantedMaxima(constraints.Maxima.begin(), constraints.Maxima.end());
   for (Index& v : constraints.BoundaryMaxima)
   {
@@ -1605,7 +1641,8 @@ TopologicalSamplingReport TopologicalSampling::Settle(const PlanarScalarField& s
   const std::size_t boundaryMinimaBefore = constraints.BoundaryMinima.size();
   const std::size_t saddlesBefore = constraints.Saddles.size();
   const double junctionReach = BoundaryJunctionReach * this->Spacing;
-  for (Index v : PlaceBoundaryJunctions(this->Complex, sampling, mesh, vertexAt, junctionReach, values))
+  for (Index v :
+    PlaceBoundaryJunctions(this->Complex, sampling, mesh, vertexAt, junctionReach, this->PitsOnJunctionVertices, values))
   {
     constraints.BoundaryMinima.push_back(v);
     constraints.Saddles.push_back(v);

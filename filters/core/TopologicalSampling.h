@@ -167,6 +167,10 @@ public:
   Index MaximumVerticesForSaddleMoves = Index(1) << 16;
   int MaximumSaddlesToMove = 4;
   int MaximumSaddleMoveTries = 24;
+  // A boundary junction's pit is the boundary pit its vertex falls into along the curve; where
+  // that descent stops beside a node it may not take (a wanted boundary minimum lower than the
+  // vertex it reached, which is then no pit), the junction's own vertex is made the pit.
+  bool PitsOnJunctionVertices = true;
 
   // `values` (one per vertex of `mesh`, at sampling.Points) is modified in place; `vertexAt`
   // gives the sampling's vertex for a vertex of the complex's mesh (InvalidIndex: none). The

@@ -97,6 +97,13 @@ REQUIRED = [
     # A saddle left off its node that verifies only when wanted one edge away (seed 41).
     dict(kind="noise", nx=24, ny=24, percent=25.0, k=30, seed=1935319987),
     dict(kind="mesh_grid", nx=87, ny=71, percent=1.0, k=20, seed=518899382),
+    # Cells whose sides needed a grid over 512 while stage 3 doubled divisors of k (seeds 41, 29).
+    dict(kind="delaunay", points=4871, percent=2.0, k=26, seed=1670037566),
+    dict(kind="delaunay", points=3412, percent=5.0, k=22, seed=923347802),
+    # A boundary saddle kept on a one-triangle grid corner without its maximum (seed 29).
+    dict(kind="noise", nx=16, ny=16, percent=2.0, k=13, seed=136824485),
+    # A boundary junction whose descent along the curve stopped beside a wanted minimum (seed 41).
+    dict(kind="noise", nx=64, ny=64, percent=10.0, k=27, seed=1073766175),
 ]
 
 
