@@ -1299,6 +1299,20 @@ std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, cons
   {
     taken.insert(vertexAt(cp.Vertex));
   }
+  // The lowest boundary neighbour of u that `eligible` accepts, in the order (value, id);
+  // InvalidIndex if none.
+  const auto lowestBoundaryNeighbour = [&](Index u, const auto& eligible) {
+    Index low = InvalidIndex;
+    for (Index w : VertexLink(mesh, u))
+    {
+      if (mesh.IsBoundaryVertex(w) && eligible(w) && (low == InvalidIndex || Key{ values[w], w } < Key{ values[low], low }))
+      {
+        low = w;
+      }
+    }
+    return low;
+  };
+  const auto any = [](Index) { return true; };
   for (Index junction : complex.BoundaryJunctions)
   {
     const Index v = vertexAt(junction);
@@ -1308,19 +1322,14 @@ std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, cons
     }
     // Down along the boundary from the junction to the boundary pit it falls into (within
     // reach; the junction itself where it is a pit already).
+    const auto reachable = [&](Index w) {
+      return !taken.count(w) && std::hypot(p[2 * w] - p[2 * v], p[2 * w + 1] - p[2 * v + 1]) <= reach;
+    };
     Index chosen = v;
     for (;;)
     {
-      Index next = chosen;
-      for (Index w : VertexLink(mesh, chosen))
-      {
-        if (mesh.IsBoundaryVertex(w) && !taken.count(w) && Key{ values[w], w } < Key{ values[next], next } &&
-          std::hypot(p[2 * w] - p[2 * v], p[2 * w + 1] - p[2 * v + 1]) <= reach)
-        {
-          next = w;
-        }
-      }
-      if (next == chosen)
+      const Index next = lowestBoundaryNeighbour(chosen, reachable);
+      if (next == InvalidIndex || !(Key{ values[next], next } < Key{ values[chosen], chosen }))
       {
         break;
       }
@@ -1334,22 +1343,11 @@ std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, cons
     // boundary neighbour; its descending 1-cells still fall through it into the domain.
     if (pitsOnJunctionVertices)
     {
-      const auto boundaryLow = [&](Index u) {
-        Index low = InvalidIndex;
-        for (Index w : VertexLink(mesh, u))
-        {
-          if (mesh.IsBoundaryVertex(w) && (low == InvalidIndex || Key{ values[w], w } < Key{ values[low], low }))
-          {
-            low = w;
-          }
-        }
-        return low;
-      };
-      const Index below = boundaryLow(chosen);
+      const Index below = lowestBoundaryNeighbour(chosen, any);
       if (below != InvalidIndex && Key{ values[below], below } < Key{ values[chosen], chosen })
       {
         // Not below a node beside it (that would take the node's own pit away).
-        const Index low = boundaryLow(v);
+        const Index low = lowestBoundaryNeighbour(v, any);
         if (low != InvalidIndex && !taken.count(low) && std::find(placed.begin(), placed.end(), v) == placed.end())
         {
           chosen = v;

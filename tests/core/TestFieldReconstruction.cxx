@@ -661,22 +661,6 @@ TEST_CASE(CountsNearOneCellsMatchExactDistancesOnManySegments)
 
 namespace
 {
-// Uniform noise in [0, 1) on an n x n grid, from splitmix64 (the same on every platform).
-GridField UniformNoise(int n, std::uint64_t seed)
-{
-  GridField grid;
-  grid.Dimensions[0] = grid.Dimensions[1] = n;
-  std::uint64_t state = seed;
-  for (int v = 0; v < n * n; ++v)
-  {
-    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    grid.Values.push_back(static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53);
-  }
-  return grid;
-}
-
 // The PL saddle multiplicity of every interior vertex: half the number of changes between lower
 // and upper neighbours around its link (LowerLink), less one.
 std::vector<int> InteriorSaddleMultiplicity(const std::vector<double>& f, int nx, int ny)

@@ -785,14 +785,7 @@ TEST_CASE(SaddlesOnOneTriangleCornersKeepTheirMaximum)
       if (kind == 0)
       {
         const int n = 8 + static_cast<int>(seed % 9);
-        GridField noise;
-        noise.Dimensions[0] = noise.Dimensions[1] = n;
-        DeterministicRandom random(seed);
-        for (int i = 0; i < n * n; ++i)
-        {
-          noise.Values.push_back(random.Uniform());
-        }
-        field = FieldOnGrid(noise);
+        field = FieldOnGrid(UniformNoise(n, seed));
         triangles = GridTriangles(n, n);
       }
       else

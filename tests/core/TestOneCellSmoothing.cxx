@@ -226,13 +226,7 @@ TEST_CASE(SmoothedOneCellsOfSyntheticFields)
 // noise at k 21.
 TEST_CASE(ShortPiecesGetNoMoreSegmentsThanEdges)
 {
-  GridField noise;
-  noise.Dimensions[0] = noise.Dimensions[1] = 40;
-  DeterministicRandom random(62);
-  for (int i = 0; i < 40 * 40; ++i)
-  {
-    noise.Values.push_back(random.Uniform());
-  }
+  const GridField noise = UniformNoise(40, 62);
   Stage3Input input;
   std::string error;
   CHECK(RunStages1And2(noise, 2.0, input, error));
@@ -322,13 +316,7 @@ TEST_CASE(RaisedCountsKeepACommonGridPerCell)
     {
       for (std::uint64_t seed = 1; seed <= 4; ++seed)
       {
-        GridField noise;
-        noise.Dimensions[0] = noise.Dimensions[1] = 64;
-        DeterministicRandom random(1000 * seed + k);
-        for (int i = 0; i < 64 * 64; ++i)
-        {
-          noise.Values.push_back(random.Uniform());
-        }
+        const GridField noise = UniformNoise(64, 1000 * seed + k);
         Stage3Input input;
         std::string error;
         CHECK(RunStages1And2(noise, percent, input, error));
@@ -642,13 +630,7 @@ TEST_CASE(MergedOneCellsShareTheirPiecesOnNoise)
   {
     for (std::uint64_t seed = 1; seed <= 3; ++seed)
     {
-      GridField noise;
-      noise.Dimensions[0] = noise.Dimensions[1] = 48;
-      DeterministicRandom random(seed);
-      for (int i = 0; i < 48 * 48; ++i)
-      {
-        noise.Values.push_back(random.Uniform());
-      }
+      const GridField noise = UniformNoise(48, seed);
       Stage3Input input;
       std::string error;
       CHECK(RunStages1And2(noise, percent, input, error));
@@ -812,13 +794,7 @@ TEST_CASE(NoSamplingFindsCrossingsWhereNoneAreReported)
   {
     for (std::uint64_t seed = 1; seed <= 4; ++seed)
     {
-      GridField noise;
-      noise.Dimensions[0] = noise.Dimensions[1] = 40;
-      DeterministicRandom random(100 + seed);
-      for (int i = 0; i < 40 * 40; ++i)
-      {
-        noise.Values.push_back(random.Uniform());
-      }
+      const GridField noise = UniformNoise(40, 100 + seed);
       Stage3Input input;
       std::string error;
       CHECK(RunStages1And2(noise, percent, input, error));

@@ -111,6 +111,19 @@ inline void ThreadedFor(Index begin, Index end, const RangeBody& body)
   }
 }
 
+// Uniform noise in [0, 1) on an n x n grid (DeterministicRandom: the same on every platform).
+inline GridField UniformNoise(int n, std::uint64_t seed)
+{
+  GridField grid;
+  grid.Dimensions[0] = grid.Dimensions[1] = n;
+  DeterministicRandom random(seed);
+  for (int v = 0; v < n * n; ++v)
+  {
+    grid.Values.push_back(random.Uniform());
+  }
+  return grid;
+}
+
 struct Pipeline
 {
   PlanarScalarField Field;
