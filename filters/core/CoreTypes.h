@@ -28,6 +28,29 @@ inline void SequentialFor(Index begin, Index end, const RangeBody& body)
   }
 }
 
+// For loops whose items append what they find to a list: the items [0, count) in stretches of
+// `size` (StretchesOf), the stretches in parallel, body(item, stretch) for each item in order
+// within its stretch. Each stretch appends to its own list; joined in stretch order afterwards,
+// the lists are what one thread would have made, whatever the split.
+inline Index StretchesOf(Index count, Index size)
+{
+  return count > 0 ? (count + size - 1) / size : 0;
+}
+
+template <typename Body>
+void ForEachInStretches(Index count, Index size, const ParallelFor& parallel, const Body& body)
+{
+  parallel(0, StretchesOf(count, size), [&](Index begin, Index end) {
+    for (Index s = begin; s < end; ++s)
+    {
+      for (Index i = s * size; i < count && i < (s + 1) * size; ++i)
+      {
+        body(i, s);
+      }
+    }
+  });
+}
+
 // An allocator whose resize() leaves new elements uninitialized (default- rather than value-
 // initialized). For the large per-cell arrays that a parallel pass fills completely anyway:
 // it saves a sequential zero-fill and lets each thread touch its own pages first.

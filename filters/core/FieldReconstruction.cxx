@@ -35,7 +35,8 @@ SamplingTopologyCheck CheckSampling(const PlanarScalarField& sampling,
   {
     return check;
   }
-  check.Comparison = CompareCriticalPoints(expected, CriticalPointLocations(found, sampling.Points), tolerance, mesh);
+  check.Comparison =
+    CompareCriticalPoints(expected, CriticalPointLocations(found, sampling.Points), tolerance, mesh, parallel);
   check.Ran = true;
   return check;
 }

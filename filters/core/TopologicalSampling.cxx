@@ -583,12 +583,14 @@ namespace
 // Adds to `constraints` the smoothed 1-cells of the complex's saddles, sampled from each saddle
 // out to `radius` (`vertexAt` as for ComplexConstraints).
 void AddSaddleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
-  const std::function<Index(Index)>& vertexAt, double radius, SamplingConstraints& constraints);
+  const std::function<Index(Index)>& vertexAt, double radius, SamplingConstraints& constraints,
+  const ParallelFor& parallel);
 // Adds to constraints.OneCells every smoothed 1-cell of the complex, from its saddle to its
 // extremum, sampled at most `step` apart (a fraction of the grid spacing, so that a walk along
 // the samples follows the curve).
 void AddOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
-  const std::function<Index(Index)>& vertexAt, double step, SamplingConstraints& constraints);
+  const std::function<Index(Index)>& vertexAt, double step, SamplingConstraints& constraints,
+  const ParallelFor& parallel);
 // Adds to `report` how many of `after` differ from `before`, and by how much at most.
 void CountChanges(const std::vector<double>& before, const std::vector<double>& after,
   TopologicalSamplingReport& report);
@@ -1188,14 +1190,16 @@ namespace
 // The smoothed 1-cells of the complex, each sampled from its saddle out to `radius`, at
 // least 16 points per cubic segment and at most `step` apart.
 std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
-  const std::function<Index(Index)>& vertexAt, double radius, double step)
+  const std::function<Index(Index)>& vertexAt, double radius, double step, const ParallelFor& parallel)
 {
-  std::vector<SaddleOneCell> cells;
   constexpr int samplesPerSegment = 16;
-  for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()) &&
-       a < static_cast<Index>(smoothed.PiecesOfOneCell.size());
-       ++a)
-  {
+  const Index oneCells =
+    std::min(static_cast<Index>(complex.OneCells.size()), static_cast<Index>(smoothed.PiecesOfOneCell.size()));
+  // Each 1-cell is sampled on its own: in parallel over stretches of them, joined in order.
+  constexpr Index stretch = 256;
+  std::vector<std::vector<SaddleOneCell>> stretches(static_cast<std::size_t>(StretchesOf(oneCells, stretch)));
+  ForEachInStretches(oneCells, stretch, parallel, [&](Index a, Index part) {
+    std::vector<SaddleOneCell>& cells = stretches[part];
     const OneCell& oneCell = complex.OneCells[a];
     const bool ascending = oneCell.Type == OneCell::Ascending;
     SaddleOneCell cell;
@@ -1203,7 +1207,7 @@ std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, cons
     cell.Ascending = ascending;
     if (cell.Saddle == InvalidIndex)
     {
-      continue;
+      return;
     }
     // Pieces run from the lower end to the higher one: away from the saddle along an ascending
     // 1-cell, towards it along a descending one.
@@ -1244,6 +1248,11 @@ std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, cons
       cell.Points.shrink_to_fit();
       cells.push_back(std::move(cell));
     }
+  });
+  std::vector<SaddleOneCell> cells;
+  for (std::vector<SaddleOneCell>& part : stretches)
+  {
+    std::move(part.begin(), part.end(), std::back_inserter(cells));
   }
   return cells;
 }
@@ -1252,10 +1261,11 @@ std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, cons
 namespace
 {
 void AddSaddleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
-  const std::function<Index(Index)>& vertexAt, double radius, SamplingConstraints& constraints)
+  const std::function<Index(Index)>& vertexAt, double radius, SamplingConstraints& constraints,
+  const ParallelFor& parallel)
 {
   std::vector<SaddleOneCell> cells =
-    SampleOneCells(complex, smoothed, vertexAt, radius, std::numeric_limits<double>::infinity());
+    SampleOneCells(complex, smoothed, vertexAt, radius, std::numeric_limits<double>::infinity(), parallel);
   std::move(cells.begin(), cells.end(), std::back_inserter(constraints.SaddleOneCells));
 }
 } // namespace
@@ -1263,10 +1273,11 @@ void AddSaddleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingR
 namespace
 {
 void AddOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
-  const std::function<Index(Index)>& vertexAt, double step, SamplingConstraints& constraints)
+  const std::function<Index(Index)>& vertexAt, double step, SamplingConstraints& constraints,
+  const ParallelFor& parallel)
 {
   std::vector<SaddleOneCell> cells =
-    SampleOneCells(complex, smoothed, vertexAt, std::numeric_limits<double>::infinity(), step);
+    SampleOneCells(complex, smoothed, vertexAt, std::numeric_limits<double>::infinity(), step, parallel);
   std::move(cells.begin(), cells.end(), std::back_inserter(constraints.OneCells));
 }
 } // namespace
@@ -1445,8 +1456,8 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
 {
   const double reach = this->SaddleReach();
   SamplingConstraints constraints = ComplexConstraints(this->Complex, this->ComplexMesh, mesh, vertexAt);
-  AddSaddleOneCells(this->Complex, this->Smoothed, vertexAt, reach, constraints);
-  AddOneCells(this->Complex, this->Smoothed, vertexAt, 0.25 * this->Spacing, constraints);
+  AddSaddleOneCells(this->Complex, this->Smoothed, vertexAt, reach, constraints, this->Parallel);
+  AddOneCells(this->Complex, this->Smoothed, vertexAt, 0.25 * this->Spacing, constraints, this->Parallel);
   const std::vector<double> before = values;
   // Every node's vertex takes the node's critical value: F o Phi has it at the node, but a
   // vertex on a node that a 2-cell's smoothed boundary passes beside (a slit, a node between
@@ -1632,7 +1643,7 @@ TopologicalSamplingReport TopologicalSampling::Settle(const PlanarScalarField& s
   std::vector<double>& values) const
 {
   const double reach = this->SaddleReach();
-  CarveOneCells(sampling, mesh, constraints, this->Spacing, values, carving);
+  CarveOneCells(sampling, mesh, constraints, this->Spacing, values, carving, this->Parallel);
   // This pass's boundary junctions join the constraints until it ends, and are taken off
   // again: a copy of the constraints per pass copied every 1-cell's samples (a tenth of
   // topological sampling's time on 1000 x 1000 noise, most of it page faults).
@@ -1739,6 +1750,7 @@ public:
     : Points(field.Points)
     , Mesh(mesh)
     , WantedSaddles(wantedSaddles)
+    , Wanted(this->Locations(wantedSaddles))
     , Tolerance(tolerance)
     , Parallel(parallel)
   {
@@ -1757,19 +1769,8 @@ public:
     // within the tolerance and within two edges of the mesh). Without the mesh, on a Delaunay
     // mesh of scattered points whose hull edges span the domain (the tolerance is the longest
     // edge), a saddle several edges from its node counted as on it, and nothing moved it back.
-    auto locations = [this](const std::vector<Index>& vertices) {
-      std::vector<CriticalPointLocation> result(vertices.size());
-      for (std::size_t i = 0; i < vertices.size(); ++i)
-      {
-        result[i].MorseIndex = 1;
-        result[i].Position[0] = this->Points[2 * vertices[i]];
-        result[i].Position[1] = this->Points[2 * vertices[i] + 1];
-        result[i].Vertex = vertices[i];
-      }
-      return result;
-    };
     const std::vector<std::size_t> partner =
-      MatchCriticalPoints(locations(this->WantedSaddles), locations(saddles), this->Tolerance, &this->Mesh);
+      MatchCriticalPoints(this->Wanted, this->Locations(saddles), this->Tolerance, &this->Mesh, this->Parallel);
     std::vector<char> used(saddles.size(), 0);
     for (std::size_t i = 0; i < this->WantedSaddles.size(); ++i)
     {
@@ -1793,6 +1794,19 @@ public:
   }
 
 private:
+  std::vector<CriticalPointLocation> Locations(const std::vector<Index>& vertices) const
+  {
+    std::vector<CriticalPointLocation> result(vertices.size());
+    for (std::size_t i = 0; i < vertices.size(); ++i)
+    {
+      result[i].MorseIndex = 1;
+      result[i].Position[0] = this->Points[2 * vertices[i]];
+      result[i].Position[1] = this->Points[2 * vertices[i] + 1];
+      result[i].Vertex = vertices[i];
+    }
+    return result;
+  }
+
   // The saddle vertices of the sampling with `values`; false if the extraction fails.
   bool ExtractSaddles(const std::vector<double>& values, std::vector<Index>& saddles)
   {
@@ -1820,6 +1834,7 @@ private:
   const std::vector<double>& Points;
   const TriangleMeshTopology& Mesh;
   const std::vector<Index>& WantedSaddles;
+  const std::vector<CriticalPointLocation> Wanted; // the same, as MatchCriticalPoints takes them
   const double Tolerance;
   const ParallelFor& Parallel;
   // Values only: the extraction reads neither positions nor triangles (it is given the mesh).
@@ -2378,15 +2393,17 @@ Index CarveSaddleOneCells(const PlanarScalarField& field, const TriangleMeshTopo
 
 namespace
 {
+struct CarvingClaims;
+
 // The sampling as the 1-cells walk over it in CarveOneCells.
 struct CarvingGround
 {
   const std::vector<double>& Points; // x, y per sampling vertex
   const TriangleMeshTopology& Mesh;
   double Spacing;
-  // The critical points themselves keep their values: a 1-cell passing next to another one's
-  // node must not lift a wanted minimum out of its pit.
-  std::unordered_set<Index> Critical;
+  // Per vertex, 1 for the critical points: they keep their values (a 1-cell passing next to
+  // another one's node must not lift a wanted minimum out of its pit).
+  std::vector<char> Critical;
 
   // Squared: the walks compare distances at every point of every 1-cell, and std::hypot took
   // half of their time (1000 x 1000 noise).
@@ -2398,27 +2415,8 @@ struct CarvingGround
 
   // The neighbour of `current` nearest to the curve point q if nearer than `current` (else
   // `current`).
-  // Vertices in `avoided` (if given) are not stepped onto.
-  Index NearerNeighbour(Index current, const double* q, bool ascending,
-    const std::unordered_map<Index, double>* avoided = nullptr) const
-  {
-    Index nearest = current;
-    double nearestDistance = this->SquaredDistanceTo(current, q);
-    const double boundaryReach = 0.25 * this->Spacing * 0.25 * this->Spacing;
-    for (Index w : VertexLink(this->Mesh, current))
-    {
-      // A ridge close along the domain boundary walks on the first row inside (the
-      // boundary curve runs lower: it is a valley there, which the boundary passes keep).
-      const double d = this->SquaredDistanceTo(w, q);
-      if (d < nearestDistance && (!ascending || !this->Mesh.IsBoundaryVertex(w) || d <= boundaryReach) &&
-        !(avoided && avoided->count(w)))
-      {
-        nearest = w;
-        nearestDistance = d;
-      }
-    }
-    return nearest;
-  }
+  // Vertices `avoided` claims (if given) are not stepped onto.
+  Index NearerNeighbour(Index current, const double* q, bool ascending, const CarvingClaims* avoided) const;
 
   // Whether a boundary neighbour of v already stands as high as a ridge's `height`: the ridge
   // then runs on the boundary curve itself, and raising v would only add a second ridge beside
@@ -2447,87 +2445,100 @@ struct CarvingGround
   bool LeftAlone(Index v, const double* start) const
   {
     return this->SquaredDistanceTo(v, start) <= this->Spacing * this->Spacing || this->Mesh.IsBoundaryVertex(v) ||
-      this->Critical.count(v);
+      this->Critical[v] != 0;
   }
 };
 
-// What the ridges ask of a vertex (the highest value) and what the valleys ask (the lowest).
-struct CarvingRequests
+// What the ridges ask of the vertices (the highest value asked of each) or what the valleys
+// ask (the lowest), per vertex: NaN where none asks. Dense arrays rather than hash maps: the
+// walks ask for millions of vertices on 1000 x 1000 noise, and the maps' nodes were most of
+// the carving's time.
+struct CarvingClaims
 {
-  std::unordered_map<Index, double> RaiseTo, LowerTo;
-  OneCellCarving Carving = OneCellCarving::Everywhere;
+  bool Up = true;
+  std::vector<double> To;      // per vertex
+  std::vector<Index> Claimed; // the vertices asked, each once
 
-  // Asks for v the height of a 1-cell there, strictly past `previous` (the value before v along
-  // the walk). Gentler carvings (OneCellCarving) leave v alone if it already lies past
-  // `previous`: the walk then goes on rising (falling) through v as it is, and no island can
-  // form there; JustPastTheWalk asks only just past `previous`. Carving every vertex walked onto
-  // up to the 1-cell's height changed 2-3 % of the vertices of a reconstruction, most of them by
-  // more than 0.1 % of the range (a vertex beside a ridge lies on its flank), and raising a
-  // vertex beside a one-pixel peak to the 1-cell's height there took it 20 % of the range above
-  // the data (docs/Reconstruction.md, "Gentle carving first"). Returns v's value along the walk
-  // once carved.
-  double Ask(Index v, double height, double previous, bool up, const std::vector<double>& values)
+  CarvingClaims(bool up, Index vertices)
+    : Up(up)
+    , To(vertices, std::numeric_limits<double>::quiet_NaN())
   {
-    const double infinity = std::numeric_limits<double>::infinity();
-    if (this->Carving != OneCellCarving::Everywhere && (up ? values[v] > previous : values[v] < previous))
+  }
+  bool Has(Index v) const { return !std::isnan(this->To[v]); }
+  void Claim(Index v, double value)
+  {
+    if (!this->Has(v))
     {
-      return values[v];
-    }
-    const double pastPrevious = std::nextafter(previous, up ? infinity : -infinity);
-    const double wanted = this->Carving == OneCellCarving::JustPastTheWalk ? pastPrevious
-      : up                                                                ? std::max(height, pastPrevious)
-                                                                          : std::min(height, pastPrevious);
-    auto& asked = up ? this->RaiseTo : this->LowerTo;
-    auto found = asked.find(v);
-    if (found == asked.end())
-    {
-      asked.emplace(v, wanted);
+      this->To[v] = value;
+      this->Claimed.push_back(v);
     }
     else
     {
-      found->second = up ? std::max(found->second, wanted) : std::min(found->second, wanted);
+      this->To[v] = this->Up ? std::max(this->To[v], value) : std::min(this->To[v], value);
     }
-    return up ? std::max(wanted, values[v]) : std::min(wanted, values[v]);
-  }
-
-  // Gives each vertex that only ridges or only valleys claim what they ask, where that moves it
-  // up (down). Returns the number of changed vertices.
-  Index Apply(std::vector<double>& values) const
-  {
-    Index changed = 0;
-    for (const auto& asked : { &this->RaiseTo, &this->LowerTo })
-    {
-      const bool up = asked == &this->RaiseTo;
-      for (const auto& [v, value] : *asked)
-      {
-        if ((up ? this->LowerTo : this->RaiseTo).count(v) == 0 && (up ? values[v] < value : values[v] > value))
-        {
-          values[v] = value;
-          ++changed;
-        }
-      }
-    }
-    return changed;
   }
 };
 
-std::unordered_set<Index> CriticalVertices(const SamplingConstraints& constraints)
+Index CarvingGround::NearerNeighbour(Index current, const double* q, bool ascending, const CarvingClaims* avoided) const
 {
-  std::unordered_set<Index> critical;
-  for (const std::vector<Index>* kind : { &constraints.Minima, &constraints.Maxima, &constraints.Saddles })
+  Index nearest = current;
+  double nearestDistance = this->SquaredDistanceTo(current, q);
+  const double boundaryReach = 0.25 * this->Spacing * 0.25 * this->Spacing;
+  for (Index w : VertexLink(this->Mesh, current))
   {
-    critical.insert(kind->begin(), kind->end());
+    // A ridge close along the domain boundary walks on the first row inside (the
+    // boundary curve runs lower: it is a valley there, which the boundary passes keep).
+    const double d = this->SquaredDistanceTo(w, q);
+    if (d < nearestDistance && (!ascending || !this->Mesh.IsBoundaryVertex(w) || d <= boundaryReach) &&
+      !(avoided && avoided->Has(w)))
+    {
+      nearest = w;
+      nearestDistance = d;
+    }
   }
-  return critical;
+  return nearest;
+}
+
+// What one stretch of walks asked, in the order of the walks: the vertices each walk asked
+// (walk c's from WalkStart[c]) and the heights asked of them (a walk is a ridge or a valley, so
+// the kind is its 1-cell's).
+struct WalkedRequests
+{
+  std::vector<Index> Walked, WalkStart{ 0 };
+  std::vector<std::pair<Index, double>> Requests;
+  std::vector<Index> RequestStart{ 0 };
+};
+
+// For v the height of a 1-cell there, strictly past `previous` (the value before v along the
+// walk), added to `requests`. Gentler carvings (OneCellCarving) leave v alone if it already lies
+// past `previous`: the walk then goes on rising (falling) through v as it is, and no island can
+// form there; JustPastTheWalk asks only just past `previous`. Carving every vertex walked onto
+// up to the 1-cell's height changed 2-3 % of the vertices of a reconstruction, most of them by
+// more than 0.1 % of the range (a vertex beside a ridge lies on its flank), and raising a vertex
+// beside a one-pixel peak to the 1-cell's height there took it 20 % of the range above the data
+// (docs/Reconstruction.md, "Gentle carving first"). Returns v's value along the walk once carved.
+double Ask(OneCellCarving carving, Index v, double height, double previous, bool up, const std::vector<double>& values,
+  std::vector<std::pair<Index, double>>& requests)
+{
+  const double infinity = std::numeric_limits<double>::infinity();
+  if (carving != OneCellCarving::Everywhere && (up ? values[v] > previous : values[v] < previous))
+  {
+    return values[v];
+  }
+  const double pastPrevious = std::nextafter(previous, up ? infinity : -infinity);
+  const double wanted = carving == OneCellCarving::JustPastTheWalk ? pastPrevious
+    : up                                                           ? std::max(height, pastPrevious)
+                                                                   : std::min(height, pastPrevious);
+  requests.emplace_back(v, wanted);
+  return up ? std::max(wanted, values[v]) : std::min(wanted, values[v]);
 }
 
 // Walks from the 1-cell's saddle along its points, to each point vertex by vertex while a
 // neighbour is nearer to it, and asks each vertex walked onto for the 1-cell's height there.
-// Vertices in `avoided` (if given) are walked round; `asked` (if given) receives the vertices
-// asked, in order.
+// Vertices `avoided` claims (if given) are walked round; the vertices asked and the heights
+// asked of them go to `out`.
 void AskAlongOneCell(const CarvingGround& ground, const SaddleOneCell& cell, const std::vector<double>& values,
-  CarvingRequests& requests, const std::unordered_map<Index, double>* avoided = nullptr,
-  std::vector<Index>* asked = nullptr)
+  OneCellCarving carving, const CarvingClaims* avoided, WalkedRequests& out)
 {
   const std::vector<double>& q = cell.Points;
   const double* start = &q[0];
@@ -2544,14 +2555,47 @@ void AskAlongOneCell(const CarvingGround& ground, const SaddleOneCell& cell, con
       }
       current = nearest;
       if (!ground.LeftAlone(current, start) &&
-        !(requests.Carving != OneCellCarving::Everywhere && cell.Ascending &&
-          ground.BoundaryCarries(current, q[i + 2], values)))
+        !(carving != OneCellCarving::Everywhere && cell.Ascending && ground.BoundaryCarries(current, q[i + 2], values)))
       {
-        previous = requests.Ask(current, q[i + 2], previous, cell.Ascending, values);
-        if (asked)
-        {
-          asked->push_back(current);
-        }
+        previous = Ask(carving, current, q[i + 2], previous, cell.Ascending, values, out.Requests);
+        out.Walked.push_back(current);
+      }
+    }
+  }
+  out.WalkStart.push_back(static_cast<Index>(out.Walked.size()));
+  out.RequestStart.push_back(static_cast<Index>(out.Requests.size()));
+}
+
+// The walks of `cells`, in parallel over stretches of them: a walk only reads the values, so the
+// walks are independent, and the claims made from them (the highest or lowest height per vertex)
+// do not depend on their order. `avoidedOf(cell)` gives the claims a walk goes round
+// (nullptr: none). Returns the stretches in the order of the cells.
+template <typename Avoided>
+std::vector<WalkedRequests> WalkOneCells(const CarvingGround& ground, const std::vector<SaddleOneCell>& cells,
+  const std::vector<double>& values, OneCellCarving carving, const Avoided& avoidedOf, const ParallelFor& parallel)
+{
+  constexpr Index stretch = 256;
+  const Index count = static_cast<Index>(cells.size());
+  std::vector<WalkedRequests> stretches(static_cast<std::size_t>(StretchesOf(count, stretch)));
+  ForEachInStretches(count, stretch, parallel, [&](Index c, Index part) {
+    AskAlongOneCell(ground, cells[c], values, carving, avoidedOf(cells[c]), stretches[part]);
+  });
+  return stretches;
+}
+
+// The claims of the walks, each walk's to the claims of its 1-cell's kind.
+void ClaimWalked(const std::vector<SaddleOneCell>& cells, const std::vector<WalkedRequests>& stretches,
+  CarvingClaims& raise, CarvingClaims& lower)
+{
+  std::size_t c = 0;
+  for (const WalkedRequests& walks : stretches)
+  {
+    for (std::size_t w = 0; w + 1 < walks.RequestStart.size(); ++w, ++c)
+    {
+      CarvingClaims& claims = cells[c].Ascending ? raise : lower;
+      for (Index r = walks.RequestStart[w]; r < walks.RequestStart[w + 1]; ++r)
+      {
+        claims.Claim(walks.Requests[r].first, walks.Requests[r].second);
       }
     }
   }
@@ -2559,18 +2603,23 @@ void AskAlongOneCell(const CarvingGround& ground, const SaddleOneCell& cell, con
 } // namespace
 
 Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
-  const SamplingConstraints& constraints, double spacing, std::vector<double>& values, OneCellCarving carving)
+  const SamplingConstraints& constraints, double spacing, std::vector<double>& values, OneCellCarving carving,
+  const ParallelFor& parallel)
 {
-  const CarvingGround ground{ field.Points, mesh, spacing, CriticalVertices(constraints) };
-  CarvingRequests requests;
-  requests.Carving = carving;
-  // The vertices each walk asked, one list after the other (walk c's from walkStart[c]).
-  std::vector<Index> walked, walkStart{ 0 };
-  for (const SaddleOneCell& cell : constraints.OneCells)
+  const Index vertices = mesh.NumberOfVertices();
+  CarvingGround ground{ field.Points, mesh, spacing, std::vector<char>(vertices, 0) };
+  for (const std::vector<Index>* kind : { &constraints.Minima, &constraints.Maxima, &constraints.Saddles })
   {
-    AskAlongOneCell(ground, cell, values, requests, nullptr, &walked);
-    walkStart.push_back(static_cast<Index>(walked.size()));
+    for (Index v : *kind)
+    {
+      ground.Critical[v] = 1;
+    }
   }
+  const std::vector<SaddleOneCell>& cells = constraints.OneCells;
+  CarvingClaims raiseTo(true, vertices), lowerTo(false, vertices);
+  const auto none = [](const SaddleOneCell&) -> const CarvingClaims* { return nullptr; };
+  const std::vector<WalkedRequests> walks = WalkOneCells(ground, cells, values, carving, none, parallel);
+  ClaimWalked(cells, walks, raiseTo, lowerTo);
   // Where a ridge and a valley run within a spacing of each other (nearly flat data, a thin
   // 2-cell between them), one vertex can be the nearest to both: both claim it, it keeps its
   // value, and the chains of both break there; the floods then drain the valley (cut the
@@ -2579,45 +2628,63 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
   // connected); the others are walked as before. Walking every 1-cell again that way changed
   // chains far from any conflict and lost a noise case (stress #77, 128² at 2 %), and so did
   // walking again every walk that met a vertex only the other kind claims.
-  auto claimedByBoth = [&requests](Index v) { return requests.RaiseTo.count(v) > 0 && requests.LowerTo.count(v) > 0; };
-  std::vector<char> rewalk(constraints.OneCells.size(), 0);
+  auto claimedByBoth = [&](Index v) { return raiseTo.Has(v) && lowerTo.Has(v); };
+  std::vector<char> rewalk(cells.size(), 0);
   bool anyRewalk = false;
-  for (std::size_t c = 0; c < constraints.OneCells.size(); ++c)
+  std::size_t c = 0;
+  for (const WalkedRequests& stretch : walks)
   {
-    rewalk[c] = std::any_of(walked.begin() + walkStart[c], walked.begin() + walkStart[c + 1], claimedByBoth);
-    anyRewalk = anyRewalk || rewalk[c];
+    for (std::size_t w = 0; w + 1 < stretch.WalkStart.size(); ++w, ++c)
+    {
+      rewalk[c] = std::any_of(
+        stretch.Walked.begin() + stretch.WalkStart[w], stretch.Walked.begin() + stretch.WalkStart[w + 1], claimedByBoth);
+      anyRewalk = anyRewalk || rewalk[c];
+    }
   }
+  CarvingClaims againRaise(true, anyRewalk ? vertices : 0), againLower(false, anyRewalk ? vertices : 0);
   if (anyRewalk)
   {
-    CarvingRequests again;
-    again.Carving = carving;
-    for (std::size_t c = 0; c < constraints.OneCells.size(); ++c)
-    {
-      const SaddleOneCell& cell = constraints.OneCells[c];
-      AskAlongOneCell(ground, cell, values, again,
-        !rewalk[c] ? nullptr : cell.Ascending ? &requests.LowerTo : &requests.RaiseTo);
-    }
-    requests = std::move(again);
+    const auto avoided = [&](const SaddleOneCell& cell) -> const CarvingClaims* {
+      return !rewalk[&cell - cells.data()] ? nullptr : cell.Ascending ? &lowerTo : &raiseTo;
+    };
+    ClaimWalked(cells, WalkOneCells(ground, cells, values, carving, avoided, parallel), againRaise, againLower);
   }
+  CarvingClaims& raise = anyRewalk ? againRaise : raiseTo;
+  CarvingClaims& lower = anyRewalk ? againLower : lowerTo;
   // A ridge passing beside a wanted maximum lower than the ridge's own extremum (another
   // 1-cell's) must not rise above it, nor a valley sink below a wanted minimum beside it.
   const double infinity = std::numeric_limits<double>::infinity();
   for (const auto& [extrema, up] : { std::make_pair(&constraints.Maxima, true), std::make_pair(&constraints.Minima, false) })
   {
-    auto& asked = up ? requests.RaiseTo : requests.LowerTo;
+    CarvingClaims& asked = up ? raise : lower;
     for (Index m : *extrema)
     {
       const double limit = std::nextafter(values[m], up ? -infinity : infinity);
       for (Index w : VertexLink(mesh, m))
       {
-        auto found = asked.find(w);
-        if (found != asked.end())
+        if (asked.Has(w))
         {
-          found->second = up ? std::min(found->second, limit) : std::max(found->second, limit);
+          asked.To[w] = up ? std::min(asked.To[w], limit) : std::max(asked.To[w], limit);
         }
       }
     }
   }
-  return requests.Apply(values);
+  // Each vertex that only ridges or only valleys claim gets what they ask, where that moves it
+  // up (down).
+  Index changed = 0;
+  for (const CarvingClaims* asked : { &raise, &lower })
+  {
+    const CarvingClaims& other = asked == &raise ? lower : raise;
+    for (Index v : asked->Claimed)
+    {
+      const double value = asked->To[v];
+      if (!other.Has(v) && (asked->Up ? values[v] < value : values[v] > value))
+      {
+        values[v] = value;
+        ++changed;
+      }
+    }
+  }
+  return changed;
 }
 } // namespace topospline

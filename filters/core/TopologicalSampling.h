@@ -117,7 +117,7 @@ enum class OneCellCarving : int
 // `carving` says how far (OneCellCarving). Returns the number of changed vertices.
 Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, double spacing, std::vector<double>& values,
-  OneCellCarving carving = OneCellCarving::Everywhere);
+  OneCellCarving carving = OneCellCarving::Everywhere, const ParallelFor& parallel = SequentialFor);
 
 // The whole topological sampling of a reconstruction: the complex's critical points as
 // constraints, its smoothed 1-cells carved in (CarveOneCells), the floods

@@ -155,7 +155,8 @@ bool WithinHops(const TriangleMeshTopology& mesh, Index a, Index b, int hops)
 } // namespace
 
 std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLocation>& expected,
-  const std::vector<CriticalPointLocation>& found, double tolerance, const TriangleMeshTopology* mesh)
+  const std::vector<CriticalPointLocation>& found, double tolerance, const TriangleMeshTopology* mesh,
+  const ParallelFor& parallel)
 {
   // Candidate pairs within the tolerance, closest first. The found points are bucketed in
   // squares of the largest reach, so each expected point looks at its 3 x 3 neighbourhood
@@ -182,12 +183,19 @@ std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLoca
   const auto byBucket = [](const std::pair<Bucket, std::size_t>& a, const std::pair<Bucket, std::size_t>& b) {
     return a.first < b.first;
   };
-  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
+  using Pair = std::tuple<double, std::size_t, std::size_t>;
   const auto onMesh = [mesh](const CriticalPointLocation& cp) {
     return mesh != nullptr && cp.Vertex != InvalidIndex && cp.Vertex < mesh->NumberOfVertices();
   };
-  for (std::size_t e = 0; e < expected.size(); ++e)
-  {
+  // Each stretch of expected points gathers its own pairs: the sampling matches 60 000 saddles
+  // about 60 times on 500 x 500 noise, a third of its time. The pairs are sorted whole after,
+  // so the stretches' order does not matter.
+  constexpr Index stretch = 4096;
+  const Index count = static_cast<Index>(expected.size());
+  std::vector<std::vector<Pair>> stretches(static_cast<std::size_t>(StretchesOf(count, stretch)));
+  ForEachInStretches(count, stretch, parallel, [&](Index item, Index part) {
+    const std::size_t e = static_cast<std::size_t>(item);
+    std::vector<Pair>& pairs = stretches[part];
     const auto home = bucketOf(expected[e].Position[0], expected[e].Position[1]);
     // The three buckets of a row follow each other in the sorted array: one search per row.
     for (long long i = home.first - 1; i <= home.first + 1; ++i)
@@ -202,9 +210,17 @@ std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLoca
         {
           continue;
         }
-        const double d = std::hypot(
-          expected[e].Position[0] - found[f].Position[0], expected[e].Position[1] - found[f].Position[1]);
-        if (d <= tolerance * expected[e].Reach &&
+        // Most points of the nine buckets are beyond the reach: told by their squared distance
+        // (with a margin for its rounding) before std::hypot, which gives the pair's order.
+        const double dx = expected[e].Position[0] - found[f].Position[0];
+        const double dy = expected[e].Position[1] - found[f].Position[1];
+        const double limit = tolerance * expected[e].Reach;
+        if (dx * dx + dy * dy > limit * limit * (1 + 1e-9))
+        {
+          continue;
+        }
+        const double d = std::hypot(dx, dy);
+        if (d <= limit &&
           (!onMesh(expected[e]) || !onMesh(found[f]) ||
             WithinHops(*mesh, expected[e].Vertex, found[f].Vertex, expected[e].Hops)))
         {
@@ -212,13 +228,20 @@ std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLoca
         }
       }
     }
+  });
+  std::vector<Pair> pairs;
+  for (std::vector<Pair>& part : stretches)
+  {
+    pairs.insert(pairs.end(), part.begin(), part.end());
+    std::vector<Pair>().swap(part);
   }
   std::sort(pairs.begin(), pairs.end());
   return MatchAsManyAsPossible(pairs, expected.size(), found.size());
 }
 
 TopologyComparison CompareCriticalPoints(const std::vector<CriticalPointLocation>& expected,
-  const std::vector<CriticalPointLocation>& found, double tolerance, const TriangleMeshTopology* mesh)
+  const std::vector<CriticalPointLocation>& found, double tolerance, const TriangleMeshTopology* mesh,
+  const ParallelFor& parallel)
 {
   TopologyComparison comparison;
   for (const auto& cp : expected)
@@ -229,7 +252,7 @@ TopologyComparison CompareCriticalPoints(const std::vector<CriticalPointLocation
   {
     ++comparison.Found[std::clamp(cp.MorseIndex, 0, 2)];
   }
-  const std::vector<std::size_t> partner = MatchCriticalPoints(expected, found, tolerance, mesh);
+  const std::vector<std::size_t> partner = MatchCriticalPoints(expected, found, tolerance, mesh, parallel);
   std::vector<char> usedFound(found.size(), 0);
   for (std::size_t e = 0; e < expected.size(); ++e)
   {

@@ -57,11 +57,14 @@ struct TopologyComparison
 // matched whole). Returns the found point of each expected one (UnmatchedCriticalPoint: none).
 constexpr std::size_t UnmatchedCriticalPoint = static_cast<std::size_t>(-1);
 // With `mesh` (whose vertices both sets' Vertex name), a pair also needs the found vertex
-// within the expected point's Hops edges.
+// within the expected point's Hops edges. The candidate pairs are looked for with `parallel`
+// (the result does not depend on it).
 std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLocation>& expected,
-  const std::vector<CriticalPointLocation>& found, double tolerance, const TriangleMeshTopology* mesh = nullptr);
+  const std::vector<CriticalPointLocation>& found, double tolerance, const TriangleMeshTopology* mesh = nullptr,
+  const ParallelFor& parallel = SequentialFor);
 
 // The comparison of MatchCriticalPoints: counts, the points left over on either side.
 TopologyComparison CompareCriticalPoints(const std::vector<CriticalPointLocation>& expected,
-  const std::vector<CriticalPointLocation>& found, double tolerance, const TriangleMeshTopology* mesh = nullptr);
+  const std::vector<CriticalPointLocation>& found, double tolerance, const TriangleMeshTopology* mesh = nullptr,
+  const ParallelFor& parallel = SequentialFor);
 } // namespace topospline

@@ -378,30 +378,35 @@ int ChooseGridLayout(const std::array<SideSegments, 4>& sides, int maximum, std:
     lowest = std::max(lowest, static_cast<int>(side.Curve.size()));
   }
   // reach[s][r]: the piece whose count ends a way of writing r as a sum of the side's piece
-  // counts (-1: none; r = 0 needs none), an unbounded coin problem per side.
+  // counts (-1: none; r = 0 needs none), an unbounded coin problem per side. Filled only as far
+  // as the counts tried need (up to `maximum` it was a sixtieth of stage 4 on noise, where the
+  // first count tried fits almost always).
   std::array<std::vector<int>, 4> reach;
-  for (int s = 0; s < 4; ++s)
-  {
-    reach[s].assign(std::max(maximum - static_cast<int>(sides[s].Curve.size()), 0) + 1, -1);
-    for (int r = 1; r < static_cast<int>(reach[s].size()); ++r)
+  const auto reachable = [&](int s, int extra) {
+    std::vector<int>& table = reach[s];
+    while (static_cast<int>(table.size()) <= extra)
     {
-      for (std::size_t i = 0; i < sides[s].Pieces.size() && reach[s][r] < 0; ++i)
+      const int r = static_cast<int>(table.size());
+      int piece = -1;
+      for (std::size_t i = 0; r > 0 && i < sides[s].Pieces.size() && piece < 0; ++i)
       {
         const int k = sides[s].Pieces[i];
-        if (k <= r && (r == k || reach[s][r - k] >= 0))
+        if (k <= r && (r == k || table[r - k] >= 0))
         {
-          reach[s][r] = static_cast<int>(i);
+          piece = static_cast<int>(i);
         }
       }
+      table.push_back(piece);
     }
-  }
+    return extra == 0 || table[extra] >= 0;
+  };
   for (int n = lowest; n <= maximum; ++n)
   {
     bool fits = true;
     for (int s = 0; s < 4 && fits; ++s)
     {
       const int extra = n - static_cast<int>(sides[s].Curve.size());
-      fits = extra == 0 || (extra > 0 && reach[s][extra] >= 0);
+      fits = extra == 0 || (extra > 0 && reachable(s, extra));
     }
     if (!fits)
     {

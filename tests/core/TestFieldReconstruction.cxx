@@ -199,6 +199,44 @@ void CheckCase(const char* name, const GridField& grid, double percent, int k, i
 }
 } // namespace
 
+TEST_CASE(ThreadsGiveTheSameSamplingOnNoise)
+{
+  // Topological sampling walks the 1-cells, samples them and matches the saddles in parallel,
+  // over stretches of a few hundred 1-cells and a few thousand saddles, and merges what each
+  // stretch found: the merge must not depend on the threads. Noise large enough for several
+  // stretches, with saddles left off their nodes after the first pass (the other carvings, the
+  // relocations and the moves of displaced saddles run), one thread against four: the same
+  // values bit for bit and the same report.
+  Pipeline p;
+  std::string error;
+  CHECK(RunStages1To3(UniformNoise(130, 2), 2.0, 4, p, error));
+  int saddles = 0;
+  for (const CriticalPoint& cp : p.Simplified.Complex.CriticalPoints)
+  {
+    saddles += cp.MorseIndex == 1 ? 1 : 0;
+  }
+  FieldReconstruction sequential, threaded;
+  threaded.Parallel = ThreadedFor;
+  FieldReconstructionReport one, four;
+  CHECK(sequential.Run(p.Field, p.Simplified.Complex, p.Smoothed, one, error));
+  CHECK(threaded.Run(p.Field, p.Simplified.Complex, p.Smoothed, four, error));
+  std::printf("  130^2 noise at 2 %%: %d saddles, %d 1-cells, %d vertices changed by sampling, %d boundary and %d "
+              "interior saddles moved\n",
+    saddles, static_cast<int>(p.Simplified.Complex.OneCells.size()), static_cast<int>(one.Sampling.ChangedVertices),
+    one.Sampling.MovedBoundarySaddles, one.Sampling.MovedInteriorSaddles);
+  CHECK(saddles > 4096);                                       // the saddles are matched in two stretches
+  CHECK(p.Simplified.Complex.OneCells.size() > 16 * 256);     // the 1-cells walked in many
+  CHECK(one.Sampling.MovedInteriorSaddles > 0);               // saddles were off after the first pass
+  CHECK(four.Sampling.MovedInteriorSaddles == one.Sampling.MovedInteriorSaddles);
+  CHECK(four.Sampling.MovedBoundarySaddles == one.Sampling.MovedBoundarySaddles);
+  CHECK(four.Values == one.Values);
+  CHECK(four.Exact == one.Exact);
+  CHECK(four.Sampling.ChangedVertices == one.Sampling.ChangedVertices);
+  CHECK(four.Sampling.MaximumChange == one.Sampling.MaximumChange);
+  CHECK(four.Sampling.DisplacedSaddles == one.Sampling.DisplacedSaddles);
+  CHECK(four.Verified == one.Verified);
+}
+
 // Constant fields and fields varying by 1e-13 of their magnitude (read as constant by stage 1,
 // as the filter asks) at every k: the reconstruction is flat at the complex's value, within the
 // input's range, every vertex covered, no cell failed, verified. (At k = 30 a constant field's
