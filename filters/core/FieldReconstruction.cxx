@@ -155,11 +155,16 @@ GridField FieldReconstruction::FinerGrid(const PlanarScalarField& field) const
 }
 
 topospline::TopologicalSampling FieldReconstruction::SamplingOf(const MorseSmaleComplex& complex,
-  const TriangleMeshTopology& mesh, const PlanarScalarField& field, const OneCellSmoothingResult& smoothed) const
+  const TriangleMeshTopology& mesh, const PlanarScalarField& field, const OneCellSmoothingResult& smoothed,
+  double progressFrom, double progressTo) const
 {
   topospline::TopologicalSampling sampling(complex, mesh, field.Points, smoothed);
   sampling.Spacing = this->Spacing;
   sampling.Parallel = this->Parallel;
+  sampling.Hooks.Progress = [this, progressFrom, progressTo](double f) {
+    this->Hooks.Report(progressFrom + (progressTo - progressFrom) * f);
+  };
+  sampling.Hooks.AbortRequested = this->Hooks.AbortRequested;
   return sampling;
 }
 
@@ -389,9 +394,16 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
   }
 
   this->EvaluateAtVertices(field, complex, smoothed, report);
+  // Topological sampling, the resampling and the verification each take seconds on large
+  // noise: an abort is honoured between them (and between the sampling's passes).
   if (this->TopologicalSampling)
   {
     this->SampleTopologicallyAtVertices(field, mesh, complex, smoothed, report);
+  }
+  if (report.Sampling.Aborted || this->Hooks.Aborted())
+  {
+    error = "aborted";
+    return false;
   }
   this->Hooks.Report(0.7);
   this->MeasureErrors(field, report);
@@ -400,6 +412,11 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
   if (this->OutputResolution > 1)
   {
     this->Resample(field, mesh, complex, smoothed, report);
+  }
+  if (report.Sampling.Aborted || this->Hooks.Aborted())
+  {
+    error = "aborted";
+    return false;
   }
   this->Hooks.Report(0.85);
   if (this->VerifyTopology)
@@ -526,7 +543,8 @@ void FieldReconstruction::SampleTopologicallyAtVertices(const PlanarScalarField&
   report.Sampled = true;
   report.Exact = report.Values;
   const auto sameVertex = [](Index v) { return v; };
-  report.Sampling = this->SamplingOf(complex, mesh, field, smoothed).Apply(field, mesh, sameVertex, report.Values);
+  report.Sampling =
+    this->SamplingOf(complex, mesh, field, smoothed, 0.6, 0.7).Apply(field, mesh, sameVertex, report.Values);
   for (std::size_t v = 0; v < report.Values.size(); ++v)
   {
     report.Difference[v] = report.Values[v] - field.Values[v];
@@ -591,7 +609,7 @@ void FieldReconstruction::Resample(const PlanarScalarField& field, const Triangl
   {
     TriangleMeshTopology fineMesh;
     fineMesh.BuildGrid(ni, nj, this->Parallel);
-    const auto fineReport = this->SamplingOf(complex, mesh, field, smoothed).Apply(fine, fineMesh,
+    const auto fineReport = this->SamplingOf(complex, mesh, field, smoothed, 0.75, 0.85).Apply(fine, fineMesh,
       [&](Index v) {
         const double* xy = &field.Points[2 * static_cast<std::size_t>(v)];
         const int i = std::clamp(static_cast<int>(std::lround((xy[0] - grid.Origin[0]) / grid.Spacing[0])), 0, ni - 1);
@@ -604,6 +622,7 @@ void FieldReconstruction::Resample(const PlanarScalarField& field, const Triangl
     report.Sampling.ChangedVertices += fineReport.ChangedVertices;
     report.Sampling.MaximumChange = std::max(report.Sampling.MaximumChange, fineReport.MaximumChange);
     report.Sampling.Converged = report.Sampling.Converged && fineReport.Converged;
+    report.Sampling.Aborted = report.Sampling.Aborted || fineReport.Aborted;
   }
   report.Finer = grid;
   report.Finer.Values = std::move(fine.Values);

@@ -148,8 +148,11 @@ private:
   void Verify(const PlanarScalarField& field, const TriangleMeshTopology& mesh, const MorseSmaleComplex& complex,
     const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const;
 
+  // The topological sampling of `complex`, its progress reported as [progressFrom, progressTo]
+  // of the reconstruction's.
   topospline::TopologicalSampling SamplingOf(const MorseSmaleComplex& complex, const TriangleMeshTopology& mesh,
-    const PlanarScalarField& field, const OneCellSmoothingResult& smoothed) const;
+    const PlanarScalarField& field, const OneCellSmoothingResult& smoothed, double progressFrom,
+    double progressTo) const;
 
   TwoCellReconstruction Cells;
   double Spacing = 0; // the tolerance of every "near its node": one grid spacing

@@ -1501,10 +1501,25 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   std::vector<double> prepared = values;
   const bool morePasses = mesh.NumberOfVertices() <= this->MaximumVerticesForMorePasses;
   OneCellCarving kept = OneCellCarving::JustPastTheWalk;
-  TopologicalSamplingReport report = this->Settle(sampling, mesh, vertexAt, constraints, kept, values);
+  // Between passes: an abort leaves the values of the last pass done (the report says so).
+  const auto stopped = [this](TopologicalSamplingReport& r, double done) {
+    this->Hooks.Report(done);
+    r.Aborted = this->Hooks.Aborted();
+    return r.Aborted;
+  };
+  TopologicalSamplingReport report;
+  if (stopped(report, 0.0))
+  {
+    return report; // the values as evaluated
+  }
+  report = this->Settle(sampling, mesh, vertexAt, constraints, kept, values);
+  if (stopped(report, 0.4))
+  {
+    return report;
+  }
   for (const OneCellCarving carving : { OneCellCarving::WhereNeeded, OneCellCarving::Everywhere })
   {
-    if (report.DisplacedSaddles == 0 || !morePasses)
+    if (report.DisplacedSaddles == 0 || !morePasses || stopped(report, 0.6))
     {
       break;
     }
@@ -1526,6 +1541,10 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   // one minimum and one saddle short. (Counting one per blocked way up instead kept a move on the
   // jittered grid #246 that lost a minimum where the blocked ways up had lost none.)
   int movedSaddles = 0;
+  if (stopped(report, 0.7))
+  {
+    return report;
+  }
   if (!report.BlockedWaysUpVertices.empty() && morePasses)
   {
     const auto missing = [&](const TopologicalSamplingReport& r, const std::vector<double>& sampled) {
@@ -1555,10 +1574,18 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
       }
     }
   }
+  if (stopped(report, 0.8))
+  {
+    return report;
+  }
   const int movedInteriorSaddles =
     morePasses && mesh.NumberOfVertices() <= this->MaximumVerticesForSaddleMoves
     ? this->MoveDisplacedSaddles(sampling, mesh, vertexAt, kept, constraints, prepared, values, report)
     : 0;
+  if (stopped(report, 0.95))
+  {
+    return report;
+  }
   // What the carving, the floods and the relocations changed beyond what the critical points
   // need goes back toward F o Phi (the nodes' vertices toward their critical values).
   RelaxTowardTargets(mesh, prepared, values);
@@ -1567,6 +1594,7 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   report.MovedBoundarySaddles = movedSaddles;
   report.MovedInteriorSaddles = movedInteriorSaddles;
   CountChanges(before, values, report);
+  this->Hooks.Report(1.0);
   return report;
 }
 
@@ -1604,7 +1632,7 @@ int TopologicalSampling::MoveDisplacedSaddles(const PlanarScalarField& sampling,
     const VertexLink link(mesh, w);
     for (Index u : link)
     {
-      if (wanted[u] || mesh.IsBoundaryVertex(u) || tries >= this->MaximumSaddleMoveTries)
+      if (wanted[u] || mesh.IsBoundaryVertex(u) || tries >= this->MaximumSaddleMoveTries || this->Hooks.Aborted())
       {
         continue;
       }

@@ -49,6 +49,9 @@ struct TopologicalSamplingReport
   // Interior saddles left off their nodes that the sampling wants one edge away instead
   // (TopologicalSampling::MoveDisplacedSaddles).
   int MovedInteriorSaddles = 0;
+  // The sampling stopped between two of its passes because an abort was requested (Hooks):
+  // the values are those of the last pass done, not a finished sampling.
+  bool Aborted = false;
 };
 
 // One smoothed 1-cell of a wanted saddle, sampled from the saddle outwards: x, y and height per
@@ -171,6 +174,9 @@ public:
   // that descent stops beside a node it may not take (a wanted boundary minimum lower than the
   // vertex it reached, which is then no pit), the junction's own vertex is made the pit.
   bool PitsOnJunctionVertices = true;
+  // Progress over the passes, and an abort polled between them (a pass takes seconds on a
+  // million vertices of noise).
+  ProgressHooks Hooks;
 
   // `values` (one per vertex of `mesh`, at sampling.Points) is modified in place; `vertexAt`
   // gives the sampling's vertex for a vertex of the complex's mesh (InvalidIndex: none). The

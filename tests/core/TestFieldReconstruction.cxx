@@ -7,7 +7,9 @@
 //   without it), and the counts it reports are the differences counted here;
 // - the verdict: when it is 1, an independent count of the sampled field's interior PL minima
 //   and maxima (lower/upper links, written here) equals the complex's interior extrema;
-// - the same report with one thread and several;
+// - the same report with one thread and several (also on noise, where the sampling's walks,
+//   1-cell samples and saddle matching run in stretches);
+// - an abort asked during the sampling ends the run between two of its passes;
 // - saddles on their nodes: on weak noise (monkey saddles, saddles a vertex apart), every
 //   interior saddle of the complex has one of the sampling's within one edge and the other way
 //   round (PL multiplicities and one-to-one pairings written here);
@@ -235,6 +237,49 @@ TEST_CASE(ThreadsGiveTheSameSamplingOnNoise)
   CHECK(four.Sampling.MaximumChange == one.Sampling.MaximumChange);
   CHECK(four.Sampling.DisplacedSaddles == one.Sampling.DisplacedSaddles);
   CHECK(four.Verified == one.Verified);
+}
+
+TEST_CASE(AnAbortStopsTheSamplingBetweenItsPasses)
+{
+  // Topological sampling and the checks after it take seconds on large noise with no other
+  // stage to poll an abort: an abort asked once the 2-cells are done, or once the sampling's
+  // first pass is, must end the run with "aborted" before the sampling ends (the progress
+  // reported stays below the sampling's end, 0.7). Without an abort the progress rises to 1.
+  Pipeline p;
+  std::string error;
+  CHECK(RunStages1To3(UniformNoise(48, 3), 2.0, 4, p, error));
+  for (const double abortAt : { 0.6, 0.64 })
+  {
+    FieldReconstruction reconstruction;
+    double last = 0;
+    bool rising = true;
+    int polledInSampling = 0;
+    reconstruction.Hooks.Progress = [&](double f) {
+      rising = rising && f >= last;
+      last = f;
+    };
+    reconstruction.Hooks.AbortRequested = [&]() {
+      polledInSampling += last >= 0.6 ? 1 : 0;
+      return last >= abortAt;
+    };
+    FieldReconstructionReport report;
+    error.clear();
+    const bool ran = reconstruction.Run(p.Field, p.Simplified.Complex, p.Smoothed, report, error);
+    std::printf("  abort from progress %.2f: run %s (%s), last progress %.3f, polled %d times from 0.6 on\n", abortAt,
+      ran ? "finished" : "stopped", error.c_str(), last, polledInSampling);
+    CHECK(!ran && error == "aborted");
+    // Asked at 0.6 the sampling does not start a pass; asked after its first pass (0.64), it
+    // does not start a second.
+    CHECK(last >= abortAt && last < (abortAt < 0.64 ? 0.64 : 0.7));
+    CHECK(rising);
+  }
+  FieldReconstruction whole;
+  double last = 0;
+  whole.Hooks.Progress = [&](double f) { last = f; };
+  whole.Hooks.AbortRequested = []() { return false; };
+  FieldReconstructionReport report;
+  CHECK(whole.Run(p.Field, p.Simplified.Complex, p.Smoothed, report, error));
+  CHECK(last == 1.0 && !report.Sampling.Aborted);
 }
 
 // Constant fields and fields varying by 1e-13 of their magnitude (read as constant by stage 1,
