@@ -572,44 +572,44 @@ vtkSmartPointer<vtkUnstructuredGrid> SmoothedOneCellsBlock(
   }
   for (Index p = 0; p < static_cast<Index>(smoothed.Pieces.size()); ++p)
   {
-  const auto& smoothedPiece = smoothed.Pieces[p];
-  for (int s = 0; s < smoothedPiece.Curve.Segments; ++s)
-  {
-    const double* curve = smoothedPiece.Curve.Segment(s);
-    const double* h = smoothedPiece.Height.Segment(s);
-    vtkIdType ids[4];
-    for (int m = 0; m < 4; ++m)
+    const auto& smoothedPiece = smoothed.Pieces[p];
+    for (int s = 0; s < smoothedPiece.Curve.Segments; ++s)
     {
-      double xyz[3];
-      plane.To3D(curve + 2 * CurvePointOfVtkPoint[m], xyz);
-      ids[m] = points->InsertNextPoint(xyz);
-      height->InsertNextValue(h[CurvePointOfVtkPoint[m]]);
+      const double* curve = smoothedPiece.Curve.Segment(s);
+      const double* h = smoothedPiece.Height.Segment(s);
+      vtkIdType ids[4];
+      for (int m = 0; m < 4; ++m)
+      {
+        double xyz[3];
+        plane.To3D(curve + 2 * CurvePointOfVtkPoint[m], xyz);
+        ids[m] = points->InsertNextPoint(xyz);
+        height->InsertNextValue(h[CurvePointOfVtkPoint[m]]);
+      }
+      cells->InsertNextCell(4, ids);
+      piece->InsertNextValue(p);
+      segments->InsertNextValue(smoothedPiece.Segments);
+      type->InsertNextValue(smoothedPiece.Type);
     }
-    cells->InsertNextCell(4, ids);
-    piece->InsertNextValue(p);
-    segments->InsertNextValue(smoothedPiece.Segments);
-    type->InsertNextValue(smoothedPiece.Type);
   }
-}
-bezier->SetPoints(points);
-bezier->SetCells(VTK_BEZIER_CURVE, cells);
-bezier->GetPointData()->AddArray(height);
-bezier->GetPointData()->SetActiveScalars(names::Height);
-conversion::AddArrays(bezier->GetCellData(), { piece, segments, type });
-// Which pieces make up every 1-cell, in order from its source: stage 4 assembles the sides of
-// the 2-cells from them. 1-cell a is SeparatrixPieces[offsets[a] .. offsets[a+1]).
-auto offsets = conversion::NewArray<vtkIntArray>(names::SeparatrixPieceOffsets);
-auto list = conversion::NewArray<vtkIntArray>(names::SeparatrixPieces);
-offsets->InsertNextValue(0);
-for (const auto& pieces : smoothed.PiecesOfOneCell)
-{
-  for (Index p : pieces)
+  bezier->SetPoints(points);
+  bezier->SetCells(VTK_BEZIER_CURVE, cells);
+  bezier->GetPointData()->AddArray(height);
+  bezier->GetPointData()->SetActiveScalars(names::Height);
+  conversion::AddArrays(bezier->GetCellData(), { piece, segments, type });
+  // Which pieces make up every 1-cell, in order from its source: stage 4 assembles the sides of
+  // the 2-cells from them. 1-cell a is SeparatrixPieces[offsets[a] .. offsets[a+1]).
+  auto offsets = conversion::NewArray<vtkIntArray>(names::SeparatrixPieceOffsets);
+  auto list = conversion::NewArray<vtkIntArray>(names::SeparatrixPieces);
+  offsets->InsertNextValue(0);
+  for (const auto& pieces : smoothed.PiecesOfOneCell)
   {
-    list->InsertNextValue(p);
+    for (Index p : pieces)
+    {
+      list->InsertNextValue(p);
+    }
+    offsets->InsertNextValue(static_cast<int>(list->GetNumberOfTuples()));
   }
-  offsets->InsertNextValue(static_cast<int>(list->GetNumberOfTuples()));
-}
-conversion::AddArrays(bezier->GetFieldData(), { offsets, list });
+  conversion::AddArrays(bezier->GetFieldData(), { offsets, list });
   return bezier;
 }
 
