@@ -117,7 +117,8 @@ enum class OneCellCarving : int
 // break there; the other 1-cells are walked once.
 // Critical vertices keep their values (the nodes' critical values, as Apply sets them), and
 // no vertex next to a wanted maximum (minimum) is raised (lowered) past it.
-// `carving` says how far (OneCellCarving). Returns the number of changed vertices.
+// `carving` says how far (OneCellCarving). The walks run with `parallel` (they only read the
+// values; the result does not depend on it). Returns the number of changed vertices.
 Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, double spacing, std::vector<double>& values,
   OneCellCarving carving = OneCellCarving::Everywhere, const ParallelFor& parallel = SequentialFor);
