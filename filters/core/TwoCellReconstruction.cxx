@@ -614,6 +614,24 @@ bool IsCriticalVertex(const TriangleMeshTopology& mesh, Index v, const Values& v
   return changes != 2;
 }
 
+// The cells [0, n) through `parallel` in successive slices, the fraction done reported (as
+// [from, to] of the caller's progress) on the calling thread after each slice: on 1000 x 1000
+// noise one pass over the half million cells takes a minute, which a single report at its end
+// left without a moving progress bar, and reports from the worker threads would reach VTK's
+// observers off the main thread. Slices of at least 256 cells keep both threads busy; the body
+// polls the abort itself, and no slice starts after one.
+void ForEachCellInSlices(Index n, const ParallelFor& parallel, const ProgressHooks& hooks, double from, double to,
+  const RangeBody& body)
+{
+  const Index slice = std::max<Index>(256, (n + 49) / 50);
+  for (Index begin = 0; begin < n && !hooks.Aborted(); begin += slice)
+  {
+    const Index end = std::min(n, begin + slice);
+    parallel(begin, end, body);
+    hooks.Report(from + (to - from) * static_cast<double>(end) / static_cast<double>(n));
+  }
+}
+
 // Per vertex: whether it is inside the mesh and its whole ring of neighbours lies in its own
 // cell (cellOf; InvalidIndex: in none).
 std::vector<char> RingsInTheirCells(
@@ -689,7 +707,7 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
   // Pass 1 (the paper's "time II"): sides, boundary samples, triangulation, parameterization.
   auto start = Clock::now();
   const std::vector<int> samplesPerPiece(smoothed.Pieces.size(), this->BoundarySamples);
-  this->Parallel(0, n, [&](Index begin, Index end) {
+  ForEachCellInSlices(n, this->Parallel, this->Hooks, 0.0, 0.65, [&](Index begin, Index end) {
     for (Index c = begin; c < end && !this->Hooks.Aborted(); ++c)
     {
       this->ParameterizeCell(complex.TwoCells[c], smoothed, samplesPerPiece, *this->Cells[c], boundaries[c]);
@@ -736,7 +754,7 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
     }
     return samples;
   };
-  this->Parallel(0, n, [&](Index begin, Index end) {
+  ForEachCellInSlices(n, this->Parallel, this->Hooks, 0.7, 0.9, [&](Index begin, Index end) {
     for (Index c = begin; c < end && !this->Hooks.Aborted(); ++c)
     {
       ReconstructedTwoCell& cell = *this->Cells[c];
@@ -784,7 +802,7 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
       remappedSamples[c] = std::move(samples);
     }
   }
-  this->Parallel(0, n, [&](Index begin, Index end) {
+  ForEachCellInSlices(n, this->Parallel, this->Hooks, 0.9, 0.99, [&](Index begin, Index end) {
     for (Index c = begin; c < end && !this->Hooks.Aborted(); ++c)
     {
       ReconstructedTwoCell& cell = *this->Cells[c];
