@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <iterator>
 #include <memory>
 #include <vector>
 
@@ -49,6 +50,28 @@ void ForEachInStretches(Index count, Index size, const ParallelFor& parallel, co
       }
     }
   });
+}
+
+// ForEachInStretches where each item appends to a list: body(item, list) with its stretch's own
+// list, the lists joined in stretch order (what one thread would have made).
+template <typename T, typename Body>
+std::vector<T> CollectInStretches(Index count, Index size, const ParallelFor& parallel, const Body& body)
+{
+  std::vector<std::vector<T>> stretches(static_cast<std::size_t>(StretchesOf(count, size)));
+  ForEachInStretches(count, size, parallel, [&](Index item, Index stretch) { body(item, stretches[stretch]); });
+  std::size_t total = 0;
+  for (const std::vector<T>& part : stretches)
+  {
+    total += part.size();
+  }
+  std::vector<T> joined;
+  joined.reserve(total);
+  for (std::vector<T>& part : stretches)
+  {
+    std::move(part.begin(), part.end(), std::back_inserter(joined));
+    std::vector<T>().swap(part);
+  }
+  return joined;
 }
 
 // An allocator whose resize() leaves new elements uninitialized (default- rather than value-

@@ -1196,10 +1196,7 @@ std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, cons
   const Index oneCells =
     std::min(static_cast<Index>(complex.OneCells.size()), static_cast<Index>(smoothed.PiecesOfOneCell.size()));
   // Each 1-cell is sampled on its own: in parallel over stretches of them, joined in order.
-  constexpr Index stretch = 256;
-  std::vector<std::vector<SaddleOneCell>> stretches(static_cast<std::size_t>(StretchesOf(oneCells, stretch)));
-  ForEachInStretches(oneCells, stretch, parallel, [&](Index a, Index part) {
-    std::vector<SaddleOneCell>& cells = stretches[part];
+  return CollectInStretches<SaddleOneCell>(oneCells, 256, parallel, [&](Index a, std::vector<SaddleOneCell>& cells) {
     const OneCell& oneCell = complex.OneCells[a];
     const bool ascending = oneCell.Type == OneCell::Ascending;
     SaddleOneCell cell;
@@ -1249,12 +1246,6 @@ std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, cons
       cells.push_back(std::move(cell));
     }
   });
-  std::vector<SaddleOneCell> cells;
-  for (std::vector<SaddleOneCell>& part : stretches)
-  {
-    std::move(part.begin(), part.end(), std::back_inserter(cells));
-  }
-  return cells;
 }
 } // namespace
 
@@ -2527,18 +2518,17 @@ Index CarvingGround::NearerNeighbour(Index current, const double* q, bool ascend
   return nearest;
 }
 
-// What one stretch of walks asked, in the order of the walks: the vertices each walk asked
-// (walk c's from WalkStart[c]) and the heights asked of them (a walk is a ridge or a valley, so
-// the kind is its 1-cell's).
+// What one stretch of walks asked, in the order of the walks: each vertex a walk asked, with
+// the height asked of it (NaN where the walk left it as it was), walk w's from Start[w] (a walk
+// is a ridge or a valley, so the kind is its 1-cell's).
 struct WalkedRequests
 {
-  std::vector<Index> Walked, WalkStart{ 0 };
-  std::vector<std::pair<Index, double>> Requests;
-  std::vector<Index> RequestStart{ 0 };
+  std::vector<std::pair<Index, double>> Asked;
+  std::vector<Index> Start{ 0 };
 };
 
 // For v the height of a 1-cell there, strictly past `previous` (the value before v along the
-// walk), added to `requests`. Gentler carvings (OneCellCarving) leave v alone if it already lies
+// walk), added to `asked` (NaN: none asked). Gentler carvings (OneCellCarving) leave v alone if it already lies
 // past `previous`: the walk then goes on rising (falling) through v as it is, and no island can
 // form there; JustPastTheWalk asks only just past `previous`. Carving every vertex walked onto
 // up to the 1-cell's height changed 2-3 % of the vertices of a reconstruction, most of them by
@@ -2546,18 +2536,19 @@ struct WalkedRequests
 // beside a one-pixel peak to the 1-cell's height there took it 20 % of the range above the data
 // (docs/Reconstruction.md, "Gentle carving first"). Returns v's value along the walk once carved.
 double Ask(OneCellCarving carving, Index v, double height, double previous, bool up, const std::vector<double>& values,
-  std::vector<std::pair<Index, double>>& requests)
+  std::vector<std::pair<Index, double>>& asked)
 {
   const double infinity = std::numeric_limits<double>::infinity();
   if (carving != OneCellCarving::Everywhere && (up ? values[v] > previous : values[v] < previous))
   {
+    asked.emplace_back(v, std::numeric_limits<double>::quiet_NaN());
     return values[v];
   }
   const double pastPrevious = std::nextafter(previous, up ? infinity : -infinity);
   const double wanted = carving == OneCellCarving::JustPastTheWalk ? pastPrevious
     : up                                                           ? std::max(height, pastPrevious)
                                                                    : std::min(height, pastPrevious);
-  requests.emplace_back(v, wanted);
+  asked.emplace_back(v, wanted);
   return up ? std::max(wanted, values[v]) : std::min(wanted, values[v]);
 }
 
@@ -2585,13 +2576,11 @@ void AskAlongOneCell(const CarvingGround& ground, const SaddleOneCell& cell, con
       if (!ground.LeftAlone(current, start) &&
         !(carving != OneCellCarving::Everywhere && cell.Ascending && ground.BoundaryCarries(current, q[i + 2], values)))
       {
-        previous = Ask(carving, current, q[i + 2], previous, cell.Ascending, values, out.Requests);
-        out.Walked.push_back(current);
+        previous = Ask(carving, current, q[i + 2], previous, cell.Ascending, values, out.Asked);
       }
     }
   }
-  out.WalkStart.push_back(static_cast<Index>(out.Walked.size()));
-  out.RequestStart.push_back(static_cast<Index>(out.Requests.size()));
+  out.Start.push_back(static_cast<Index>(out.Asked.size()));
 }
 
 // The walks of `cells`, in parallel over stretches of them: a walk only reads the values, so the
@@ -2611,22 +2600,35 @@ std::vector<WalkedRequests> WalkOneCells(const CarvingGround& ground, const std:
   return stretches;
 }
 
-// The claims of the walks, each walk's to the claims of its 1-cell's kind.
-void ClaimWalked(const std::vector<SaddleOneCell>& cells, const std::vector<WalkedRequests>& stretches,
-  CarvingClaims& raise, CarvingClaims& lower)
+// visit(c, first, last) for the walk of 1-cell c, [first, last) being what it asked, in the
+// order of the 1-cells.
+template <typename Visit>
+void ForEachWalk(const std::vector<WalkedRequests>& stretches, const Visit& visit)
 {
   std::size_t c = 0;
   for (const WalkedRequests& walks : stretches)
   {
-    for (std::size_t w = 0; w + 1 < walks.RequestStart.size(); ++w, ++c)
+    for (std::size_t w = 0; w + 1 < walks.Start.size(); ++w, ++c)
     {
-      CarvingClaims& claims = cells[c].Ascending ? raise : lower;
-      for (Index r = walks.RequestStart[w]; r < walks.RequestStart[w + 1]; ++r)
-      {
-        claims.Claim(walks.Requests[r].first, walks.Requests[r].second);
-      }
+      visit(c, walks.Asked.begin() + walks.Start[w], walks.Asked.begin() + walks.Start[w + 1]);
     }
   }
+}
+
+// The claims of the walks, each walk's to the claims of its 1-cell's kind.
+void ClaimWalked(const std::vector<SaddleOneCell>& cells, const std::vector<WalkedRequests>& stretches,
+  CarvingClaims& raise, CarvingClaims& lower)
+{
+  ForEachWalk(stretches, [&](std::size_t c, auto first, auto last) {
+    CarvingClaims& claims = cells[c].Ascending ? raise : lower;
+    for (auto ask = first; ask != last; ++ask)
+    {
+      if (!std::isnan(ask->second))
+      {
+        claims.Claim(ask->first, ask->second);
+      }
+    }
+  });
 }
 } // namespace
 
@@ -2656,19 +2658,15 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
   // connected); the others are walked as before. Walking every 1-cell again that way changed
   // chains far from any conflict and lost a noise case (stress #77, 128² at 2 %), and so did
   // walking again every walk that met a vertex only the other kind claims.
-  auto claimedByBoth = [&](Index v) { return raiseTo.Has(v) && lowerTo.Has(v); };
+  auto claimedByBoth = [&](const std::pair<Index, double>& ask) {
+    return raiseTo.Has(ask.first) && lowerTo.Has(ask.first);
+  };
   std::vector<char> rewalk(cells.size(), 0);
   bool anyRewalk = false;
-  std::size_t c = 0;
-  for (const WalkedRequests& stretch : walks)
-  {
-    for (std::size_t w = 0; w + 1 < stretch.WalkStart.size(); ++w, ++c)
-    {
-      rewalk[c] = std::any_of(
-        stretch.Walked.begin() + stretch.WalkStart[w], stretch.Walked.begin() + stretch.WalkStart[w + 1], claimedByBoth);
-      anyRewalk = anyRewalk || rewalk[c];
-    }
-  }
+  ForEachWalk(walks, [&](std::size_t c, auto first, auto last) {
+    rewalk[c] = std::any_of(first, last, claimedByBoth);
+    anyRewalk = anyRewalk || rewalk[c];
+  });
   CarvingClaims againRaise(true, anyRewalk ? vertices : 0), againLower(false, anyRewalk ? vertices : 0);
   if (anyRewalk)
   {

@@ -190,12 +190,9 @@ std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLoca
   // Each stretch of expected points gathers its own pairs: the sampling matches 60 000 saddles
   // about 60 times on 500 x 500 noise, a third of its time. The pairs are sorted whole after,
   // so the stretches' order does not matter.
-  constexpr Index stretch = 4096;
   const Index count = static_cast<Index>(expected.size());
-  std::vector<std::vector<Pair>> stretches(static_cast<std::size_t>(StretchesOf(count, stretch)));
-  ForEachInStretches(count, stretch, parallel, [&](Index item, Index part) {
+  const auto candidatesOf = [&](Index item, std::vector<Pair>& candidates) {
     const std::size_t e = static_cast<std::size_t>(item);
-    std::vector<Pair>& pairs = stretches[part];
     const auto home = bucketOf(expected[e].Position[0], expected[e].Position[1]);
     // The three buckets of a row follow each other in the sorted array: one search per row.
     for (long long i = home.first - 1; i <= home.first + 1; ++i)
@@ -224,17 +221,12 @@ std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLoca
           (!onMesh(expected[e]) || !onMesh(found[f]) ||
             WithinHops(*mesh, expected[e].Vertex, found[f].Vertex, expected[e].Hops)))
         {
-          pairs.emplace_back(d, e, f);
+          candidates.emplace_back(d, e, f);
         }
       }
     }
-  });
-  std::vector<Pair> pairs;
-  for (std::vector<Pair>& part : stretches)
-  {
-    pairs.insert(pairs.end(), part.begin(), part.end());
-    std::vector<Pair>().swap(part);
-  }
+  };
+  std::vector<Pair> pairs = CollectInStretches<Pair>(count, 4096, parallel, candidatesOf);
   std::sort(pairs.begin(), pairs.end());
   return MatchAsManyAsPossible(pairs, expected.size(), found.size());
 }
