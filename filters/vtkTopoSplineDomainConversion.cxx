@@ -236,11 +236,16 @@ bool MeshToField(vtkDataSet* input, topospline::PlanarScalarField& field, std::s
 
 namespace vtkTopoSplineDomainConversion
 {
-ReleaseFreedMemoryOnReturn::~ReleaseFreedMemoryOnReturn()
+void ReleaseFreedMemory()
 {
 #if defined(__GLIBC__)
   malloc_trim(0);
 #endif
+}
+
+ReleaseFreedMemoryOnReturn::~ReleaseFreedMemoryOnReturn()
+{
+  ReleaseFreedMemory();
 }
 
 topospline::ParallelFor SMPParallelFor()

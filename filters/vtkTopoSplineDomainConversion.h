@@ -23,11 +23,15 @@ namespace vtkTopoSplineDomainConversion
 // vtkSMPTools-backed loop (results are identical with every backend: see CoreTypes.h).
 topospline::ParallelFor SMPParallelFor();
 
-// Hands the heap memory freed during a filter's run back to the system when it goes out of
-// scope (glibc's malloc_trim; nothing elsewhere). Stages 3 and 4 allocate and free gigabytes
-// in many small blocks, from several threads' arenas; without it glibc keeps most of it: 300 x
-// 300 noise at 5 % left the process at 1.65 GB resident after stage 4, 0.89 GB of it live. A
-// ParaView session then stays at its largest run's size, after an error as well.
+// Hands the heap memory freed so far back to the system (glibc's malloc_trim; nothing
+// elsewhere). Stages 3 and 4 allocate and free gigabytes in many small blocks, from several
+// threads' arenas; without it glibc keeps most of it: 300 x 300 noise at 5 % left the process
+// at 1.65 GB resident after stage 4, 0.89 GB of it live. Stage 4 also calls it once its 2-cells
+// are released, before the topological sampling (FieldReconstruction::ReleaseFreedMemory).
+void ReleaseFreedMemory();
+
+// Calls ReleaseFreedMemory when it goes out of scope, at the end of a filter's run: a ParaView
+// session then stays at its largest run's size, after an error as well.
 struct ReleaseFreedMemoryOnReturn
 {
   ReleaseFreedMemoryOnReturn() = default;

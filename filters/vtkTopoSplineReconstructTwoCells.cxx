@@ -429,6 +429,7 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
   reconstruction.Parallel = conversion::SMPParallelFor();
   reconstruction.Hooks.Progress = [this](double f) { this->UpdateProgress(f); };
   reconstruction.Hooks.AbortRequested = [this]() { return this->GetAbortExecute() != 0; };
+  reconstruction.ReleaseFreedMemory = conversion::ReleaseFreedMemory;
   topospline::FieldReconstructionReport report;
   {
     vtkLogScopeF(TRACE, "reconstruct %d 2-cells", static_cast<int>(complex.TwoCells.size()));

@@ -53,6 +53,19 @@ public:
   // interior vertices), to show both give the same gradient.
   static bool GeneralPathOnly;
 
+  // The vertices of the critical edges (saddles) that Compute gives for `values`, with
+  // multiplicity and in increasing order, without computing the gradient: counted from each
+  // vertex's lower link. Per lower star, ProcessLowerStars leaves one critical edge for each run
+  // of lower link vertices but the one it starts from; with the boundary rule a boundary
+  // vertex starts from a lower boundary edge, runs that reach a boundary neighbour are paired
+  // from its boundary edge, every other run leaves one, and with both boundary neighbours lower
+  // the second boundary edge is one (TestDiscreteGradient compares both on random fields).
+  // Topological sampling matches saddles after each of its trials: on 4 million vertices this
+  // takes a tenth of the time of a gradient. False, as Compute's callers fail, on a non-finite
+  // value or a vertex in no triangle.
+  static bool SaddleVertices(
+    const TriangleMeshTopology& mesh, const double* values, const ParallelFor& parallelFor, std::vector<Index>& saddles);
+
   // The vertex whose lower star holds the cell (its highest vertex): where a critical cell
   // is placed in the domain.
   static Index EdgeOwner(const TriangleMeshTopology& mesh, const VertexOrder& order, Index e);

@@ -393,7 +393,20 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
     }
   }
 
+  // Everything that needs the cells first (F o Phi at the vertices and on the finer grid, the
+  // patches); then they are released: on large noise they are half the memory, and the
+  // sampling and the check would come on top of them.
   this->EvaluateAtVertices(field, complex, smoothed, report);
+  if (this->OutputResolution > 1)
+  {
+    this->EvaluateOnFinerGrid(field, report);
+  }
+  this->CollectPatches(report);
+  this->Cells = TwoCellReconstruction();
+  if (this->ReleaseFreedMemory)
+  {
+    this->ReleaseFreedMemory();
+  }
   // Topological sampling, the resampling and the verification each take seconds on large
   // noise: an abort is honoured between them (and between the sampling's passes).
   if (this->TopologicalSampling)
@@ -407,11 +420,10 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
   }
   this->Hooks.Report(0.7);
   this->MeasureErrors(field, report);
-  this->CollectPatches(report);
   this->Hooks.Report(0.75);
-  if (this->OutputResolution > 1)
+  if (this->OutputResolution > 1 && this->TopologicalSampling)
   {
-    this->Resample(field, mesh, complex, smoothed, report);
+    this->SampleFinerGrid(field, mesh, complex, smoothed, report);
   }
   if (report.Sampling.Aborted || this->Hooks.Aborted())
   {
@@ -585,13 +597,10 @@ void FieldReconstruction::CollectPatches(FieldReconstructionReport& report) cons
   });
 }
 
-// F o Phi on the finer grid (0 where no cell covers a point), then its topological sampling,
-// with each node on the grid point nearest to it.
-void FieldReconstruction::Resample(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
-  const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const
+// F o Phi on the finer grid (0 where no cell covers a point).
+void FieldReconstruction::EvaluateOnFinerGrid(const PlanarScalarField& field, FieldReconstructionReport& report) const
 {
   const GridField grid = this->FinerGrid(field);
-  const int ni = grid.Dimensions[0], nj = grid.Dimensions[1];
   PlanarScalarField fine = FieldOnGrid(grid);
   const Index m = static_cast<Index>(fine.Points.size() / 2);
   fine.Values.resize(m);
@@ -605,26 +614,36 @@ void FieldReconstruction::Resample(const PlanarScalarField& field, const Triangl
       report.FinerValid[p] = e.Cell == InvalidIndex ? 0 : 1;
     }
   });
-  if (this->TopologicalSampling)
-  {
-    TriangleMeshTopology fineMesh;
-    fineMesh.BuildGrid(ni, nj, this->Parallel);
-    const auto fineReport = this->SamplingOf(complex, mesh, field, smoothed, 0.75, 0.85).Apply(fine, fineMesh,
-      [&](Index v) {
-        const double* xy = &field.Points[2 * static_cast<std::size_t>(v)];
-        const int i = std::clamp(static_cast<int>(std::lround((xy[0] - grid.Origin[0]) / grid.Spacing[0])), 0, ni - 1);
-        const int j = std::clamp(static_cast<int>(std::lround((xy[1] - grid.Origin[1]) / grid.Spacing[1])), 0, nj - 1);
-        return static_cast<Index>(j * ni + i);
-      },
-      fine.Values);
-    report.Sampling.DisplacedSaddles += fineReport.DisplacedSaddles;
-    report.Sampling.MovedBoundarySaddles += fineReport.MovedBoundarySaddles;
-    report.Sampling.ChangedVertices += fineReport.ChangedVertices;
-    report.Sampling.MaximumChange = std::max(report.Sampling.MaximumChange, fineReport.MaximumChange);
-    report.Sampling.Converged = report.Sampling.Converged && fineReport.Converged;
-    report.Sampling.Aborted = report.Sampling.Aborted || fineReport.Aborted;
-  }
   report.Finer = grid;
+  report.Finer.Values = std::move(fine.Values);
+}
+
+// The topological sampling of the finer grid, with each node on the grid point nearest to it.
+void FieldReconstruction::SampleFinerGrid(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const
+{
+  // The grid's values move into the sampled field and back (no second copy of a fine grid).
+  std::vector<double> values = std::move(report.Finer.Values);
+  const GridField& grid = report.Finer;
+  const int ni = grid.Dimensions[0], nj = grid.Dimensions[1];
+  PlanarScalarField fine = FieldOnGrid(grid);
+  fine.Values = std::move(values);
+  TriangleMeshTopology fineMesh;
+  fineMesh.BuildGrid(ni, nj, this->Parallel);
+  const auto fineReport = this->SamplingOf(complex, mesh, field, smoothed, 0.75, 0.85).Apply(fine, fineMesh,
+    [&](Index v) {
+      const double* xy = &field.Points[2 * static_cast<std::size_t>(v)];
+      const int i = std::clamp(static_cast<int>(std::lround((xy[0] - grid.Origin[0]) / grid.Spacing[0])), 0, ni - 1);
+      const int j = std::clamp(static_cast<int>(std::lround((xy[1] - grid.Origin[1]) / grid.Spacing[1])), 0, nj - 1);
+      return static_cast<Index>(j * ni + i);
+    },
+    fine.Values);
+  report.Sampling.DisplacedSaddles += fineReport.DisplacedSaddles;
+  report.Sampling.MovedBoundarySaddles += fineReport.MovedBoundarySaddles;
+  report.Sampling.ChangedVertices += fineReport.ChangedVertices;
+  report.Sampling.MaximumChange = std::max(report.Sampling.MaximumChange, fineReport.MaximumChange);
+  report.Sampling.Converged = report.Sampling.Converged && fineReport.Converged;
+  report.Sampling.Aborted = report.Sampling.Aborted || fineReport.Aborted;
   report.Finer.Values = std::move(fine.Values);
 }
 

@@ -107,6 +107,11 @@ public:
   static constexpr double MaximumPatchTriangles = 4e6;
   ParallelFor Parallel = SequentialFor;
   ProgressHooks Hooks;
+  // Called once the 2-cells are evaluated and released, before the topological sampling (the
+  // filter hands the freed heap back to the system there: on 1000 x 1000 noise the cells hold
+  // gigabytes in small blocks of two threads' arenas, which the sampling's large arrays would
+  // not reuse). Optional.
+  std::function<void()> ReleaseFreedMemory;
 
   // About how many bytes the reconstruction of `cells` 2-cells and a finer grid of
   // `finerPoints` points take (measured on uniform noise at 5 %, k = 4, 5 000 to 45 000 cells:
@@ -121,10 +126,6 @@ public:
   // malformed input or abort ("aborted"); failed cells are reported.
   bool Run(const PlanarScalarField& field, const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
     FieldReconstructionReport& report, std::string& error);
-
-  // The reconstructed 2-cells of the last Run (their surfaces, fits and parameterizations), in
-  // the complex's frame.
-  const TwoCellReconstruction& Reconstruction() const { return this->Cells; }
 
   // The finer grid of OutputResolution over `field` (no values yet): a grid's own points
   // refined, or for a triangle mesh a grid over its bounding box at the mean edge length /
@@ -143,8 +144,9 @@ private:
     const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const;
   void MeasureErrors(const PlanarScalarField& field, FieldReconstructionReport& report) const;
   void CollectPatches(FieldReconstructionReport& report) const;
-  void Resample(const PlanarScalarField& field, const TriangleMeshTopology& mesh, const MorseSmaleComplex& complex,
-    const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const;
+  void EvaluateOnFinerGrid(const PlanarScalarField& field, FieldReconstructionReport& report) const;
+  void SampleFinerGrid(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+    const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const;
   void Verify(const PlanarScalarField& field, const TriangleMeshTopology& mesh, const MorseSmaleComplex& complex,
     const OneCellSmoothingResult& smoothed, FieldReconstructionReport& report) const;
 
@@ -154,7 +156,7 @@ private:
     const PlanarScalarField& field, const OneCellSmoothingResult& smoothed, double progressFrom,
     double progressTo) const;
 
-  TwoCellReconstruction Cells;
+  TwoCellReconstruction Cells; // during Run, until every evaluation is done
   double Spacing = 0; // the tolerance of every "near its node": one grid spacing
 };
 

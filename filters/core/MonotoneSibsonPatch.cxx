@@ -215,6 +215,21 @@ void MonotoneSibsonPatch::EvaluateWithGradient(double X, double Y, double& value
   this->EvaluateTriangle(LocateTriangle(X, Y), X, Y, value, localGradient);
 }
 
+void MonotoneSibsonPatch::EvaluateMany(const MonotoneSibsonPatch* patches, int count, double X, double Y, double* values)
+{
+  const int t = static_cast<int>(LocateTriangle(X, Y));
+  double vertices[3][2];
+  TriangleVertices(t, vertices);
+  double lambda[3], linear[3];
+  Barycentric(vertices, X, Y, lambda);
+  for (int m = 0; m < count; ++m)
+  {
+    // As EvaluateTriangle computes the value.
+    ReduceToLinear(patches[m].Ordinates[t], lambda, linear);
+    values[m] = lambda[0] * linear[0] + lambda[1] * linear[1] + lambda[2] * linear[2];
+  }
+}
+
 void MonotoneSibsonPatch::EvaluateTriangle(
   SibsonTriangle t, double X, double Y, double& value, double localGradient[2]) const
 {

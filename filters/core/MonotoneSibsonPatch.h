@@ -93,6 +93,9 @@ public:
   // (that is h * grad F: divide by h for the gradient in the grid's units).
   double Evaluate(double X, double Y) const;
   void EvaluateWithGradient(double X, double Y, double& value, double localGradient[2]) const;
+  // Evaluate(X, Y) of `count` elements at once, bit for bit, with the point located once: the
+  // fits weigh every sample by the 12 elements of unit corner data.
+  static void EvaluateMany(const MonotoneSibsonPatch* patches, int count, double X, double Y, double* values);
   // The same restricted to one sub-triangle (extended polynomially outside it), so that both
   // sides of an interior half-diagonal can be compared.
   void EvaluateTriangle(SibsonTriangle t, double X, double Y, double& value, double localGradient[2]) const;

@@ -878,6 +878,26 @@ void MonotoneSibsonSurface::EvaluateWithGradient(double u, double v, double& val
   gradient[1] *= this->N;
 }
 
+void MonotoneSibsonSurface::EvaluateSamples(const std::vector<SurfaceSample>& samples, std::vector<double>& values) const
+{
+  values.resize(samples.size());
+  MonotoneSibsonPatch patch;
+  int patchI = -1, patchJ = -1;
+  for (std::size_t k = 0; k < samples.size(); ++k)
+  {
+    int i, j;
+    double X, Y;
+    this->Locate(samples[k].U, samples[k].V, i, j, X, Y);
+    if (i != patchI || j != patchJ)
+    {
+      patch = this->GetPatch(i, j);
+      patchI = i;
+      patchJ = j;
+    }
+    values[k] = patch.Evaluate(X, Y);
+  }
+}
+
 std::vector<SurfaceBezierTriangle> MonotoneSibsonSurface::GetBezierTriangles() const
 {
   std::vector<SurfaceBezierTriangle> triangles;

@@ -178,6 +178,9 @@ public:
   const MonotoneSurfaceFitReport& FitReport() const { return this->Fit; }
   // Largest and root-mean-square |F(u, v) - value| over samples.
   void MeasureResiduals(const std::vector<SurfaceSample>& samples, double& maximum, double& rms) const;
+  // Evaluate(U, V) of every sample, bit for bit. Samples in input order mostly follow each
+  // other within a grid cell, whose element (25 ordinates) is then made once for all of them.
+  void EvaluateSamples(const std::vector<SurfaceSample>& samples, std::vector<double>& values) const;
 
   int GetGridSize() const { return this->N; }
   const MonotoneSurfaceReport& Report() const { return this->BuildReport; }

@@ -86,12 +86,8 @@ const LocalMatrix& ThinPlateEnergy()
 // The 12 weights of F at local (X, Y): F = sum_m weight_m * datum_m.
 LocalVector EvaluationWeights(double X, double Y)
 {
-  const auto& patches = UnitPatches();
   LocalVector weights;
-  for (int m = 0; m < LocalData; ++m)
-  {
-    weights[m] = patches[m].Evaluate(X, Y);
-  }
+  MonotoneSibsonPatch::EvaluateMany(UnitPatches().data(), LocalData, X, Y, weights.data());
   return weights;
 }
 
@@ -158,9 +154,11 @@ void MonotoneSibsonSurface::MeasureResiduals(
   const std::vector<SurfaceSample>& samples, double& maximum, double& rms) const
 {
   maximum = rms = 0;
-  for (const SurfaceSample& sample : samples)
+  std::vector<double> values;
+  this->EvaluateSamples(samples, values);
+  for (std::size_t k = 0; k < samples.size(); ++k)
   {
-    const double residual = this->Evaluate(sample.U, sample.V) - sample.Value;
+    const double residual = values[k] - samples[k].Value;
     maximum = std::max(maximum, std::abs(residual));
     rms += residual * residual;
   }

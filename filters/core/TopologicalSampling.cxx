@@ -1,4 +1,5 @@
 #include "TopologicalSampling.h"
+#include "DiscreteGradient.h"
 #include "TopologyVerification.h"
 
 #include "PlanarGeometry.h"
@@ -16,21 +17,68 @@
 
 namespace topospline
 {
+// The vertex adjacency that the floods, the restores and the boundary moves walk: along all
+// edges, and along boundary edges only (the boundary curve). It depends on the mesh alone and
+// took a seventh of a second per flood on 4 million vertices, nine floods in a pass of the
+// 2000 x 2000 terrain: TopologicalSampling::Apply builds it once for all its passes and trials.
+struct VertexGraphs
+{
+  // A graph in compressed rows: the neighbours of v are Adjacent[Start[v] .. Start[v + 1]).
+  struct Graph
+  {
+    std::vector<Index> Start;
+    std::vector<Index> Adjacent;
+  };
+  Graph All, Boundary;
+
+  explicit VertexGraphs(const TriangleMeshTopology& mesh);
+};
+
+VertexGraphs::VertexGraphs(const TriangleMeshTopology& mesh)
+{
+  const Index n = mesh.NumberOfVertices();
+  this->All.Start.assign(n + 1, 0);
+  this->Boundary.Start.assign(n + 1, 0);
+  for (Index e = 0; e < mesh.NumberOfEdges(); ++e)
+  {
+    for (Index v : mesh.EdgeVertices[e])
+    {
+      ++this->All.Start[v + 1];
+      this->Boundary.Start[v + 1] += mesh.IsBoundaryEdge(e) ? 1 : 0;
+    }
+  }
+  for (Index v = 0; v < n; ++v)
+  {
+    this->All.Start[v + 1] += this->All.Start[v];
+    this->Boundary.Start[v + 1] += this->Boundary.Start[v];
+  }
+  this->All.Adjacent.resize(this->All.Start[n]);
+  this->Boundary.Adjacent.resize(this->Boundary.Start[n]);
+  std::vector<Index> fill(this->All.Start.begin(), this->All.Start.end() - 1);
+  std::vector<Index> boundaryFill(this->Boundary.Start.begin(), this->Boundary.Start.end() - 1);
+  for (Index e = 0; e < mesh.NumberOfEdges(); ++e)
+  {
+    const Index a = mesh.EdgeVertices[e][0], b = mesh.EdgeVertices[e][1];
+    this->All.Adjacent[fill[a]++] = b;
+    this->All.Adjacent[fill[b]++] = a;
+    if (mesh.IsBoundaryEdge(e))
+    {
+      this->Boundary.Adjacent[boundaryFill[a]++] = b;
+      this->Boundary.Adjacent[boundaryFill[b]++] = a;
+    }
+  }
+}
+
 namespace
 {
+using Graph = VertexGraphs::Graph;
+
 // Stage 1's order: by value, then by vertex id.
 struct Key
 {
   double Value;
   Index Vertex;
   bool operator<(const Key& o) const { return this->Value < o.Value || (this->Value == o.Value && this->Vertex < o.Vertex); }
-};
-
-// A graph in compressed rows: the neighbours of v are Adjacent[Start[v] .. Start[v + 1]).
-struct Graph
-{
-  std::vector<Index> Start;
-  std::vector<Index> Adjacent;
 };
 
 // Whether v has no neighbour before it in the sweep order (a minimum when ascending).
@@ -601,13 +649,13 @@ std::vector<Index> UnmatchedSaddles(const PlanarScalarField& field, const Triang
 
 // RelocateSaddles tries the patterns of the links (PlaceMissingSaddlesByTheirLinks) of at most
 // this many saddles left off their nodes by the carving, and this many patterns per saddle: each
-// costs a flood and an extraction, and 10 saddles with 16 patterns each gained no verdict more
+// costs a flood and a saddle count, and 10 saddles with 16 patterns each gained no verdict more
 // than these on the stress set's failing noise cases (#12-#80).
 constexpr int LinkPatternSaddles = 4;
 constexpr int LinkPatternsPerSaddle = 6;
 
 // After EnforceCriticalVertices the extrema are the wanted ones, but a saddle can sit a few
-// vertices from its node in a nearly flat pass. Each round extracts the complex of `field`
+// vertices from its node in a nearly flat pass. Each round counts the saddles of `field`
 // with `values`; for every wanted saddle (constraints.Saddles) with no saddle within `tolerance`, the nearest
 // unmatched saddle within `reach` is moved past the wanted saddle's value (raised if it is
 // lower: the pass then lies elsewhere along the ridge; lowered if higher), and the extrema are
@@ -615,12 +663,12 @@ constexpr int LinkPatternsPerSaddle = 6;
 // when more than `maximumMissing` are unmatched. Returns the number of unmatched wanted saddles
 // left.
 // With constraints.SaddleOneCells, the unmatched saddles' 1-cells are first carved into the
-// sampling (CarveSaddleOneCells, within `reach`; one extraction, whatever the number
+// sampling (CarveSaddleOneCells, within `reach`; one saddle count, whatever the number
 // unmatched): where a 1-cell runs between two rows of vertices, as next to the domain
 // boundary, the ridge or valley it follows is seen by no vertex and the saddle slides along
 // it; carving gives it vertices. Then the patterns of the links of the saddles still unmatched
 // (PlaceMissingSaddlesByTheirLinks), while few are.
-int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+int RelocateSaddles(const VertexGraphs& graphs, const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, double tolerance, double reach, std::vector<double>& values,
   int maximumRounds = 3, int maximumMissing = 10, const ParallelFor& parallel = SequentialFor);
 // Makes the wanted saddle `saddle` a saddle of the sampling with its own 1-cells
@@ -669,47 +717,6 @@ private:
 
 namespace
 {
-// Vertex adjacency of a mesh: along all edges, and along boundary edges only (the boundary curve).
-struct VertexGraphs
-{
-  Graph All, Boundary;
-
-  explicit VertexGraphs(const TriangleMeshTopology& mesh)
-  {
-    const Index n = mesh.NumberOfVertices();
-    this->All.Start.assign(n + 1, 0);
-    this->Boundary.Start.assign(n + 1, 0);
-    for (Index e = 0; e < mesh.NumberOfEdges(); ++e)
-    {
-      for (Index v : mesh.EdgeVertices[e])
-      {
-        ++this->All.Start[v + 1];
-        this->Boundary.Start[v + 1] += mesh.IsBoundaryEdge(e) ? 1 : 0;
-      }
-    }
-    for (Index v = 0; v < n; ++v)
-    {
-      this->All.Start[v + 1] += this->All.Start[v];
-      this->Boundary.Start[v + 1] += this->Boundary.Start[v];
-    }
-    this->All.Adjacent.resize(this->All.Start[n]);
-    this->Boundary.Adjacent.resize(this->Boundary.Start[n]);
-    std::vector<Index> fill(this->All.Start.begin(), this->All.Start.end() - 1);
-    std::vector<Index> boundaryFill(this->Boundary.Start.begin(), this->Boundary.Start.end() - 1);
-    for (Index e = 0; e < mesh.NumberOfEdges(); ++e)
-    {
-      const Index a = mesh.EdgeVertices[e][0], b = mesh.EdgeVertices[e][1];
-      this->All.Adjacent[fill[a]++] = b;
-      this->All.Adjacent[fill[b]++] = a;
-      if (mesh.IsBoundaryEdge(e))
-      {
-        this->Boundary.Adjacent[boundaryFill[a]++] = b;
-        this->Boundary.Adjacent[boundaryFill[b]++] = a;
-      }
-    }
-  }
-};
-
 // Bits of WantedFlags: which constraint wants a vertex as an extremum (or saddle).
 enum : unsigned char
 {
@@ -753,10 +760,10 @@ public:
 
   // `blockedWaysUp`, if given, collects the wanted boundary saddles whose way up had to raise a
   // wanted minimum or saddle.
-  FloodPass(const TriangleMeshTopology& mesh, const SamplingConstraints& constraints,
+  FloodPass(const VertexGraphs& graphs, const TriangleMeshTopology& mesh, const SamplingConstraints& constraints,
     std::vector<Index>* blockedWaysUp = nullptr)
     : Mesh(mesh)
-    , Graphs(mesh)
+    , Graphs(graphs)
     , Wanted(WantedFlags(mesh.NumberOfVertices(), constraints))
     , BlockedWaysUp(blockedWaysUp)
   {
@@ -901,20 +908,20 @@ private:
   }
 
   const TriangleMeshTopology& Mesh;
-  VertexGraphs Graphs;
+  const VertexGraphs& Graphs;
   std::vector<unsigned char> Wanted;
   std::vector<Index>* BlockedWaysUp;
   VisitMarks Visits;
 };
-} // namespace
 
-TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
-  const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds,
-  std::vector<Index>* blockedWaysUp)
+// EnforceCriticalVertices on the mesh's graphs.
+TopologicalSamplingReport EnforceCriticalVertices(const VertexGraphs& graphs, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds = 6,
+  std::vector<Index>* blockedWaysUp = nullptr)
 {
   TopologicalSamplingReport report;
   const std::vector<double> original = values;
-  FloodPass floods(mesh, constraints, blockedWaysUp);
+  FloodPass floods(graphs, mesh, constraints, blockedWaysUp);
   Index previousChanged = -1;
   for (report.Rounds = 1; report.Rounds <= maximumRounds; ++report.Rounds)
   {
@@ -935,6 +942,14 @@ TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& me
   report.Rounds = std::min(report.Rounds, maximumRounds);
   CountChanges(original, values, report);
   return report;
+}
+} // namespace
+
+TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds,
+  std::vector<Index>* blockedWaysUp)
+{
+  return EnforceCriticalVertices(VertexGraphs(mesh), mesh, constraints, values, maximumRounds, blockedWaysUp);
 }
 
 namespace
@@ -981,22 +996,20 @@ void ForEachWantedExtremum(
 
 // The wanted extrema that `values` does not have (each judged in its graph, as
 // RestoreWantedExtrema judges them).
-Index CountMissingWantedExtrema(
-  const TriangleMeshTopology& mesh, const SamplingConstraints& constraints, const std::vector<double>& values)
+Index CountMissingWantedExtrema(const VertexGraphs& graphs, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, const std::vector<double>& values)
 {
-  const VertexGraphs graphs(mesh);
   Index missing = 0;
   ForEachWantedExtremum(mesh, constraints, graphs, [&](const Graph& graph, Index v, bool minimum) {
     missing += graph.Start[v] != graph.Start[v + 1] && !IsExtremum(graph, values, v, minimum) ? 1 : 0;
   });
   return missing;
 }
-} // namespace
 
-Index RestoreWantedExtrema(const TriangleMeshTopology& mesh, const SamplingConstraints& constraints,
-  std::vector<double>& values)
+// RestoreWantedExtrema on the mesh's graphs.
+Index RestoreWantedExtrema(const VertexGraphs& graphs, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, std::vector<double>& values)
 {
-  const VertexGraphs graphs(mesh);
   Index changed = 0;
   // Moves v just past its extreme neighbour in `graph` unless it is an extremum there already.
   auto restore = [&](const Graph& graph, Index v, bool minimum) {
@@ -1016,6 +1029,13 @@ Index RestoreWantedExtrema(const TriangleMeshTopology& mesh, const SamplingConst
   };
   ForEachWantedExtremum(mesh, constraints, graphs, restore);
   return changed;
+}
+} // namespace
+
+Index RestoreWantedExtrema(const TriangleMeshTopology& mesh, const SamplingConstraints& constraints,
+  std::vector<double>& values)
+{
+  return RestoreWantedExtrema(VertexGraphs(mesh), mesh, constraints, values);
 }
 
 Index RelaxTowardTargets(const TriangleMeshTopology& mesh, const std::vector<double>& targets,
@@ -1377,14 +1397,14 @@ std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, cons
   }
   return placed;
 }
-} // namespace
 
-int MoveBlockedBoundarySaddles(const TriangleMeshTopology& mesh, const std::vector<Index>& blocked,
-  const std::vector<double>& settled, SamplingConstraints& constraints, std::vector<double>& start)
+// MoveBlockedBoundarySaddles on the mesh's graphs.
+int MoveBlockedBoundarySaddles(const VertexGraphs& graphs, const TriangleMeshTopology& mesh,
+  const std::vector<Index>& blocked, const std::vector<double>& settled, SamplingConstraints& constraints,
+  std::vector<double>& start)
 {
   std::vector<unsigned char> wanted = WantedFlags(mesh.NumberOfVertices(), constraints);
   const std::unordered_set<Index> candidates(blocked.begin(), blocked.end());
-  const VertexGraphs graphs(mesh);
   const Graph& curve = graphs.Boundary;
   std::vector<double> values = settled;
   VisitMarks visits;
@@ -1441,6 +1461,13 @@ int MoveBlockedBoundarySaddles(const TriangleMeshTopology& mesh, const std::vect
   }
   return moved;
 }
+} // namespace
+
+int MoveBlockedBoundarySaddles(const TriangleMeshTopology& mesh, const std::vector<Index>& blocked,
+  const std::vector<double>& settled, SamplingConstraints& constraints, std::vector<double>& start)
+{
+  return MoveBlockedBoundarySaddles(VertexGraphs(mesh), mesh, blocked, settled, constraints, start);
+}
 
 TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sampling,
   const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, std::vector<double>& values) const
@@ -1449,6 +1476,7 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   SamplingConstraints constraints = ComplexConstraints(this->Complex, this->ComplexMesh, mesh, vertexAt);
   AddSaddleOneCells(this->Complex, this->Smoothed, vertexAt, reach, constraints, this->Parallel);
   AddOneCells(this->Complex, this->Smoothed, vertexAt, 0.25 * this->Spacing, constraints, this->Parallel);
+  const VertexGraphs graphs(mesh);
   const std::vector<double> before = values;
   // Every node's vertex takes the node's critical value: F o Phi has it at the node, but a
   // vertex on a node that a 2-cell's smoothed boundary passes beside (a slit, a node between
@@ -1503,7 +1531,7 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   {
     return report; // the values as evaluated
   }
-  report = this->Settle(sampling, mesh, vertexAt, constraints, kept, values);
+  report = this->Settle(graphs, sampling, mesh, vertexAt, constraints, kept, values);
   if (stopped(report, 0.4))
   {
     return report;
@@ -1515,7 +1543,7 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
       break;
     }
     std::vector<double> carved = prepared;
-    const TopologicalSamplingReport next = this->Settle(sampling, mesh, vertexAt, constraints, carving, carved);
+    const TopologicalSamplingReport next = this->Settle(graphs, sampling, mesh, vertexAt, constraints, carving, carved);
     if (next.DisplacedSaddles < report.DisplacedSaddles)
     {
       values = std::move(carved);
@@ -1539,17 +1567,17 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   if (!report.BlockedWaysUpVertices.empty() && morePasses)
   {
     const auto missing = [&](const TopologicalSamplingReport& r, const std::vector<double>& sampled) {
-      return static_cast<Index>(r.DisplacedSaddles) + CountMissingWantedExtrema(mesh, constraints, sampled);
+      return static_cast<Index>(r.DisplacedSaddles) + CountMissingWantedExtrema(graphs, mesh, constraints, sampled);
     };
     const Index before = missing(report, values);
     const std::vector<Index> boundaryMaxima = constraints.BoundaryMaxima;
     const std::vector<Index> saddles = constraints.Saddles;
     std::vector<double> moved = prepared;
-    movedSaddles = MoveBlockedBoundarySaddles(mesh, report.BlockedWaysUpVertices, values, constraints, moved);
+    movedSaddles = MoveBlockedBoundarySaddles(graphs, mesh, report.BlockedWaysUpVertices, values, constraints, moved);
     if (movedSaddles > 0)
     {
       std::vector<double> settled = moved;
-      const TopologicalSamplingReport next = this->Settle(sampling, mesh, vertexAt, constraints, kept, settled);
+      const TopologicalSamplingReport next = this->Settle(graphs, sampling, mesh, vertexAt, constraints, kept, settled);
       const Index after = missing(next, settled); // the saddles wanted where they moved
       if (after < before || (after == before && next.BlockedWaysUp.size() < report.BlockedWaysUp.size()))
       {
@@ -1571,7 +1599,7 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   }
   const int movedInteriorSaddles =
     morePasses && mesh.NumberOfVertices() <= this->MaximumVerticesForSaddleMoves
-    ? this->MoveDisplacedSaddles(sampling, mesh, vertexAt, kept, constraints, prepared, values, report)
+    ? this->MoveDisplacedSaddles(graphs, sampling, mesh, vertexAt, kept, constraints, prepared, values, report)
     : 0;
   if (stopped(report, 0.95))
   {
@@ -1597,7 +1625,8 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
 // along, the saddle leaves the way free. Each try runs the kept carving's pass again (Settle)
 // from the prepared values, the node's critical value on the neighbour; a try is kept if fewer
 // wanted points are missing, judged against the nodes themselves as the verdict judges them.
-int TopologicalSampling::MoveDisplacedSaddles(const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
+int TopologicalSampling::MoveDisplacedSaddles(const VertexGraphs& graphs, const PlanarScalarField& sampling,
+  const TriangleMeshTopology& mesh,
   const std::function<Index(Index)>& vertexAt, OneCellCarving carving, SamplingConstraints& constraints,
   std::vector<double>& prepared, std::vector<double>& values, TopologicalSamplingReport& report) const
 {
@@ -1608,7 +1637,7 @@ int TopologicalSampling::MoveDisplacedSaddles(const PlanarScalarField& sampling,
   const double tolerance = this->Spacing * (1 + 1e-9);
   const std::vector<Index> nodes = constraints.Saddles; // the verdict's saddles, never moved here
   const auto missing = [&](const std::vector<Index>& unmatched, const std::vector<double>& sampled) {
-    return static_cast<Index>(unmatched.size()) + CountMissingWantedExtrema(mesh, constraints, sampled);
+    return static_cast<Index>(unmatched.size()) + CountMissingWantedExtrema(graphs, mesh, constraints, sampled);
   };
   const std::vector<Index> unmatched = UnmatchedSaddles(sampling, mesh, nodes, tolerance, this->Parallel, values);
   Index current = missing(unmatched, values);
@@ -1637,7 +1666,7 @@ int TopologicalSampling::MoveDisplacedSaddles(const PlanarScalarField& sampling,
       std::vector<double> start = prepared;
       start[u] = prepared[w];
       std::vector<double> settled = start;
-      const TopologicalSamplingReport next = this->Settle(sampling, mesh, vertexAt, trial, carving, settled);
+      const TopologicalSamplingReport next = this->Settle(graphs, sampling, mesh, vertexAt, trial, carving, settled);
       const Index after =
         missing(UnmatchedSaddles(sampling, mesh, nodes, tolerance, this->Parallel, settled), settled);
       if (after < current)
@@ -1657,7 +1686,8 @@ int TopologicalSampling::MoveDisplacedSaddles(const PlanarScalarField& sampling,
 
 // The steps of Apply after the nodes' values: the 1-cells carved in, the boundary junctions
 // placed, the floods, and the saddles moved back onto their nodes.
-TopologicalSamplingReport TopologicalSampling::Settle(const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
+TopologicalSamplingReport TopologicalSampling::Settle(const VertexGraphs& graphs, const PlanarScalarField& sampling,
+  const TriangleMeshTopology& mesh,
   const std::function<Index(Index)>& vertexAt, SamplingConstraints& constraints, OneCellCarving carving,
   std::vector<double>& values) const
 {
@@ -1678,7 +1708,7 @@ TopologicalSamplingReport TopologicalSampling::Settle(const PlanarScalarField& s
   // The saddles whose way up took a wanted point away, from this pass's own floods (not from
   // the relocation's trials, which are kept only if they match better).
   std::vector<Index> blocked;
-  TopologicalSamplingReport report = EnforceCriticalVertices(mesh, constraints, values, 6, &blocked);
+  TopologicalSamplingReport report = EnforceCriticalVertices(graphs, mesh, constraints, values, 6, &blocked);
   // With every wanted extremum an extremum and no other one, the saddles (with multiplicity)
   // are as many as the complex's: min - saddle + max is the same on every disk. A flood of
   // one kind can take a wanted extremum of the other kind away (a cut peak sinking below a
@@ -1690,12 +1720,12 @@ TopologicalSamplingReport TopologicalSampling::Settle(const PlanarScalarField& s
   for (int round = 0; round <= restoreRounds; ++round)
   {
     report.DisplacedSaddles =
-      RelocateSaddles(sampling, mesh, constraints, this->Spacing * (1 + 1e-9), reach, values, 3, 10, this->Parallel);
-    if (RestoreWantedExtrema(mesh, constraints, values) == 0)
+      RelocateSaddles(graphs, sampling, mesh, constraints, this->Spacing * (1 + 1e-9), reach, values, 3, 10, this->Parallel);
+    if (RestoreWantedExtrema(graphs, mesh, constraints, values) == 0)
     {
       break;
     }
-    EnforceCriticalVertices(mesh, constraints, values, 6, &blocked);
+    EnforceCriticalVertices(graphs, mesh, constraints, values, 6, &blocked);
   }
   constraints.BoundaryMinima.resize(boundaryMinimaBefore);
   constraints.Saddles.resize(saddlesBefore);
@@ -1759,7 +1789,7 @@ struct SaddleMatch
   }
 };
 
-// Extracts the saddles of a sampling's values and matches them to the wanted ones within the
+// Counts the saddles of a sampling's values (as stage 1 finds them) and matches them to the wanted ones within the
 // tolerance, as the verdict does.
 class SaddleMatcher
 {
@@ -1779,7 +1809,7 @@ public:
   {
     SaddleMatch match;
     std::vector<Index> saddles;
-    if (!this->ExtractSaddles(values, saddles))
+    if (!this->CountSaddles(values, saddles))
     {
       match.Missing = this->WantedSaddles;
       return match;
@@ -1826,28 +1856,11 @@ private:
     return result;
   }
 
-  // The saddle vertices of the sampling with `values`; false if the extraction fails.
-  bool ExtractSaddles(const std::vector<double>& values, std::vector<Index>& saddles)
+  // The saddle vertices of the sampling with `values` (stage 1's, counted from the lower links:
+  // DiscreteGradient::SaddleVertices); false on a value stage 1 refuses.
+  bool CountSaddles(const std::vector<double>& values, std::vector<Index>& saddles)
   {
-    this->Sampled.Values = values;
-    MorseSmaleComplexExtraction extraction;
-    extraction.CriticalPointsOnly = true;
-    extraction.GivenMesh = &this->Mesh;
-    extraction.Parallel = this->Parallel;
-    MorseSmaleComplex found;
-    std::string error;
-    if (!extraction.Extract(this->Sampled, found, error))
-    {
-      return false;
-    }
-    for (const CriticalPoint& cp : found.CriticalPoints)
-    {
-      if (cp.MorseIndex == 1)
-      {
-        saddles.push_back(cp.Vertex);
-      }
-    }
-    return true;
+    return DiscreteGradient::SaddleVertices(this->Mesh, values.data(), this->Parallel, saddles);
   }
 
   const std::vector<double>& Points;
@@ -1856,14 +1869,13 @@ private:
   const std::vector<CriticalPointLocation> Wanted; // the same, as MatchCriticalPoints takes them
   const double Tolerance;
   const ParallelFor& Parallel;
-  // Values only: the extraction reads neither positions nor triangles (it is given the mesh).
-  PlanarScalarField Sampled;
 };
 
 // The sampling whose saddles RelocateSaddles moves, with its current match; trials are kept
 // only if they match better.
 struct SaddleRelocation
 {
+  const VertexGraphs& Graphs;
   const PlanarScalarField& Field;
   const TriangleMeshTopology& Mesh;
   const SamplingConstraints& Constraints;
@@ -1875,7 +1887,7 @@ struct SaddleRelocation
   // Floods `trial` again and matches its saddles.
   SaddleMatch Settle(std::vector<double>& trial)
   {
-    EnforceCriticalVertices(this->Mesh, this->Constraints, trial);
+    EnforceCriticalVertices(this->Graphs, this->Mesh, this->Constraints, trial);
     return this->Matcher.Match(trial);
   }
 
@@ -1897,7 +1909,7 @@ struct SaddleRelocation
   // its own saddle): the saddles the trial leaves unmatched are carved as well, round after
   // round. On noise a saddle can be off at the end of a chain of wanted saddles each one vertex
   // from its node; each carve moves the gap one saddle along (4 rounds on a 32² field at 0.5 %).
-  // Each round costs an extraction of the whole sampling: the rounds after the first are for a
+  // Each round costs a saddle count and a matching over the whole sampling: the rounds after the first are for a
   // few displaced saddles (at most `maximumMissing`), not for a sampling with many off.
   void TryCarvingMissingOneCells(int maximumMissing)
   {
@@ -1936,7 +1948,7 @@ struct SaddleRelocation
   // a 1-cell can be a dead end: on noise a ridge leaving the saddle beside a minimum of its own
   // descending 1-cell has no vertex to go on along it, so the raised vertex is a peak that the
   // floods cut back, where the link vertex next to it leads on up by itself. Each pattern
-  // costs a flood and an extraction of the whole sampling: only for a few saddles
+  // costs a flood and a saddle count and a matching over the whole sampling: only for a few saddles
   // (`maximumMissing`) and the cheapest `maximumPatterns` patterns each.
   void TryLinkPatterns(int maximumMissing, int maximumPatterns)
   {
@@ -2033,24 +2045,24 @@ struct SaddleRelocation
   }
 };
 
-int RelocateSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+int RelocateSaddles(const VertexGraphs& graphs, const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, double tolerance, double reach, std::vector<double>& values,
   int maximumRounds, int maximumMissing, const ParallelFor& parallel)
 {
   SaddleMatcher matcher(field, mesh, constraints.Saddles, tolerance, parallel);
-  SaddleRelocation relocation{ field, mesh, constraints, reach, matcher, values, matcher.Match(values) };
+  SaddleRelocation relocation{ graphs, field, mesh, constraints, reach, matcher, values, matcher.Match(values) };
   const std::vector<Index>& missing = relocation.Current.Missing;
   if (!missing.empty() && !constraints.SaddleOneCells.empty())
   {
     relocation.TryCarvingMissingOneCells(maximumMissing);
   }
   // Then, for a few saddles still off, the patterns of their links (cheap next to the carving
-  // only while few are off: each pattern floods and extracts the whole sampling).
+  // only while few are off: each pattern floods the whole sampling and counts its saddles).
   if (!missing.empty())
   {
     relocation.TryLinkPatterns(LinkPatternSaddles, LinkPatternsPerSaddle);
   }
-  // Each round costs an extraction of the whole sampling: worth it for the few saddles of a
+  // Each round costs a saddle count and a matching over the whole sampling: worth it for the few saddles of a
   // flat pass, not when many are missing (a failed 2-cell keeps the input's own saddles).
   if (static_cast<int>(missing.size()) > maximumMissing)
   {
@@ -2074,7 +2086,8 @@ int PlaceMissingSaddlesByTheirLinks(const PlanarScalarField& field, const Triang
 {
   const ParallelFor sequential = SequentialFor; // the matcher keeps a reference
   SaddleMatcher matcher(field, mesh, constraints.Saddles, tolerance, sequential);
-  SaddleRelocation relocation{ field, mesh, constraints, 0, matcher, values, matcher.Match(values) };
+  const VertexGraphs graphs(mesh);
+  SaddleRelocation relocation{ graphs, field, mesh, constraints, 0, matcher, values, matcher.Match(values) };
   relocation.TryLinkPatterns(maximumMissing, maximumPatterns);
   return static_cast<int>(relocation.Current.Missing.size());
 }

@@ -146,6 +146,8 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
 // boundary (within 3 spacings), with the field falling into the domain there; a wanted
 // boundary saddle at a domain corner is wanted on the higher corner neighbour (a corner above
 // both its neighbours is also a maximum of stage 1).
+struct VertexGraphs; // the adjacency the floods walk (TopologicalSampling.cxx)
+
 class TopologicalSampling
 {
 public:
@@ -160,7 +162,7 @@ public:
 
   // One grid spacing of the samplings: how near its node a critical point must be.
   double Spacing = 1;
-  // Runs the extractions of the sampled critical points (the floods are sequential).
+  // Runs the saddle counts and matchings of the samplings (the floods are sequential).
   ParallelFor Parallel = SequentialFor;
   // Samplings with more vertices keep the first pass (the gentlest carving) even with saddles
   // off their nodes (see Apply).
@@ -186,14 +188,15 @@ public:
     const std::function<Index(Index)>& vertexAt, std::vector<double>& values) const;
 
 private:
-  int MoveDisplacedSaddles(const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
+  int MoveDisplacedSaddles(const VertexGraphs& graphs, const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
     const std::function<Index(Index)>& vertexAt, OneCellCarving carving, SamplingConstraints& constraints,
     std::vector<double>& prepared, std::vector<double>& values, TopologicalSamplingReport& report) const;
   // How far from its node a saddle is looked for and carved back.
   double SaddleReach() const { return 8 * this->Spacing; }
   // One pass: carves the 1-cells, places the boundary junctions (added to `constraints` for the
   // pass only), floods and relocates saddles.
-  TopologicalSamplingReport Settle(const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
+  TopologicalSamplingReport Settle(const VertexGraphs& graphs, const PlanarScalarField& sampling,
+    const TriangleMeshTopology& mesh,
     const std::function<Index(Index)>& vertexAt, SamplingConstraints& constraints, OneCellCarving carving,
     std::vector<double>& values) const;
 
@@ -239,7 +242,7 @@ int MoveBlockedBoundarySaddles(const TriangleMeshTopology& mesh, const std::vect
 // saddle of its multiplicity needs (just past the saddle's value), one pattern of sides at a
 // time in the order of the change it costs, and the floods run again; a pattern is kept if more
 // wanted saddles are then matched within `tolerance` without more found ones. Only if at most
-// `maximumMissing` wanted saddles are off (each pattern floods and extracts the whole sampling),
+// `maximumMissing` wanted saddles are off (each pattern floods the whole sampling and counts its saddles),
 // and the cheapest `maximumPatterns` patterns of each. Boundary saddles are left alone (the
 // boundary rule has its own passes). Returns the number of wanted saddles still off.
 // RelocateSaddles (TopologicalSampling::Apply) runs this after the carving.

@@ -1190,10 +1190,7 @@ bool TwoCellReconstruction::StiffenWhereSamplingBreaks(ReconstructedTwoCell& cel
   }
   std::vector<double> sampled(count);
   const auto criticalSpots = [&](const MonotoneSibsonSurface& surface) {
-    for (Index k = 0; k < count; ++k)
-    {
-      sampled[k] = surface.Evaluate(samples[k].U, samples[k].V);
-    }
+    surface.EvaluateSamples(samples, sampled);
     const auto value = [&](Index w) { return sampled[slotOf.at(w)]; };
     std::vector<Index> critical;
     for (Index k : deep)

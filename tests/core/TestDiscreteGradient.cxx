@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <map>
 #include <numeric>
@@ -497,6 +498,68 @@ TEST_CASE(RegularVertexShortcutEqualsProcessLowerStars)
     CHECK(fast.EdgeTriangle == general.EdgeTriangle);
     CHECK(fast.TriangleEdge == general.TriangleEdge);
   }
+}
+
+TEST_CASE(SaddleVerticesCountedFromLowerLinksAreTheGradientsCriticalEdges)
+{
+  // DiscreteGradient::SaddleVertices (used by topological sampling) must list exactly the
+  // owners of the gradient's critical edges, with multiplicity, in increasing order: on the
+  // meshes above (ties, random diagonals, 2 x 2 and 3 x 2 grids), on larger noise with few
+  // levels (monkey saddles, plateaus touching the boundary), with both lower-star paths, and
+  // with threads.
+  std::vector<MeshField> fields = TestMeshes();
+  for (std::uint64_t seed = 1; seed <= 4; ++seed)
+  {
+    MeshField field = JitteredGrid(40 + static_cast<int>(seed), 37, 500 + seed, seed % 2 ? 0.0 : 0.4, seed % 2 == 0);
+    RandomValues(field, 700 + seed, seed <= 2 ? 0 : static_cast<int>(seed));
+    fields.push_back(field);
+  }
+  // Three stretches, as threads would take them (the count must not depend on them).
+  const ParallelFor inThreeStretches = [](Index begin, Index end, const RangeBody& body) {
+    const Index third = (end - begin + 2) / 3;
+    for (Index b = begin; b < end; b += std::max<Index>(third, 1))
+    {
+      body(b, std::min(end, b + std::max<Index>(third, 1)));
+    }
+  };
+  Index compared = 0, multiple = 0;
+  for (const bool generalPath : { false, true })
+  {
+    for (const MeshField& field : fields)
+    {
+      const TriangleMeshTopology mesh = MeshOf(field);
+      DiscreteGradient::GeneralPathOnly = generalPath;
+      const DiscreteGradient g = GradientOf(mesh, field);
+      DiscreteGradient::GeneralPathOnly = false;
+      std::vector<Index> expected;
+      const VertexOrder order{ field.Values.data() };
+      for (Index e = 0; e < mesh.NumberOfEdges(); ++e)
+      {
+        if (g.IsCriticalEdge(e))
+        {
+          expected.push_back(DiscreteGradient::EdgeOwner(mesh, order, e));
+        }
+      }
+      std::sort(expected.begin(), expected.end());
+      std::vector<Index> counted;
+      CHECK(DiscreteGradient::SaddleVertices(mesh, field.Values.data(), inThreeStretches, counted));
+      if (counted != expected)
+      {
+        std::printf("  %s: %zu saddles counted, %zu critical edges\n", field.Name.c_str(), counted.size(),
+          expected.size());
+      }
+      CHECK(counted == expected);
+      compared += static_cast<Index>(expected.size());
+      multiple += std::adjacent_find(expected.begin(), expected.end()) != expected.end() ? 1 : 0;
+    }
+  }
+  CHECK(compared > 1000);
+  CHECK(multiple > 0); // some fields have saddles of multiplicity 2 or more
+  // Stage 1 refuses non-finite values: so does the count.
+  MeshField broken = fields.front();
+  broken.Values[broken.Values.size() / 2] = std::nan("");
+  std::vector<Index> counted;
+  CHECK(!DiscreteGradient::SaddleVertices(MeshOf(broken), broken.Values.data(), SequentialFor, counted));
 }
 
 int main()
