@@ -7,7 +7,6 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
-#include <queue>
 #include <unordered_map>
 
 namespace topospline
@@ -665,6 +664,79 @@ std::vector<MorseSmaleComplexSimplification::PersistencePair> MorseSmaleComplexS
 
 //------------------------------------------------------------------------------
 // A saddle-extremum pair joined by a 1-cell, waiting in the greedy queue.
+namespace
+{
+// A priority queue on a 4-ary heap: the element for which popsBefore holds against every other
+// is on top. The greedy cancellation pushes and pops about two million candidates on the 2000 x
+// 2000 terrain (51 297 critical points), with up to 1.9 million waiting: a binary heap spent
+// most of stage 2 waiting for its cache misses, a level per comparison; four children share a
+// cache line or two and the heap is half as deep. Any correct queue pops the same sequence:
+// the order is total on distinct candidates.
+template <typename T, typename PopsBefore>
+class FourAryHeap
+{
+public:
+  explicit FourAryHeap(PopsBefore popsBefore)
+    : Before(popsBefore)
+  {
+  }
+  bool empty() const { return this->Items.empty(); }
+  std::size_t size() const { return this->Items.size(); }
+  const T& top() const { return this->Items.front(); }
+  void push(const T& item)
+  {
+    std::size_t hole = this->Items.size();
+    this->Items.push_back(item);
+    while (hole > 0)
+    {
+      const std::size_t parent = (hole - 1) / 4;
+      if (!this->Before(item, this->Items[parent]))
+      {
+        break;
+      }
+      this->Items[hole] = this->Items[parent];
+      hole = parent;
+    }
+    this->Items[hole] = item;
+  }
+  void pop()
+  {
+    const T last = this->Items.back();
+    this->Items.pop_back();
+    const std::size_t n = this->Items.size();
+    if (n == 0)
+    {
+      return;
+    }
+    std::size_t hole = 0;
+    for (;;)
+    {
+      const std::size_t first = 4 * hole + 1;
+      if (first >= n)
+      {
+        break;
+      }
+      std::size_t best = first;
+      for (std::size_t c = first + 1; c < std::min(first + 4, n); ++c)
+      {
+        best = this->Before(this->Items[c], this->Items[best]) ? c : best;
+      }
+      if (!this->Before(this->Items[best], last))
+      {
+        break;
+      }
+      this->Items[hole] = this->Items[best];
+      hole = best;
+    }
+    this->Items[hole] = last;
+  }
+
+private:
+  PopsBefore Before;
+  std::vector<T> Items;
+};
+} // namespace
+
 struct MorseSmaleComplexSimplification::Candidate
 {
   double Persistence;
@@ -704,12 +776,12 @@ struct MorseSmaleComplexSimplification::GreedyState
     return false;
   }
   // The queue's order: the top pops first.
-  struct PopsAfter
+  struct PopsFirst
   {
     const std::vector<CriticalPoint>* CriticalPoints;
     bool operator()(const Candidate& a, const Candidate& b) const
     {
-      return PopsBefore(*this->CriticalPoints, b, a);
+      return PopsBefore(*this->CriticalPoints, a, b);
     }
   };
 
@@ -720,7 +792,7 @@ struct MorseSmaleComplexSimplification::GreedyState
     , PersistencePartner(cps.size(), InvalidIndex)
     , PinnedBy(cps.size())
     , StructuralPair(cps.size(), 0)
-    , Queue(PopsAfter{ &cps })
+    , Queue(PopsFirst{ &cps })
     , SaddlesOf(cps.size())
     , Forward(cps.size())
     , Stamp(cps.size(), InvalidIndex)
@@ -758,7 +830,7 @@ struct MorseSmaleComplexSimplification::GreedyState
   // boundary junction (cancelled with the saddle on its own vertex).
   std::vector<std::vector<Index>> PinnedBy;
   std::vector<unsigned char> StructuralPair;
-  std::priority_queue<Candidate, std::vector<Candidate>, PopsAfter> Queue;
+  FourAryHeap<Candidate, PopsFirst> Queue;
   // Per guard of a maximum kept on a one-triangle vertex (KeepsCornerMaximum: the boundary
   // saddle there and the minima its 1-cells end at): that maximum, offered again when it dies.
   std::vector<Index> CornerMaximumOf;
