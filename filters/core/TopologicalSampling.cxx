@@ -761,9 +761,10 @@ public:
   // `blockedWaysUp`, if given, collects the wanted boundary saddles whose way up had to raise a
   // wanted minimum or saddle.
   FloodPass(const VertexGraphs& graphs, const TriangleMeshTopology& mesh, const SamplingConstraints& constraints,
-    std::vector<Index>* blockedWaysUp = nullptr)
+    std::vector<Index>* blockedWaysUp = nullptr, const ParallelFor& parallel = SequentialFor)
     : Mesh(mesh)
     , Graphs(graphs)
+    , Parallel(parallel)
     , Wanted(WantedFlags(mesh.NumberOfVertices(), constraints))
     , BlockedWaysUp(blockedWaysUp)
   {
@@ -800,13 +801,17 @@ private:
       return !(wanted[v] & flag) && !(wholeLink && mesh.IsBoundaryVertex(v) && !getsWayUp(v)) &&
         IsExtremum(graph, values, v, ascending);
     };
-    for (Index v = mesh.NumberOfVertices() - 1; v >= 0; --v) // taken from the back: in vertex order
-    {
+    // Every vertex is looked at (a read-only test; on 4 million vertices the scans were most of
+    // a flood): in parallel stretches joined in order, from the last vertex down, so that the
+    // candidates are taken from the back in vertex order.
+    const Index n = mesh.NumberOfVertices();
+    candidates = CollectInStretches<Index>(n, 1 << 16, this->Parallel, [&](Index item, std::vector<Index>& found) {
+      const Index v = n - 1 - item;
       if (isCandidate(v))
       {
-        candidates.push_back(v);
+        found.push_back(v);
       }
-    }
+    });
     const SweepDirection direction{ graph, ascending, wanted, flag, wholeLink ? &mesh : nullptr };
     LocalFlood flood{ direction, values, this->Visits };
     // A fill can leave a vertex next to its region with no lower neighbour (a cut, no higher
@@ -909,6 +914,7 @@ private:
 
   const TriangleMeshTopology& Mesh;
   const VertexGraphs& Graphs;
+  const ParallelFor& Parallel;
   std::vector<unsigned char> Wanted;
   std::vector<Index>* BlockedWaysUp;
   VisitMarks Visits;
@@ -917,11 +923,11 @@ private:
 // EnforceCriticalVertices on the mesh's graphs.
 TopologicalSamplingReport EnforceCriticalVertices(const VertexGraphs& graphs, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds = 6,
-  std::vector<Index>* blockedWaysUp = nullptr)
+  std::vector<Index>* blockedWaysUp = nullptr, const ParallelFor& parallel = SequentialFor)
 {
   TopologicalSamplingReport report;
   const std::vector<double> original = values;
-  FloodPass floods(graphs, mesh, constraints, blockedWaysUp);
+  FloodPass floods(graphs, mesh, constraints, blockedWaysUp, parallel);
   Index previousChanged = -1;
   for (report.Rounds = 1; report.Rounds <= maximumRounds; ++report.Rounds)
   {
@@ -1708,7 +1714,7 @@ TopologicalSamplingReport TopologicalSampling::Settle(const VertexGraphs& graphs
   // The saddles whose way up took a wanted point away, from this pass's own floods (not from
   // the relocation's trials, which are kept only if they match better).
   std::vector<Index> blocked;
-  TopologicalSamplingReport report = EnforceCriticalVertices(graphs, mesh, constraints, values, 6, &blocked);
+  TopologicalSamplingReport report = EnforceCriticalVertices(graphs, mesh, constraints, values, 6, &blocked, this->Parallel);
   // With every wanted extremum an extremum and no other one, the saddles (with multiplicity)
   // are as many as the complex's: min - saddle + max is the same on every disk. A flood of
   // one kind can take a wanted extremum of the other kind away (a cut peak sinking below a
@@ -1725,7 +1731,7 @@ TopologicalSamplingReport TopologicalSampling::Settle(const VertexGraphs& graphs
     {
       break;
     }
-    EnforceCriticalVertices(graphs, mesh, constraints, values, 6, &blocked);
+    EnforceCriticalVertices(graphs, mesh, constraints, values, 6, &blocked, this->Parallel);
   }
   constraints.BoundaryMinima.resize(boundaryMinimaBefore);
   constraints.Saddles.resize(saddlesBefore);
@@ -1876,6 +1882,7 @@ private:
 struct SaddleRelocation
 {
   const VertexGraphs& Graphs;
+  const ParallelFor& Parallel; // the floods' scans
   const PlanarScalarField& Field;
   const TriangleMeshTopology& Mesh;
   const SamplingConstraints& Constraints;
@@ -1887,7 +1894,7 @@ struct SaddleRelocation
   // Floods `trial` again and matches its saddles.
   SaddleMatch Settle(std::vector<double>& trial)
   {
-    EnforceCriticalVertices(this->Graphs, this->Mesh, this->Constraints, trial);
+    EnforceCriticalVertices(this->Graphs, this->Mesh, this->Constraints, trial, 6, nullptr, this->Parallel);
     return this->Matcher.Match(trial);
   }
 
@@ -2050,7 +2057,7 @@ int RelocateSaddles(const VertexGraphs& graphs, const PlanarScalarField& field, 
   int maximumRounds, int maximumMissing, const ParallelFor& parallel)
 {
   SaddleMatcher matcher(field, mesh, constraints.Saddles, tolerance, parallel);
-  SaddleRelocation relocation{ graphs, field, mesh, constraints, reach, matcher, values, matcher.Match(values) };
+  SaddleRelocation relocation{ graphs, parallel, field, mesh, constraints, reach, matcher, values, matcher.Match(values) };
   const std::vector<Index>& missing = relocation.Current.Missing;
   if (!missing.empty() && !constraints.SaddleOneCells.empty())
   {
@@ -2087,7 +2094,7 @@ int PlaceMissingSaddlesByTheirLinks(const PlanarScalarField& field, const Triang
   const ParallelFor sequential = SequentialFor; // the matcher keeps a reference
   SaddleMatcher matcher(field, mesh, constraints.Saddles, tolerance, sequential);
   const VertexGraphs graphs(mesh);
-  SaddleRelocation relocation{ graphs, field, mesh, constraints, 0, matcher, values, matcher.Match(values) };
+  SaddleRelocation relocation{ graphs, sequential, field, mesh, constraints, 0, matcher, values, matcher.Match(values) };
   relocation.TryLinkPatterns(maximumMissing, maximumPatterns);
   return static_cast<int>(relocation.Current.Missing.size());
 }

@@ -162,7 +162,8 @@ public:
 
   // One grid spacing of the samplings: how near its node a critical point must be.
   double Spacing = 1;
-  // Runs the saddle counts and matchings of the samplings (the floods are sequential).
+  // Runs the saddle counts and matchings of the samplings and the floods' scans for candidates
+  // (the floods themselves are sequential).
   ParallelFor Parallel = SequentialFor;
   // Samplings with more vertices keep the first pass (the gentlest carving) even with saddles
   // off their nodes (see Apply).
