@@ -356,8 +356,8 @@ void DiscreteGradient::Compute(const TriangleMeshTopology& mesh, const double* v
   });
 }
 
-bool DiscreteGradient::SaddleVertices(
-  const TriangleMeshTopology& mesh, const double* values, const ParallelFor& parallelFor, std::vector<Index>& saddles)
+bool DiscreteGradient::SaddleVertices(const TriangleMeshTopology& mesh, const double* values,
+  const ParallelFor& parallelFor, std::vector<Index>& saddles)
 {
   const Index n = mesh.NumberOfVertices();
   const VertexOrder order{ values };

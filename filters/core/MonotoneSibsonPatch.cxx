@@ -215,7 +215,8 @@ void MonotoneSibsonPatch::EvaluateWithGradient(double X, double Y, double& value
   this->EvaluateTriangle(LocateTriangle(X, Y), X, Y, value, localGradient);
 }
 
-void MonotoneSibsonPatch::EvaluateMany(const MonotoneSibsonPatch* patches, int count, double X, double Y, double* values)
+void MonotoneSibsonPatch::EvaluateMany(
+  const MonotoneSibsonPatch* patches, int count, double X, double Y, double* values)
 {
   const int t = static_cast<int>(LocateTriangle(X, Y));
   double vertices[3][2];

@@ -878,7 +878,8 @@ void MonotoneSibsonSurface::EvaluateWithGradient(double u, double v, double& val
   gradient[1] *= this->N;
 }
 
-void MonotoneSibsonSurface::EvaluateSamples(const std::vector<SurfaceSample>& samples, std::vector<double>& values) const
+void MonotoneSibsonSurface::EvaluateSamples(
+  const std::vector<SurfaceSample>& samples, std::vector<double>& values) const
 {
   values.resize(samples.size());
   MonotoneSibsonPatch patch;

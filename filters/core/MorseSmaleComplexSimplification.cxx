@@ -663,7 +663,6 @@ std::vector<MorseSmaleComplexSimplification::PersistencePair> MorseSmaleComplexS
 }
 
 //------------------------------------------------------------------------------
-// A saddle-extremum pair joined by a 1-cell, waiting in the greedy queue.
 namespace
 {
 // A priority queue on a 4-ary heap: the element for which popsBefore holds against every other
@@ -681,7 +680,6 @@ public:
   {
   }
   bool empty() const { return this->Items.empty(); }
-  std::size_t size() const { return this->Items.size(); }
   const T& top() const { return this->Items.front(); }
   void push(const T& item)
   {
@@ -737,6 +735,7 @@ private:
 };
 } // namespace
 
+// A saddle-extremum pair joined by a 1-cell, waiting in the greedy queue.
 struct MorseSmaleComplexSimplification::Candidate
 {
   double Persistence;

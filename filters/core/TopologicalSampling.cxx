@@ -1714,7 +1714,8 @@ TopologicalSamplingReport TopologicalSampling::Settle(const VertexGraphs& graphs
   // The saddles whose way up took a wanted point away, from this pass's own floods (not from
   // the relocation's trials, which are kept only if they match better).
   std::vector<Index> blocked;
-  TopologicalSamplingReport report = EnforceCriticalVertices(graphs, mesh, constraints, values, 6, &blocked, this->Parallel);
+  TopologicalSamplingReport report =
+    EnforceCriticalVertices(graphs, mesh, constraints, values, 6, &blocked, this->Parallel);
   // With every wanted extremum an extremum and no other one, the saddles (with multiplicity)
   // are as many as the complex's: min - saddle + max is the same on every disk. A flood of
   // one kind can take a wanted extremum of the other kind away (a cut peak sinking below a
@@ -1726,7 +1727,8 @@ TopologicalSamplingReport TopologicalSampling::Settle(const VertexGraphs& graphs
   for (int round = 0; round <= restoreRounds; ++round)
   {
     report.DisplacedSaddles =
-      RelocateSaddles(graphs, sampling, mesh, constraints, this->Spacing * (1 + 1e-9), reach, values, 3, 10, this->Parallel);
+      RelocateSaddles(graphs, sampling, mesh, constraints, this->Spacing * (1 + 1e-9), reach, values, 3, 10,
+        this->Parallel);
     if (RestoreWantedExtrema(graphs, mesh, constraints, values) == 0)
     {
       break;
@@ -1795,8 +1797,8 @@ struct SaddleMatch
   }
 };
 
-// Counts the saddles of a sampling's values (as stage 1 finds them) and matches them to the wanted ones within the
-// tolerance, as the verdict does.
+// Counts the saddles of a sampling's values (as stage 1 finds them) and matches them to the
+// wanted ones within the tolerance, as the verdict does.
 class SaddleMatcher
 {
 public:
@@ -1916,8 +1918,9 @@ struct SaddleRelocation
   // its own saddle): the saddles the trial leaves unmatched are carved as well, round after
   // round. On noise a saddle can be off at the end of a chain of wanted saddles each one vertex
   // from its node; each carve moves the gap one saddle along (4 rounds on a 32² field at 0.5 %).
-  // Each round costs a saddle count and a matching over the whole sampling: the rounds after the first are for a
-  // few displaced saddles (at most `maximumMissing`), not for a sampling with many off.
+  // Each round costs a saddle count and a matching over the whole sampling: the rounds after
+  // the first are for a few displaced saddles (at most `maximumMissing`), not for a sampling
+  // with many off.
   void TryCarvingMissingOneCells(int maximumMissing)
   {
     const int rounds = static_cast<int>(this->Current.Missing.size()) <= maximumMissing ? 8 : 1;
@@ -2057,7 +2060,8 @@ int RelocateSaddles(const VertexGraphs& graphs, const PlanarScalarField& field, 
   int maximumRounds, int maximumMissing, const ParallelFor& parallel)
 {
   SaddleMatcher matcher(field, mesh, constraints.Saddles, tolerance, parallel);
-  SaddleRelocation relocation{ graphs, parallel, field, mesh, constraints, reach, matcher, values, matcher.Match(values) };
+  SaddleRelocation relocation{ graphs, parallel, field, mesh, constraints, reach, matcher, values,
+    matcher.Match(values) };
   const std::vector<Index>& missing = relocation.Current.Missing;
   if (!missing.empty() && !constraints.SaddleOneCells.empty())
   {
@@ -2069,8 +2073,9 @@ int RelocateSaddles(const VertexGraphs& graphs, const PlanarScalarField& field, 
   {
     relocation.TryLinkPatterns(LinkPatternSaddles, LinkPatternsPerSaddle);
   }
-  // Each round costs a saddle count and a matching over the whole sampling: worth it for the few saddles of a
-  // flat pass, not when many are missing (a failed 2-cell keeps the input's own saddles).
+  // Each round costs a saddle count and a matching over the whole sampling: worth it for the
+  // few saddles of a flat pass, not when many are missing (a failed 2-cell keeps the input's own
+  // saddles).
   if (static_cast<int>(missing.size()) > maximumMissing)
   {
     return static_cast<int>(missing.size());
@@ -2094,7 +2099,8 @@ int PlaceMissingSaddlesByTheirLinks(const PlanarScalarField& field, const Triang
   const ParallelFor sequential = SequentialFor; // the matcher keeps a reference
   SaddleMatcher matcher(field, mesh, constraints.Saddles, tolerance, sequential);
   const VertexGraphs graphs(mesh);
-  SaddleRelocation relocation{ graphs, sequential, field, mesh, constraints, 0, matcher, values, matcher.Match(values) };
+  SaddleRelocation relocation{ graphs, sequential, field, mesh, constraints, 0, matcher, values,
+    matcher.Match(values) };
   relocation.TryLinkPatterns(maximumMissing, maximumPatterns);
   return static_cast<int>(relocation.Current.Missing.size());
 }

@@ -189,7 +189,8 @@ public:
     const std::function<Index(Index)>& vertexAt, std::vector<double>& values) const;
 
 private:
-  int MoveDisplacedSaddles(const VertexGraphs& graphs, const PlanarScalarField& sampling, const TriangleMeshTopology& mesh,
+  int MoveDisplacedSaddles(const VertexGraphs& graphs, const PlanarScalarField& sampling,
+    const TriangleMeshTopology& mesh,
     const std::function<Index(Index)>& vertexAt, OneCellCarving carving, SamplingConstraints& constraints,
     std::vector<double>& prepared, std::vector<double>& values, TopologicalSamplingReport& report) const;
   // How far from its node a saddle is looked for and carved back.
@@ -243,8 +244,8 @@ int MoveBlockedBoundarySaddles(const TriangleMeshTopology& mesh, const std::vect
 // saddle of its multiplicity needs (just past the saddle's value), one pattern of sides at a
 // time in the order of the change it costs, and the floods run again; a pattern is kept if more
 // wanted saddles are then matched within `tolerance` without more found ones. Only if at most
-// `maximumMissing` wanted saddles are off (each pattern floods the whole sampling and counts its saddles),
-// and the cheapest `maximumPatterns` patterns of each. Boundary saddles are left alone (the
+// `maximumMissing` wanted saddles are off (each pattern floods the whole sampling and counts its
+// saddles), and the cheapest `maximumPatterns` patterns of each. Boundary saddles are left alone (the
 // boundary rule has its own passes). Returns the number of wanted saddles still off.
 // RelocateSaddles (TopologicalSampling::Apply) runs this after the carving.
 int PlaceMissingSaddlesByTheirLinks(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
