@@ -1334,8 +1334,27 @@ bool TwoCellParameterization::Parameterize(
   std::vector<double> alikePoints, alikeParameters, opened;
   bool resampled = false;
   int pinched = 0;
+  // Set where the walk has a simple outer loop but what it retraces besides is no set of trees
+  // hanging from it (a retraced stretch that passes another loop point: a merged 1-cell that
+  // runs round a loop of its own through its saddle, outside this cell). Such a walk can still
+  // be parameterized if all of that lies outside the loop and is left out (dropOutsideSlits).
+  bool loopWithoutTrees = false;
+  auto analyzeWalk = [&](std::string& message) {
+    loopWithoutTrees = false;
+    if (!IdentifyEqualPoints(cell.XY, cell.Count, cell.Graph, message) ||
+      !FindOuterLoop(cell.Count, cell.Graph, message))
+    {
+      return false;
+    }
+    if (CollectBoundaryEdges(cell.Count, cell.Graph, message))
+    {
+      return true;
+    }
+    loopWithoutTrees = true;
+    return false;
+  };
   auto analyze = [&]() {
-    if (AnalyzeBoundary(cell.XY, cell.Count, cell.Graph, error))
+    if (analyzeWalk(error))
     {
       return true;
     }
@@ -1349,7 +1368,7 @@ bool TwoCellParameterization::Parameterize(
       }
       cell = alike;
       resampled = true;
-      if (AnalyzeBoundary(cell.XY, cell.Count, cell.Graph, ignored))
+      if (analyzeWalk(ignored))
       {
         error.clear();
         return true;
@@ -1357,7 +1376,7 @@ bool TwoCellParameterization::Parameterize(
     }
     if (cell.Graph.Pinched.empty())
     {
-      return false;
+      return loopWithoutTrees;
     }
     opened.assign(cell.XY, cell.XY + 2 * cell.Count);
     if (!OpenPinches(cell.Graph, cell.Count, DoubleSignedArea(opened) >= 0 ? 1 : -1, opened))
@@ -1380,7 +1399,7 @@ bool TwoCellParameterization::Parameterize(
     outsideSlits = DropSlitsOutsideTheLoop(cell, withoutPoints, withoutParameters);
     if (outsideSlits == 0)
     {
-      return true;
+      return !loopWithoutTrees; // the error of the first analysis stands
     }
     CellBoundary without;
     if (!ReadBoundaryWalk(withoutPoints, withoutParameters, without, error) ||
@@ -1389,6 +1408,7 @@ bool TwoCellParameterization::Parameterize(
       return false;
     }
     cell = without;
+    error.clear();
     return true;
   };
   if (!ReadBoundaryWalk(boundaryPoints, boundaryParameters, cell, error) || !analyze() ||

@@ -1575,6 +1575,77 @@ TEST_CASE(SlitRefusals)
   CHECK(Fails(needle.Points, needle.Parameters, "only a slit (no area)"));
 }
 
+// A merged 1-cell that runs round a loop of its own through its saddle (uniform noise at 25-50 %,
+// stress seeds 13, 29 and 41) gives the 2-cell beside it a walk that retraces a stretch outside
+// its outer loop, and that stretch passes another point of the loop on its way out to its tip:
+// what the walk retraces is then no tree hanging from the loop at one point. Outside the loop it
+// bounds nothing of the cell and is left out; inside it, the same walk must still be refused.
+// The two traversals are sampled differently along one straight stretch (each side cut from its
+// own piece), as they were in the stress cases.
+TEST_CASE(RetracedStretchThroughAnotherLoopPoint)
+{
+  auto withExcursion = [](double radius) {
+    // Out from c_10 = (0, 1) at `radius`, round to the angle of c_12, onto c_12 itself, out to a
+    // tip at the angle of c_13 and straight back the same way; the way out has one more sample,
+    // halfway along its first (straight) edge.
+    const double tipRadius = radius > 1 ? 1.2 : 0.8;
+    const std::vector<std::pair<double, double>> away = { CirclePoint(10, 40, radius), CirclePoint(11, 40, radius),
+      CirclePoint(12, 40, radius), CirclePoint(12, 40), CirclePoint(13, 40, tipRadius) };
+    const std::pair<double, double> c10 = CirclePoint(10, 40);
+    Walk walk;
+    for (int k = 0; k < 40; ++k)
+    {
+      walk.Add(CirclePoint(k, 40));
+      if (k == 10)
+      {
+        walk.Add({ 0.5 * (c10.first + away[0].first), 0.5 * (c10.second + away[0].second) });
+        for (const auto& p : away)
+        {
+          walk.Add(p);
+        }
+        for (int j = static_cast<int>(away.size()) - 2; j >= 0; --j)
+        {
+          walk.Add(away[j]);
+        }
+        walk.Add(c10);
+      }
+    }
+    return MakeCell(walk.Points);
+  };
+  const Cell outside = withExcursion(1.3);
+  TwoCellParameterization tcp;
+  std::string error;
+  const bool parameterized = tcp.Parameterize(outside.Points, outside.Parameters, error);
+  CHECK(parameterized && error.empty());
+  const TwoCellMesh& mesh = tcp.GetMesh();
+  CHECK(mesh.OutsideSlits >= 1);
+  CHECK_EQ(static_cast<int>(mesh.BoundaryCount), 40); // the circle's samples, each once
+  for (Index i = 0; i < mesh.BoundaryCount; ++i)
+  {
+    CHECK(std::abs(std::hypot(mesh.Points[2 * i], mesh.Points[2 * i + 1]) - 1) <= 1e-12);
+  }
+  // One to one: every triangle turned alike in (u, v) (the oracle of SlitRefusals).
+  int positive = 0, negative = 0;
+  for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
+  {
+    const Index* v = &mesh.Triangles[3 * t];
+    const double* a = &mesh.Parameters[2 * v[0]];
+    const double* b = &mesh.Parameters[2 * v[1]];
+    const double* c = &mesh.Parameters[2 * v[2]];
+    const double area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    positive += area > 0 ? 1 : 0;
+    negative += area < 0 ? 1 : 0;
+  }
+  CHECK(mesh.NumberOfTriangles() > 0 && (positive == 0 || negative == 0));
+  double uv[2];
+  const std::pair<double, double> onExcursion = CirclePoint(11, 40, 1.3);
+  CHECK(tcp.Evaluate(0, 0.5, uv) && !tcp.Evaluate(onExcursion.first, onExcursion.second, uv));
+  std::printf("  retraced stretch through another loop point, outside: %s (%d left out, %d boundary samples)\n",
+    parameterized ? "parameterized" : error.c_str(), mesh.OutsideSlits, static_cast<int>(mesh.BoundaryCount));
+  const Cell inside = withExcursion(0.7);
+  CHECK(Fails(inside.Points, inside.Parameters, "retraced stretch through another loop point, inside"));
+}
+
 TEST_CASE(ThinPouches)
 {
   // Slits nearly touching the outer loop: a radial slit whose tip comes within `gap` of the

@@ -104,6 +104,10 @@ REQUIRED = [
     dict(kind="noise", nx=16, ny=16, percent=2.0, k=13, seed=136824485),
     # A boundary junction whose descent along the curve stopped beside a wanted minimum (seed 41).
     dict(kind="noise", nx=64, ny=64, percent=10.0, k=27, seed=1073766175),
+    # A 2-cell beside a merged 1-cell that runs round a loop through its own saddle: the walk
+    # retraced a stretch outside its loop that passed another loop point (seed 29; its verdict
+    # is still 0: two boundary saddles a few vertices off their nodes).
+    dict(kind="noise", nx=64, ny=64, percent=50.0, k=12, seed=1343509327, only="cells"),
 ]
 
 
