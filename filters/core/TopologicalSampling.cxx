@@ -1308,10 +1308,12 @@ namespace
 // the domain there: stage 1 then sees the junction's minimum and saddle on one vertex, and not
 // a boundary pit with its saddle a few vertices away. Where every interior neighbour is above
 // that vertex, the lowest one is brought just below it, by a step clear of rounding (the
-// inward 1-cell goes on down from there). Returns the sampling vertices chosen, one per
-// junction.
+// inward 1-cell goes on down from there). `curve`: the boundary curve's adjacency (a boundary
+// vertex can have other boundary vertices in its link across the domain: the corner triangle's
+// diagonal of a grid, a hull chord of a triangle mesh). Returns the sampling vertices chosen,
+// one per junction.
 std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, const PlanarScalarField& sampling,
-  const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, double reach,
+  const TriangleMeshTopology& mesh, const Graph& curve, const std::function<Index(Index)>& vertexAt, double reach,
   bool pitsOnJunctionVertices, std::vector<double>& values)
 {
   std::vector<Index> placed;
@@ -1327,13 +1329,17 @@ std::vector<Index> PlaceBoundaryJunctions(const MorseSmaleComplex& complex, cons
   {
     taken.insert(vertexAt(cp.Vertex));
   }
-  // The lowest boundary neighbour of u that `eligible` accepts, in the order (value, id);
-  // InvalidIndex if none.
+  // The lowest neighbour of u along the boundary curve that `eligible` accepts, in the order
+  // (value, id); InvalidIndex if none. (Taking any boundary vertex of u's link, a junction
+  // beside a grid's one-triangle corner descended across the corner's diagonal onto the other
+  // side: its own vertex, left a pit of the curve below the corner's maximum, was filled past
+  // that maximum, and both went missing; stress seed 53 #13.)
   const auto lowestBoundaryNeighbour = [&](Index u, const auto& eligible) {
     Index low = InvalidIndex;
-    for (Index w : VertexLink(mesh, u))
+    for (Index i = curve.Start[u]; i < curve.Start[u + 1]; ++i)
     {
-      if (mesh.IsBoundaryVertex(w) && eligible(w) && (low == InvalidIndex || Key{ values[w], w } < Key{ values[low], low }))
+      const Index w = curve.Adjacent[i];
+      if (eligible(w) && (low == InvalidIndex || Key{ values[w], w } < Key{ values[low], low }))
       {
         low = w;
       }
@@ -1706,7 +1712,8 @@ TopologicalSamplingReport TopologicalSampling::Settle(const VertexGraphs& graphs
   const std::size_t saddlesBefore = constraints.Saddles.size();
   const double junctionReach = BoundaryJunctionReach * this->Spacing;
   for (Index v :
-    PlaceBoundaryJunctions(this->Complex, sampling, mesh, vertexAt, junctionReach, this->PitsOnJunctionVertices, values))
+    PlaceBoundaryJunctions(this->Complex, sampling, mesh, graphs.Boundary, vertexAt, junctionReach,
+      this->PitsOnJunctionVertices, values))
   {
     constraints.BoundaryMinima.push_back(v);
     constraints.Saddles.push_back(v);
