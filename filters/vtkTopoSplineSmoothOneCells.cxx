@@ -15,6 +15,7 @@
 #include <vtkDataSet.h>
 #include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
+#include <vtkImageData.h>
 #include <vtkInformation.h>
 #include <vtkInformationVector.h>
 #include <vtkIntArray.h>
@@ -135,6 +136,12 @@ int vtkTopoSplineSmoothOneCells::RequestData(
       frame.ToWorld(xy);
       return at->ValueAt(xy[0], xy[1], value);
     };
+  }
+  // A mesh's corners need not be those of its bounds (a jittered grid): the boundary vertices
+  // nearest them are taken instead. An image keeps the corners of its bounds.
+  if (between && !vtkImageData::SafeDownCast(domain))
+  {
+    smoothing.BoundaryPoints = topospline::OneCellSmoothing::BoundaryPointsOf(field);
   }
   smoothing.Parallel = vtkTopoSplineDomainConversion::SMPParallelFor();
   smoothing.Hooks.Progress = [this](double f) { this->UpdateProgress(0.9 * f); };

@@ -2,6 +2,7 @@
 
 #include "JunctionValueProgram.h"
 #include "PlanarGeometry.h"
+#include "TriangleMeshTopology.h"
 
 #include <algorithm>
 #include <cmath>
@@ -387,14 +388,35 @@ std::vector<std::vector<Cut>> CutsAtJunctions(const std::vector<const OneCell*>&
 }
 
 // The corners of the domain as nodes, made when a 1-cell first passes one, so that the
-// boundary keeps its corners.
+// boundary keeps its corners: the corners of the bounds, or, given the boundary's points, the
+// point nearest each of them (OneCellSmoothing::BoundaryPoints).
 class DomainCornerNodes
 {
 public:
-  explicit DomainCornerNodes(const double domainBounds[4])
+  DomainCornerNodes(const double domainBounds[4], const std::vector<double>& boundaryPoints)
     : Corners{ { domainBounds[0], domainBounds[2] }, { domainBounds[1], domainBounds[2] },
       { domainBounds[1], domainBounds[3] }, { domainBounds[0], domainBounds[3] } }
   {
+    if (boundaryPoints.size() < 2)
+    {
+      return;
+    }
+    for (auto& corner : this->Corners)
+    {
+      std::size_t nearest = 0;
+      double best = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i + 1 < boundaryPoints.size(); i += 2)
+      {
+        const double d = std::hypot(boundaryPoints[i] - corner[0], boundaryPoints[i + 1] - corner[1]);
+        if (d < best)
+        {
+          best = d;
+          nearest = i;
+        }
+      }
+      corner[0] = boundaryPoints[nearest];
+      corner[1] = boundaryPoints[nearest + 1];
+    }
   }
 
   // Cuts `oneCell` at the corners it passes (not at its ends).
@@ -655,11 +677,11 @@ void KeepShortcutsClear(const std::vector<Shortcut>& shortcuts, OneCellSmoothing
 // once. A 1-cell keeps only the cuts that rise in one order of all nodes (RankNodes), which
 // drops cuts on cycles only. Node positions become the ends of the pieces that meet there.
 void CutIntoPieces(const std::vector<const OneCell*>& oneCells, const std::vector<JunctionPoint>& junctions,
-  const std::vector<Index>& junctionNode, const double domainBounds[4], std::vector<SmoothingNode>& nodes,
-  OneCellSmoothingResult& result)
+  const std::vector<Index>& junctionNode, const double domainBounds[4], const std::vector<double>& boundaryPoints,
+  std::vector<SmoothingNode>& nodes, OneCellSmoothingResult& result)
 {
   std::vector<std::vector<Cut>> cuts = CutsAtJunctions(oneCells, junctions, junctionNode);
-  DomainCornerNodes corners(domainBounds);
+  DomainCornerNodes corners(domainBounds, boundaryPoints);
   for (Index a = 0; a < static_cast<Index>(oneCells.size()); ++a)
   {
     corners.AddCuts(*oneCells[a], nodes, cuts[a]);
@@ -1880,7 +1902,7 @@ bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<Smoothin
 //------------------------------------------------------------------------------
 bool OneCellSmoothing::CutAndSolveJunctionValues(const MorseSmaleComplex& complex,
   const std::vector<JunctionPoint>& junctions, const std::vector<Index>& junctionNode, const double domainBounds[4],
-  OneCellSmoothingResult& result, std::string& error) const
+  const std::vector<double>& boundaryPoints, OneCellSmoothingResult& result, std::string& error) const
 {
   // Every 1-cell is cut at every node it passes, except where the cuts would order nodes in a
   // cycle (see RankNodes).
@@ -1906,7 +1928,7 @@ bool OneCellSmoothing::CutAndSolveJunctionValues(const MorseSmaleComplex& comple
       oneCells[a] = trimmed[a].get();
     }
   }
-  CutIntoPieces(oneCells, junctions, junctionNode, domainBounds, result.Nodes, result);
+  CutIntoPieces(oneCells, junctions, junctionNode, domainBounds, boundaryPoints, result.Nodes, result);
   this->Hooks.Report(0.1);
   JunctionValueProgram program;
   if (!SolveJunctionValues(result.Nodes, result, program, error))
@@ -2094,13 +2116,34 @@ bool OneCellSmoothing::RepairCrossings(
 }
 
 //------------------------------------------------------------------------------
+std::vector<double> OneCellSmoothing::BoundaryPointsOf(const PlanarScalarField& mesh)
+{
+  TriangleMeshTopology topology;
+  std::string error;
+  std::vector<double> points;
+  const Index n = static_cast<Index>(mesh.Points.size() / 2);
+  if (!topology.Build(n, mesh.Triangles, SequentialFor, error))
+  {
+    return points;
+  }
+  for (Index v = 0; v < n; ++v)
+  {
+    if (topology.IsBoundaryVertex(v))
+    {
+      points.insert(points.end(), { mesh.Points[2 * v], mesh.Points[2 * v + 1] });
+    }
+  }
+  return points;
+}
+
+//------------------------------------------------------------------------------
 bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
   const double domainBounds[4], OneCellSmoothingResult& result, std::string& error) const
 {
   const PlanarFrame& frame = complex.Frame;
   if (frame.IsIdentity())
   {
-    return this->SmoothInFrame(complex, junctions, domainBounds, result, error);
+    return this->SmoothInFrame(complex, junctions, domainBounds, this->BoundaryPoints, result, error);
   }
   // The fits, crossings and clamping in the complex's frame (see PlanarFrame); the per-vertex
   // arrays are not needed here.
@@ -2117,7 +2160,9 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
   }
   double bounds[4] = { domainBounds[0], domainBounds[1], domainBounds[2], domainBounds[3] };
   frame.BoundsToFrame(bounds);
-  if (!this->SmoothInFrame(framed, framedJunctions, bounds, result, error))
+  std::vector<double> boundaryPoints = this->BoundaryPoints;
+  frame.ToFrame(boundaryPoints);
+  if (!this->SmoothInFrame(framed, framedJunctions, bounds, boundaryPoints, result, error))
   {
     return false;
   }
@@ -2126,7 +2171,8 @@ bool OneCellSmoothing::Smooth(const MorseSmaleComplex& complex, const std::vecto
 }
 
 bool OneCellSmoothing::SmoothInFrame(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
-  const double domainBounds[4], OneCellSmoothingResult& result, std::string& error) const
+  const double domainBounds[4], const std::vector<double>& boundaryPoints, OneCellSmoothingResult& result,
+  std::string& error) const
 {
   result = OneCellSmoothingResult();
   if (this->Segments < 2 || this->Segments > MaximumCurveSegments)
@@ -2148,7 +2194,7 @@ bool OneCellSmoothing::SmoothInFrame(const MorseSmaleComplex& complex, const std
   const std::vector<Index> junctionNode = AddJunctionNodes(junctions, result.Nodes);
 
   // Paper, section 4, step 1: the pieces between nodes and the junction values.
-  if (!this->CutAndSolveJunctionValues(complex, junctions, junctionNode, domainBounds, result, error))
+  if (!this->CutAndSolveJunctionValues(complex, junctions, junctionNode, domainBounds, boundaryPoints, result, error))
   {
     return false;
   }

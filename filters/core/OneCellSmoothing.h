@@ -106,9 +106,19 @@ public:
   // arc length (see FitPiece).
   double RiseCurveTolerance = 0.25;
 
+  // x, y (the complex's coordinates) of the domain's boundary vertices, for a mesh whose
+  // corners need not be the corners of domainBounds (a jittered grid: a 1-cell's curve along
+  // the boundary cut its corner vertex off, and that vertex was in no 2-cell): the boundary
+  // vertex nearest each corner of the bounds (in the complex's frame) is then the domain's
+  // corner. Empty (an image; the filter leaves it so): the corners of domainBounds.
+  std::vector<double> BoundaryPoints;
+  // The points of a triangle mesh's boundary vertices, for BoundaryPoints (empty if the mesh is
+  // not one the complex can be built on).
+  static std::vector<double> BoundaryPointsOf(const PlanarScalarField& mesh);
+
   // domainBounds: xmin, xmax, ymin, ymax of the domain (its corners become nodes when 1-cells
-  // run through them, so that the boundary keeps its corners). Works in complex.Frame; the
-  // result is in the complex's coordinates. Returns false with a message.
+  // run through them, so that the boundary keeps its corners; see BoundaryPoints). Works in
+  // complex.Frame; the result is in the complex's coordinates. Returns false with a message.
   bool Smooth(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
     const double domainBounds[4], OneCellSmoothingResult& result, std::string& error) const;
 
@@ -132,13 +142,15 @@ public:
 
 private:
   // Smooth in the coordinates given (Smooth maps the complex into its frame and back).
+  // (boundaryPoints: BoundaryPoints in those coordinates.)
   bool SmoothInFrame(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
-    const double domainBounds[4], OneCellSmoothingResult& result, std::string& error) const;
+    const double domainBounds[4], const std::vector<double>& boundaryPoints, OneCellSmoothingResult& result,
+    std::string& error) const;
   // Paper, section 4, step 1: cuts the 1-cells into pieces at their nodes and solves the
   // junction values; a 1-cell on a cycle of the relations is not cut where it runs down.
   bool CutAndSolveJunctionValues(const MorseSmaleComplex& complex, const std::vector<JunctionPoint>& junctions,
-    const std::vector<Index>& junctionNode, const double domainBounds[4], OneCellSmoothingResult& result,
-    std::string& error) const;
+    const std::vector<Index>& junctionNode, const double domainBounds[4], const std::vector<double>& boundaryPoints,
+    OneCellSmoothingResult& result, std::string& error) const;
   // Steps 2 and 3 on every piece with k = Segments (fewer on pieces of fewer edges).
   bool FitAllPieces(OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const;
   // Raises k on crossing pieces and fits them again (sets AdaptedPieces, RiseKnotPieces, RemainingCrossings).

@@ -1375,6 +1375,95 @@ TEST_CASE(AJunctionBesideAOneTriangleCornerKeepsItsSaddle)
   CHECK_EQ(unequal, 0);
 }
 
+// A triangle mesh whose corner vertices are not the corners of its bounds (a grid with jittered
+// points, as the stress test makes them): the curve of a 1-cell that runs along the boundary
+// round such a corner was fitted through it without a node there and cut the corner off, and the
+// corner vertex lay in no 2-cell (stress seed 53 #261 and #264). Stage 3 now takes the boundary
+// vertex nearest each corner of the bounds as the domain's corner. Jittered grids at 25 and
+// 50 %, k = 2 and 5 (long pieces, the worst cut), eight seeds. The oracles, written here: each
+// of the grid's four corner vertices is the end of a smoothed piece (the boundary is made of
+// 1-cells, so one passes every corner), and every vertex lies in a reconstructed 2-cell. Without
+// the mesh's corners (meshCorners false, the version before) 112 of the 128 corners had no node
+// and 32 vertices over the 32 grids were in no 2-cell.
+TEST_CASE(AJitteredGridKeepsItsCornerVertices)
+{
+  int cases = 0, cornersOff = 0, uncovered = 0, cornersOffWithout = 0, uncoveredWithout = 0;
+  for (std::uint64_t seed = 1; seed <= 8; ++seed)
+  {
+    for (const double percent : { 25.0, 50.0 })
+    {
+      for (const int k : { 2, 5 })
+      {
+        const int nx = 24 + static_cast<int>(seed % 3) * 7, ny = 30 + static_cast<int>(seed % 4) * 9;
+        DeterministicRandom random(seed);
+        PlanarScalarField field;
+        for (int j = 0; j < ny; ++j)
+        {
+          for (int i = 0; i < nx; ++i)
+          {
+            field.Points.push_back(i + random.Uniform(-0.2, 0.2));
+            field.Points.push_back(j + random.Uniform(-0.2, 0.2));
+            field.Values.push_back(std::sin(i / 5.0) * std::cos(j / 7.0) + 0.3 * random.Uniform(0, 1));
+          }
+        }
+        field.Triangles = GridTriangles(nx, ny);
+        const Index corners[4] = { 0, nx - 1, nx * (ny - 1), nx * ny - 1 };
+        for (const bool meshCorners : { false, true })
+        {
+          Pipeline p;
+          std::string error;
+          if (!RunStages1To3(field, percent, k, p, error, false, meshCorners))
+          {
+            CHECK(false);
+            std::printf("  seed %d at %g %%, k = %d: %s\n", static_cast<int>(seed), percent, k, error.c_str());
+            continue;
+          }
+          int off = 0;
+          for (const Index c : corners)
+          {
+            const double x = field.Points[2 * c], y = field.Points[2 * c + 1];
+            bool end = false;
+            for (const SmoothedPiece& piece : p.Smoothed.Pieces)
+            {
+              const std::vector<double>& b = piece.Curve.ControlPoints;
+              const std::size_t last = b.size() - 2;
+              end = end || (b[0] == x && b[1] == y) || (b[last] == x && b[last + 1] == y);
+            }
+            off += end ? 0 : 1;
+          }
+          FieldReconstruction reconstruction;
+          reconstruction.VerifyTopology = false;
+          FieldReconstructionReport report;
+          CHECK(reconstruction.Run(p.Field, p.Simplified.Complex, p.Smoothed, report, error));
+          const int outside = static_cast<int>(
+            std::count(report.CellOfVertex.begin(), report.CellOfVertex.end(), InvalidIndex));
+          if (!meshCorners)
+          {
+            cornersOffWithout += off;
+            uncoveredWithout += outside;
+            continue;
+          }
+          ++cases;
+          cornersOff += off;
+          uncovered += outside;
+          if (off > 0 || outside > 0)
+          {
+            std::printf("  seed %d at %g %%, k = %d: %d corners without a node, %d vertices in no 2-cell\n",
+              static_cast<int>(seed), percent, k, off, outside);
+          }
+        }
+      }
+    }
+  }
+  std::printf("  %d jittered grids: %d corner vertices without a piece ending there, %d vertices in no 2-cell "
+              "(without the mesh's corners: %d and %d)\n", cases, cornersOff, uncovered, cornersOffWithout,
+    uncoveredWithout);
+  CHECK(cases > 0);
+  CHECK_EQ(cornersOff, 0);
+  CHECK_EQ(uncovered, 0);
+  CHECK(uncoveredWithout > 0); // the case exercises what it tests
+}
+
 int main()
 {
   return testing_harness::RunAll();

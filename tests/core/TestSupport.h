@@ -138,8 +138,10 @@ struct Pipeline
 // Stages 1-3 on any planar field (a grid's or a triangle mesh's): the domain's bounds are
 // the points' bounding box. `nearConstantAsConstant`: stage 1 as the filter runs it
 // (MorseSmaleComplexExtraction::NearConstantAsConstant).
+// `meshCorners`: on a triangle mesh, the boundary vertices nearest the bounds' corners are the
+// domain's corners, as the filter takes them (OneCellSmoothing::BoundaryPoints).
 inline bool RunStages1To3(const PlanarScalarField& field, double percent, int k, Pipeline& p, std::string& error,
-  bool nearConstantAsConstant = false)
+  bool nearConstantAsConstant = false, bool meshCorners = false)
 {
   p.Field = field;
   MorseSmaleComplexExtraction extraction;
@@ -166,6 +168,10 @@ inline bool RunStages1To3(const PlanarScalarField& field, double percent, int k,
   }
   OneCellSmoothing smoothing;
   smoothing.Segments = k;
+  if (meshCorners && !field.IsGrid())
+  {
+    smoothing.BoundaryPoints = OneCellSmoothing::BoundaryPointsOf(field);
+  }
   return smoothing.Smooth(p.Simplified.Complex, p.Simplified.JunctionPoints, p.Bounds, p.Smoothed, error);
 }
 

@@ -111,6 +111,9 @@ REQUIRED = [
     # A junction beside a one-triangle corner whose pit was placed across the corner's diagonal:
     # the junction's pair and the corner's maximum and saddle went missing (seed 53).
     dict(kind="noise", nx=24, ny=24, percent=25.0, k=3, seed=802912928),
+    # A jittered grid whose corner vertex a boundary 1-cell's curve cut off: the vertex was in no
+    # 2-cell (seed 53).
+    dict(kind="mesh_grid", nx=91, ny=88, percent=50.0, k=2, seed=513933502),
 ]
 
 
