@@ -1444,6 +1444,18 @@ TEST_CASE(PinchedCellIsOpenedAtItsPinch)
     tcp.GetMesh().MinimumParameterArea);
 }
 
+namespace
+{
+// The signed area of triangle `v` with the given (x, y) or (u, v) pairs per vertex.
+double SignedArea(const std::vector<double>& xy, const Index* v)
+{
+  const double* a = &xy[2 * v[0]];
+  const double* b = &xy[2 * v[1]];
+  const double* c = &xy[2 * v[2]];
+  return 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
+}
+} // namespace
+
 TEST_CASE(SlitRefusals)
 {
   // A walk around the 40-sample circle with an excursion from s = c_10 = (0, 1) through the
@@ -1516,15 +1528,8 @@ TEST_CASE(SlitRefusals)
     int flipped = 0, firstTurn = 0;
     for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
     {
-      const Index* v = &mesh.Triangles[3 * t];
-      const double* a = &mesh.Parameters[2 * v[0]];
-      const double* b = &mesh.Parameters[2 * v[1]];
-      const double* c = &mesh.Parameters[2 * v[2]];
-      const double area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
-      const double* p = &mesh.Points[2 * v[0]];
-      const double* q = &mesh.Points[2 * v[1]];
-      const double* r = &mesh.Points[2 * v[2]];
-      const double xyArea = 0.5 * ((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]));
+      const double area = SignedArea(mesh.Parameters, &mesh.Triangles[3 * t]);
+      const double xyArea = SignedArea(mesh.Points, &mesh.Triangles[3 * t]);
       // The same turn in (x, y) and in (u, v) for every triangle, or the opposite for every one.
       const int turn = (area > 0) == (xyArea > 0) ? 1 : -1;
       firstTurn = firstTurn == 0 ? turn : firstTurn;
@@ -1628,11 +1633,7 @@ TEST_CASE(RetracedStretchThroughAnotherLoopPoint)
   int positive = 0, negative = 0;
   for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
   {
-    const Index* v = &mesh.Triangles[3 * t];
-    const double* a = &mesh.Parameters[2 * v[0]];
-    const double* b = &mesh.Parameters[2 * v[1]];
-    const double* c = &mesh.Parameters[2 * v[2]];
-    const double area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    const double area = SignedArea(mesh.Parameters, &mesh.Triangles[3 * t]);
     positive += area > 0 ? 1 : 0;
     negative += area < 0 ? 1 : 0;
   }
