@@ -925,9 +925,13 @@ void TwoCellReconstruction::ParameterizeCell(const TwoCell& twoCell, const OneCe
           this->BoundarySamples, this->MaximumGridSize, walk, parameters, boundary) &&
       !BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed, true, 0, &samplesPerPiece),
         this->BoundarySamples, this->MaximumGridSize, walk, parameters, boundary) &&
-      !this->BuildBoundaryWalkCutOffMiddle(cell.Sides, smoothed, samplesPerPiece, walk, parameters, boundary))
+      !this->BuildBoundaryWalkCutOffMiddle(cell.Sides, smoothed, samplesPerPiece, walk, parameters, boundary) &&
+      !(this->LargestGridSize > this->MaximumGridSize &&
+        BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed, false, 0, &samplesPerPiece),
+          this->BoundarySamples, this->LargestGridSize, walk, parameters, boundary)))
     {
-      message = "its sides need more than " + std::to_string(this->MaximumGridSize) + " segments each (pieces";
+      message = "its sides need more than " +
+        std::to_string(std::max(this->MaximumGridSize, this->LargestGridSize)) + " segments each (pieces";
       for (const SideSegments& side : TwoCellSideSegments(cell.Sides, smoothed))
       {
         std::string counts;

@@ -162,9 +162,14 @@ public:
   // and up to MostDensifiedSamples per segment (never below BoundarySamples).
   int BoundaryDensifications = 3;
   static constexpr int MostDensifiedSamples = 64;
-  // Cells whose sides need more grid segments than this (ChooseGridLayout) are not
-  // reconstructed.
+  // The grid of a cell's sides (ChooseGridLayout) is looked for up to this many segments, with
+  // the split sides cut at their middle or off it; where none fits, the cell's own segment
+  // boundaries are taken with a grid up to LargestGridSize, at that cell's cost (stage 3 raises
+  // the pieces of a 1-cell that still crosses to hundreds of segments: four cells of seed 53
+  // #79, 128² noise at 50 % with k = 2, need 544: about 1.5 s and 16 MB each). Cells beyond are
+  // not reconstructed; the surfaces' memory estimate still refuses what would not fit.
   int MaximumGridSize = 512;
+  int LargestGridSize = 1024;
   // A point outside every cell by at most this distance (the smoothed boundary differs from
   // the jagged one) takes the value of the nearest boundary point. <= 0: 1e-3 of the domain.
   double SnapDistance = 0;

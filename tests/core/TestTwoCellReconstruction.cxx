@@ -433,6 +433,57 @@ TEST_CASE(SplitSidesAreCutWhereAGridLayoutFits)
   CHECK(far[TwoCellSides::Bottom].Pieces == std::vector<int>({ 1 }));
 }
 
+// Where no grid layout within MaximumGridSize exists, with the split sides cut at their middle
+// or off it, the cell's own segment boundaries are taken with a grid up to LargestGridSize
+// instead of leaving the cell unreconstructed (stress seed 53 #79: four cells of 128² noise at
+// 50 %, k = 2, whose sides needed 544). Here the first limit is made tiny (4) so that most cells
+// of 24² noise fall back: the oracle is the same reconstruction with the limit at 1024 from the
+// start, whose first try is the fallback's walk: every cell valid in one is valid in the other,
+// and every cell that fell back has the reference's grid and surface (a cell whose split sides
+// fit 4 when cut at their exact middle keeps that cut); without the fallback (LargestGridSize 0)
+// cells fail.
+TEST_CASE(CellsBeyondTheGridLimitFallBackToALargerOne)
+{
+  int cells = 0, fellBack = 0, failedWithout = 0;
+  for (std::uint64_t seed : { 1, 2, 3 })
+  {
+    Pipeline p;
+    std::string error;
+    CHECK(RunStages1To3(UniformNoise(24, seed), 25, 4, p, error));
+    auto run = [&](int maximum, int largest, TwoCellReconstruction& r) {
+      r.MaximumGridSize = maximum;
+      r.LargestGridSize = largest;
+      CHECK(r.Reconstruct(p.Simplified.Complex, p.Smoothed, error));
+    };
+    TwoCellReconstruction tiny, fallback, reference;
+    run(4, 0, tiny);
+    run(4, 1024, fallback);
+    run(1024, 0, reference);
+    failedWithout += static_cast<int>(tiny.Report().FailedCells);
+    CHECK_EQ(fallback.Report().FailedCells, reference.Report().FailedCells);
+    for (Index c = 0; c < reference.NumberOfCells(); ++c)
+    {
+      const ReconstructedTwoCell& a = fallback.Cell(c);
+      const ReconstructedTwoCell& b = reference.Cell(c);
+      CHECK_EQ(a.Valid, b.Valid);
+      if (!a.Valid || !b.Valid)
+      {
+        continue;
+      }
+      ++cells;
+      if (a.GridSize > 4) // fell back: the reference's first try, the same walk and grid
+      {
+        ++fellBack;
+        CHECK_EQ(a.GridSize, b.GridSize);
+        CHECK(a.Surface.Evaluate(0.3, 0.6) == b.Surface.Evaluate(0.3, 0.6));
+      }
+    }
+  }
+  std::printf("  %d cells: %d on grids beyond the first limit of 4 (the same as with 1024 at once); %d cells fail "
+              "without the fallback\n", cells, fellBack, failedWithout);
+  CHECK(fellBack > 0 && failedWithout > 0);
+}
+
 TEST_CASE(DegenerateInputsNeverCrash)
 {
   // Tiny grids, a ramp (one cell), noise with many tiny and pouch cells, a plateau.
