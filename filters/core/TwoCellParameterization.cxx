@@ -367,11 +367,29 @@ bool CollectBoundaryEdges(std::size_t n, BoundaryGraph& graph, std::string& erro
 }
 
 // Splits the walk into the outer loop and slits. A slit is retraced: ..., x, y, x, ... steps
-// out along edge xy and straight back. Geometry is checked later.
-bool AnalyzeBoundary(const double* xy, std::size_t n, BoundaryGraph& graph, std::string& error)
+// out along edge xy and straight back. Geometry is checked later. `loopWithoutTrees`, if
+// given, tells whether the walk failed only there: a simple outer loop (graph.Loop) whose
+// retraced rest is no set of trees hanging from it at one point each.
+bool AnalyzeBoundary(
+  const double* xy, std::size_t n, BoundaryGraph& graph, std::string& error, bool* loopWithoutTrees = nullptr)
 {
-  return IdentifyEqualPoints(xy, n, graph, error) && FindOuterLoop(n, graph, error) &&
-    CollectBoundaryEdges(n, graph, error);
+  if (loopWithoutTrees)
+  {
+    *loopWithoutTrees = false;
+  }
+  if (!IdentifyEqualPoints(xy, n, graph, error) || !FindOuterLoop(n, graph, error))
+  {
+    return false;
+  }
+  if (CollectBoundaryEdges(n, graph, error))
+  {
+    return true;
+  }
+  if (loopWithoutTrees)
+  {
+    *loopWithoutTrees = true;
+  }
+  return false;
 }
 
 // Cuts the mesh open along the slits: gives every corner of a domain face at a boundary vertex
@@ -1340,18 +1358,7 @@ bool TwoCellParameterization::Parameterize(
   // be parameterized if all of that lies outside the loop and is left out (dropOutsideSlits).
   bool loopWithoutTrees = false;
   auto analyzeWalk = [&](std::string& message) {
-    loopWithoutTrees = false;
-    if (!IdentifyEqualPoints(cell.XY, cell.Count, cell.Graph, message) ||
-      !FindOuterLoop(cell.Count, cell.Graph, message))
-    {
-      return false;
-    }
-    if (CollectBoundaryEdges(cell.Count, cell.Graph, message))
-    {
-      return true;
-    }
-    loopWithoutTrees = true;
-    return false;
+    return AnalyzeBoundary(cell.XY, cell.Count, cell.Graph, message, &loopWithoutTrees);
   };
   auto analyze = [&]() {
     if (analyzeWalk(error))

@@ -921,14 +921,16 @@ void TwoCellReconstruction::ParameterizeCell(const TwoCell& twoCell, const OneCe
     // Halves cut at a segment boundary keep the samples of the neighbouring cell that shares
     // the split 1-cell; when their counts (k and k + 1) make the grid too fine, they are cut at
     // the exact middle instead, and the two cells' boundaries differ by slivers between samples.
-    if (!BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed, false, 0, &samplesPerPiece),
-          this->BoundarySamples, this->MaximumGridSize, walk, parameters, boundary) &&
+    const std::array<SideSegments, 4> atSegmentBoundaries =
+      TwoCellSideSegments(cell.Sides, smoothed, false, 0, &samplesPerPiece);
+    if (!BuildBoundaryWalk(atSegmentBoundaries, this->BoundarySamples, this->MaximumGridSize, walk, parameters,
+          boundary) &&
       !BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed, true, 0, &samplesPerPiece),
         this->BoundarySamples, this->MaximumGridSize, walk, parameters, boundary) &&
       !this->BuildBoundaryWalkCutOffMiddle(cell.Sides, smoothed, samplesPerPiece, walk, parameters, boundary) &&
       !(this->LargestGridSize > this->MaximumGridSize &&
-        BuildBoundaryWalk(TwoCellSideSegments(cell.Sides, smoothed, false, 0, &samplesPerPiece),
-          this->BoundarySamples, this->LargestGridSize, walk, parameters, boundary)))
+        BuildBoundaryWalk(
+          atSegmentBoundaries, this->BoundarySamples, this->LargestGridSize, walk, parameters, boundary)))
     {
       message = "its sides need more than " +
         std::to_string(std::max(this->MaximumGridSize, this->LargestGridSize)) + " segments each (pieces";

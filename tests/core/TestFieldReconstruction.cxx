@@ -927,6 +927,21 @@ std::vector<std::vector<Index>> NeighboursOnMesh(const PlanarScalarField& field)
   return neighbours;
 }
 
+// Per vertex v, its link as successor pairs (u -> w for every triangle (v, u, w) in the
+// triangle's own vertex order): a cycle round an interior vertex, a path round a boundary one.
+std::vector<std::map<Index, Index>> LinkSuccessors(const PlanarScalarField& field, std::size_t n)
+{
+  std::vector<std::map<Index, Index>> successor(n);
+  for (std::size_t t = 0; t + 2 < field.Triangles.size(); t += 3)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      successor[field.Triangles[t + k]][field.Triangles[t + (k + 1) % 3]] = field.Triangles[t + (k + 2) % 3];
+    }
+  }
+  return successor;
+}
+
 // The saddles of a sampling on a triangle mesh by the complex's closed-boundary rule
 // (docs/MorseSmaleComplex.md; the stress test counts the same way): an interior vertex is a
 // saddle of multiplicity (lower-link pieces round its link cycle) - 1; a boundary vertex, whose
@@ -938,14 +953,7 @@ std::vector<Index> SaddlesByTheBoundaryRule(
   const PlanarScalarField& field, const std::vector<double>& values, bool withBoundary = true)
 {
   const std::size_t n = values.size();
-  std::vector<std::map<Index, Index>> successor(n);
-  for (std::size_t t = 0; t + 2 < field.Triangles.size(); t += 3)
-  {
-    for (int k = 0; k < 3; ++k)
-    {
-      successor[field.Triangles[t + k]][field.Triangles[t + (k + 1) % 3]] = field.Triangles[t + (k + 2) % 3];
-    }
-  }
+  const std::vector<std::map<Index, Index>> successor = LinkSuccessors(field, n);
   std::vector<Index> saddles;
   for (std::size_t v = 0; v < n; ++v)
   {
@@ -1023,14 +1031,7 @@ std::vector<Index> SaddlesByTheBoundaryRule(
 std::array<int, 3> CriticalCountsByTheBoundaryRule(const PlanarScalarField& field, const std::vector<double>& values)
 {
   const std::size_t n = values.size();
-  std::vector<std::map<Index, Index>> successor(n);
-  for (std::size_t t = 0; t + 2 < field.Triangles.size(); t += 3)
-  {
-    for (int k = 0; k < 3; ++k)
-    {
-      successor[field.Triangles[t + k]][field.Triangles[t + (k + 1) % 3]] = field.Triangles[t + (k + 2) % 3];
-    }
-  }
+  const std::vector<std::map<Index, Index>> successor = LinkSuccessors(field, n);
   std::array<int, 3> counts{ { 0, static_cast<int>(SaddlesByTheBoundaryRule(field, values).size()), 0 } };
   for (std::size_t v = 0; v < n; ++v)
   {
