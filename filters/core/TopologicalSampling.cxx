@@ -4,6 +4,8 @@
 
 #include "PlanarGeometry.h"
 
+#include <Eigen/Sparse>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -30,11 +32,16 @@ struct VertexGraphs
     std::vector<Index> Adjacent;
   };
   Graph All, Boundary;
+  // Whether vertex ids run along the rows of an image grid (PlanarScalarField::IsGrid): ties
+  // ordered by id then tilt a plateau like a plane, with no critical point inside it. On other
+  // meshes the ids can be in any order (LocalFlood::RevalueFromOutlet).
+  bool IdsAlongRows = false;
 
-  explicit VertexGraphs(const TriangleMeshTopology& mesh);
+  explicit VertexGraphs(const TriangleMeshTopology& mesh, bool idsAlongRows = false);
 };
 
-VertexGraphs::VertexGraphs(const TriangleMeshTopology& mesh)
+VertexGraphs::VertexGraphs(const TriangleMeshTopology& mesh, bool idsAlongRows)
+  : IdsAlongRows(idsAlongRows)
 {
   const Index n = mesh.NumberOfVertices();
   this->All.Start.assign(n + 1, 0);
@@ -131,6 +138,7 @@ struct SweepDirection
   const std::vector<unsigned char>& Wanted;
   unsigned char Flag;
   const TriangleMeshTopology* DrainsToBoundary;
+  bool IdsAlongRows; // VertexGraphs::IdsAlongRows
 
   bool Before(const Key& a, const Key& b) const { return this->Ascending ? a < b : b < a; }
   bool EndsRegion(Index u) const
@@ -223,6 +231,61 @@ private:
       u, { this->Values[u], u }, true, [this, seen](Index w) { return this->Visits.Mark[w] == seen; });
   }
 
+  // Re-values the region from its outlet. On an image grid, on the outlet's level with ties
+  // (RevalueWithTies): the ids run along its rows, so the region lies on a plane tilted along
+  // them; where that still leaves a region vertex with no neighbour before it or none after it,
+  // the region is spread harmonically instead (SpreadHarmonically), if that keeps every region
+  // vertex between its neighbours. On other meshes the ids can be in any order, and ties left
+  // there become the bounds of later fills and cuts with no room between them (stress seed 67
+  // #279: a pit filled and a peak cut to one vertex's value, a spurious pair between them that
+  // no round could move): there the harmonic spread comes first, ties only where it fails.
+  Index RevalueFromOutlet(Index outlet, const std::vector<Index>& region, std::vector<Index>* revalued)
+  {
+    if (!this->Sweep.IdsAlongRows)
+    {
+      const Index spread = this->SpreadHarmonically(outlet, region, revalued);
+      return spread >= 0 ? spread : this->RevalueWithTies(outlet, region, revalued);
+    }
+    std::vector<double> before(region.size());
+    std::transform(region.begin(), region.end(), before.begin(), [this](Index r) { return this->Values[r]; });
+    const std::size_t revaluedBefore = revalued ? revalued->size() : 0;
+    const Index tied = this->RevalueWithTies(outlet, region, revalued);
+    if (std::all_of(region.begin(), region.end(), [this](Index r) { return this->IsBetweenNeighbours(r); }))
+    {
+      return tied;
+    }
+    std::vector<double> withTies(region.size());
+    for (std::size_t i = 0; i < region.size(); ++i)
+    {
+      withTies[i] = this->Values[region[i]];
+      this->Values[region[i]] = before[i];
+    }
+    std::vector<Index> spreadRevalued;
+    const Index spread = this->SpreadHarmonically(outlet, region, &spreadRevalued);
+    if (spread >= 0)
+    {
+      if (revalued)
+      {
+        revalued->resize(revaluedBefore);
+        revalued->insert(revalued->end(), spreadRevalued.begin(), spreadRevalued.end());
+      }
+      return spread;
+    }
+    for (std::size_t i = 0; i < region.size(); ++i)
+    {
+      this->Values[region[i]] = withTies[i];
+    }
+    return tied;
+  }
+
+  // Whether v has a neighbour before it and one after it in the sweep's graph.
+  bool IsBetweenNeighbours(Index v) const
+  {
+    const Key key{ this->Values[v], v };
+    auto none = [](Index) { return false; };
+    return this->HasNeighbour(v, key, true, none) && this->HasNeighbour(v, key, false, none);
+  }
+
   // From the outlet inwards, each region vertex gets the first key after the region neighbour
   // it is reached from, in the sweep order: that neighbour's value if the vertex id already
   // orders it after (ties go by id), else one ulp past it. Taking vertices nearest the outlet
@@ -230,7 +293,7 @@ private:
   // every vertex instead lifted a filled pit above a plateau it lies in (every region vertex
   // past all the plateau vertices around it): a peak, which the cut made a pit again, round
   // after round.
-  Index RevalueFromOutlet(Index outlet, const std::vector<Index>& region, std::vector<Index>* revalued)
+  Index RevalueWithTies(Index outlet, const std::vector<Index>& region, std::vector<Index>* revalued)
   {
     const Graph& g = this->Sweep.Neighbours;
     std::vector<double>& values = this->Values;
@@ -276,6 +339,134 @@ private:
       }
     }
     return changed + this->GiveEveryVertexOneAfter(outlet, region, revalued);
+  }
+
+  // The region re-valued by a harmonic function of the sweep's graph: 1 at the outlet, 0 at the
+  // region's other neighbours (all after the outlet in the sweep), mapped into the open interval
+  // between the outlet's value and the earliest of those neighbours, at most a ten-millionth of
+  // the values' scale past the outlet. A harmonic function has no extremum inside the region (each
+  // vertex is the mean of its neighbours), so every region vertex has a neighbour before it and
+  // one after it: the fill (cut) makes no new peak (pit), in the region or around it. Ties ordered
+  // by id make one wherever ids do not follow the positions (stress seed 41 #279, #284, Delaunay
+  // meshes at 25 %: a plateau cut left a spurious minimum-saddle pair, the floods undid each other
+  // round after round and never converged). Returns -1, and leaves the values, where the
+  // interval is empty or the computed values do not keep that property in double precision.
+  Index SpreadHarmonically(Index outlet, const std::vector<Index>& region, std::vector<Index>* revalued)
+  {
+    const Graph& g = this->Sweep.Neighbours;
+    std::vector<double>& values = this->Values;
+    const Index n = static_cast<Index>(region.size());
+    std::vector<std::pair<Index, Index>> local(n);
+    for (Index i = 0; i < n; ++i)
+    {
+      local[i] = { region[i], i };
+    }
+    std::sort(local.begin(), local.end());
+    auto localIndex = [&local](Index v) {
+      const auto it = std::lower_bound(local.begin(), local.end(), std::make_pair(v, Index{ 0 }));
+      return it != local.end() && it->first == v ? it->second : InvalidIndex;
+    };
+    const Key outletKey{ values[outlet], outlet };
+    bool bounded = false;
+    Key bound{ 0, 0 };
+    std::vector<Eigen::Triplet<double>> entries;
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
+    for (Index i = 0; i < n; ++i)
+    {
+      const Index r = region[i];
+      entries.emplace_back(i, i, static_cast<double>(g.Start[r + 1] - g.Start[r]));
+      for (Index k = g.Start[r]; k < g.Start[r + 1]; ++k)
+      {
+        const Index w = g.Adjacent[k];
+        const Index j = localIndex(w);
+        if (j != InvalidIndex)
+        {
+          entries.emplace_back(i, j, -1.0);
+        }
+        else if (w == outlet)
+        {
+          rhs[i] += 1.0;
+        }
+        else
+        {
+          const Key other{ values[w], w };
+          if (!this->Sweep.Before(outletKey, other))
+          {
+            return -1; // not after the outlet: the region is not what GrowRegionToOutlet gives
+          }
+          if (!bounded || this->Sweep.Before(other, bound))
+          {
+            bound = other;
+            bounded = true;
+          }
+        }
+      }
+    }
+    const double value = outletKey.Value;
+    const double gap = bounded ? std::abs(bound.Value - value) : 0.0;
+    const double scale = std::max(std::abs(value), gap);
+    const double width = bounded ? std::min(0.5 * gap, 1e-7 * scale) : 1e-7 * std::abs(value);
+    if (!(width > 0) || !std::isfinite(width))
+    {
+      return -1;
+    }
+    Eigen::SparseMatrix<double> laplacian(n, n);
+    laplacian.setFromTriplets(entries.begin(), entries.end());
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(laplacian);
+    if (solver.info() != Eigen::Success)
+    {
+      return -1;
+    }
+    const Eigen::VectorXd harmonic = solver.solve(rhs);
+    if (solver.info() != Eigen::Success)
+    {
+      return -1;
+    }
+    // By rank, not by the harmonic values themselves: far from the outlet those fall by orders of
+    // magnitude (1e-12 at the far end of a cut of 59 vertices) and round to one value.
+    std::vector<Index> order(n);
+    std::iota(order.begin(), order.end(), Index{ 0 });
+    std::sort(order.begin(), order.end(), [&](Index a, Index b) {
+      return harmonic[a] > harmonic[b] || (harmonic[a] == harmonic[b] && region[a] < region[b]);
+    });
+    const double direction = this->Sweep.Ascending ? 1.0 : -1.0;
+    std::vector<double> old(n);
+    for (Index i = 0; i < n; ++i)
+    {
+      old[i] = values[region[i]];
+    }
+    for (Index rank = 0; rank < n; ++rank)
+    {
+      values[region[order[rank]]] =
+        value + direction * width * (static_cast<double>(rank + 1) / static_cast<double>(n + 1));
+    }
+    for (Index i = 0; i < n; ++i)
+    {
+      const Index r = region[i];
+      const Key key{ values[r], r };
+      const bool strictlyInside = this->Sweep.Before(outletKey, key) && (!bounded || this->Sweep.Before(key, bound));
+      if (!strictlyInside || !this->IsBetweenNeighbours(r))
+      {
+        for (Index j = 0; j < n; ++j)
+        {
+          values[region[j]] = old[j];
+        }
+        return -1;
+      }
+    }
+    Index changed = 0;
+    for (Index i = 0; i < n; ++i)
+    {
+      if (values[region[i]] != old[i])
+      {
+        ++changed;
+        if (revalued)
+        {
+          revalued->push_back(region[i]);
+        }
+      }
+    }
+    return changed;
   }
 
   // The re-valued region lies on one level, its ties ordered by id. A vertex inside it (every
@@ -812,7 +1003,8 @@ private:
         found.push_back(v);
       }
     });
-    const SweepDirection direction{ graph, ascending, wanted, flag, wholeLink ? &mesh : nullptr };
+    const SweepDirection direction{ graph, ascending, wanted, flag, wholeLink ? &mesh : nullptr,
+      this->Graphs.IdsAlongRows };
     LocalFlood flood{ direction, values, this->Visits };
     // A fill can leave a vertex next to its region with no lower neighbour (a cut, no higher
     // one) where values differ by a few ulps (a nearly flat patch): such vertices are taken in
@@ -953,9 +1145,10 @@ TopologicalSamplingReport EnforceCriticalVertices(const VertexGraphs& graphs, co
 
 TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds,
-  std::vector<Index>* blockedWaysUp)
+  std::vector<Index>* blockedWaysUp, bool idsAlongRows)
 {
-  return EnforceCriticalVertices(VertexGraphs(mesh), mesh, constraints, values, maximumRounds, blockedWaysUp);
+  return EnforceCriticalVertices(
+    VertexGraphs(mesh, idsAlongRows), mesh, constraints, values, maximumRounds, blockedWaysUp);
 }
 
 namespace
@@ -1488,7 +1681,7 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   SamplingConstraints constraints = ComplexConstraints(this->Complex, this->ComplexMesh, mesh, vertexAt);
   AddSaddleOneCells(this->Complex, this->Smoothed, vertexAt, reach, constraints, this->Parallel);
   AddOneCells(this->Complex, this->Smoothed, vertexAt, 0.25 * this->Spacing, constraints, this->Parallel);
-  const VertexGraphs graphs(mesh);
+  const VertexGraphs graphs(mesh, sampling.IsGrid());
   const std::vector<double> before = values;
   // Every node's vertex takes the node's critical value: F o Phi has it at the node, but a
   // vertex on a node that a 2-cell's smoothed boundary passes beside (a slit, a node between

@@ -216,10 +216,13 @@ private:
 // changes as many vertices as the one before (Converged is then false, and a few spurious
 // pairs may remain).
 // `blockedWaysUp`, if given, collects the wanted boundary saddles whose way up could not keep off
-// the wanted points (see TopologicalSamplingReport::BlockedWaysUp).
+// the wanted points (see TopologicalSamplingReport::BlockedWaysUp). `idsAlongRows`: the mesh's
+// vertex ids run along the rows of an image grid (PlanarScalarField::IsGrid), so that a region
+// re-valued on one level with ties ordered by id lies on a tilted plane; otherwise regions are
+// spread between their bounds first (a harmonic order), ties only where that fails.
 TopologicalSamplingReport EnforceCriticalVertices(const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, std::vector<double>& values, int maximumRounds = 6,
-  std::vector<Index>* blockedWaysUp = nullptr);
+  std::vector<Index>* blockedWaysUp = nullptr, bool idsAlongRows = false);
 
 // A wanted boundary saddle whose way up the floods had to force through a wanted minimum or
 // saddle (SamplingBlockedWaysUp; on noise its only interior neighbour can be a wanted minimum)

@@ -114,6 +114,12 @@ REQUIRED = [
     # A jittered grid whose corner vertex a boundary 1-cell's curve cut off: the vertex was in no
     # 2-cell (seed 53).
     dict(kind="mesh_grid", nx=91, ny=88, percent=50.0, k=2, seed=513933502),
+    # Floods on Delaunay meshes whose plateaus, ordered by random ids, left a spurious
+    # minimum-saddle pair and never converged (seeds 41 and 67).
+    dict(kind="delaunay", points=2562, percent=25.0, k=23, seed=1030514989),
+    dict(kind="delaunay", points=3112, percent=5.0, k=9, seed=1267327014),
+    # A height fit whose dual program stalled in GLPK's simplex for over 15 minutes (seed 67).
+    dict(kind="mesh_grid", nx=104, ny=47, percent=1.0, k=10, seed=1872602736),
 ]
 
 
