@@ -1674,6 +1674,46 @@ int MoveBlockedBoundarySaddles(const TriangleMeshTopology& mesh, const std::vect
   return MoveBlockedBoundarySaddles(VertexGraphs(mesh), mesh, blocked, settled, constraints, start);
 }
 
+namespace
+{
+// Each critical point's value as its smoothed 1-cells give it: a 1-cell's heights rise from its
+// lower end to its upper end, their Bezier ordinates too (monotone fits), so the lowest ordinate
+// is the lower end's value and the highest the upper end's. The complex's value where no 1-cell
+// ends (or the 1-cells do not match the complex).
+std::vector<double> SmoothedNodeValues(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed)
+{
+  std::vector<double> values(complex.CriticalPoints.size());
+  for (std::size_t c = 0; c < values.size(); ++c)
+  {
+    values[c] = complex.CriticalPoints[c].Value;
+  }
+  if (smoothed.PiecesOfOneCell.size() != complex.OneCells.size())
+  {
+    return values;
+  }
+  for (std::size_t a = 0; a < complex.OneCells.size(); ++a)
+  {
+    double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
+    for (Index p : smoothed.PiecesOfOneCell[a])
+    {
+      for (double height : smoothed.Pieces[p].Height.ControlPoints)
+      {
+        lowest = std::min(lowest, height);
+        highest = std::max(highest, height);
+      }
+    }
+    const OneCell& oneCell = complex.OneCells[a];
+    if (std::isfinite(lowest) && oneCell.Source >= 0 && oneCell.Source < Index(values.size()) &&
+      oneCell.Destination >= 0 && oneCell.Destination < Index(values.size()))
+    {
+      values[oneCell.Source] = lowest; // the lower end: a minimum or a saddle
+      values[oneCell.Destination] = highest;
+    }
+  }
+  return values;
+}
+} // namespace
+
 TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sampling,
   const TriangleMeshTopology& mesh, const std::function<Index(Index)>& vertexAt, std::vector<double>& values) const
 {
@@ -1683,15 +1723,22 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   AddOneCells(this->Complex, this->Smoothed, vertexAt, 0.25 * this->Spacing, constraints, this->Parallel);
   const VertexGraphs graphs(mesh, sampling.IsGrid());
   const std::vector<double> before = values;
-  // Every node's vertex takes the node's critical value: F o Phi has it at the node, but a
-  // vertex on a node that a 2-cell's smoothed boundary passes beside (a slit, a node between
-  // two short 1-cells) can be evaluated in a neighbouring cell.
-  for (const CriticalPoint& cp : this->Complex.CriticalPoints)
+  // Every node's vertex takes the node's value: F o Phi has it at the node, but a vertex on a
+  // node that a 2-cell's smoothed boundary passes beside (a slit, a node between two short
+  // 1-cells) can be evaluated in a neighbouring cell. The value at the ends of the node's
+  // smoothed 1-cells, not the complex's: stage 3 raises tied critical values apart
+  // (SeparateTiedCriticalValues, JunctionValueProgram's spreading), and the 1-cells and
+  // surfaces interpolate the raised ones. (With the complex's value, a boundary saddle on an
+  // integer DEM's plateau, 96 like the minimum below it, went below the boundary junction
+  // between them, which stage 3 had put 2e-9 above 96: stress seed 67 #191, the boundary
+  // stretch sampled falling and a minimum 12 vertices off the junction's pit.)
+  const std::vector<double> nodeValue = SmoothedNodeValues(this->Complex, this->Smoothed);
+  for (std::size_t c = 0; c < nodeValue.size(); ++c)
   {
-    const Index v = vertexAt(cp.Vertex);
+    const Index v = vertexAt(this->Complex.CriticalPoints[c].Vertex);
     if (v >= 0 && v < mesh.NumberOfVertices())
     {
-      values[v] = cp.Value;
+      values[v] = nodeValue[c];
     }
   }
   // A boundary saddle at a domain corner cannot be sampled there: a corner above both its
