@@ -120,6 +120,9 @@ REQUIRED = [
     dict(kind="delaunay", points=3112, percent=5.0, k=9, seed=1267327014),
     # A height fit whose dual program stalled in GLPK's simplex for over 15 minutes (seed 67).
     dict(kind="mesh_grid", nx=104, ny=47, percent=1.0, k=10, seed=1872602736),
+    # A boundary saddle tied with the minimum below it (an integer DEM), sampled at the complex's
+    # value below the junction that stage 3 had raised between them (seed 67).
+    dict(kind="crop", file="r_volcano_maunga_whau.vti", i0=50, j0=11, w=30, h=49, percent=10.0, k=21, seed=1726055964),
 ]
 
 
