@@ -241,41 +241,28 @@ private:
   // no round could move): there the harmonic spread comes first, ties only where it fails.
   Index RevalueFromOutlet(Index outlet, const std::vector<Index>& region, std::vector<Index>* revalued)
   {
-    if (!this->Sweep.IdsAlongRows)
+    if (this->Sweep.IdsAlongRows)
     {
-      const Index spread = this->SpreadHarmonically(outlet, region, revalued);
-      return spread >= 0 ? spread : this->RevalueWithTies(outlet, region, revalued);
-    }
-    std::vector<double> before(region.size());
-    std::transform(region.begin(), region.end(), before.begin(), [this](Index r) { return this->Values[r]; });
-    const std::size_t revaluedBefore = revalued ? revalued->size() : 0;
-    const Index tied = this->RevalueWithTies(outlet, region, revalued);
-    if (std::all_of(region.begin(), region.end(), [this](Index r) { return this->IsBetweenNeighbours(r); }))
-    {
-      return tied;
-    }
-    std::vector<double> withTies(region.size());
-    for (std::size_t i = 0; i < region.size(); ++i)
-    {
-      withTies[i] = this->Values[region[i]];
-      this->Values[region[i]] = before[i];
-    }
-    std::vector<Index> spreadRevalued;
-    const Index spread = this->SpreadHarmonically(outlet, region, &spreadRevalued);
-    if (spread >= 0)
-    {
+      std::vector<double> before(region.size());
+      std::transform(region.begin(), region.end(), before.begin(), [this](Index r) { return this->Values[r]; });
+      const std::size_t revaluedBefore = revalued ? revalued->size() : 0;
+      const Index tied = this->RevalueWithTies(outlet, region, revalued);
+      if (std::all_of(region.begin(), region.end(), [this](Index r) { return this->IsBetweenNeighbours(r); }))
+      {
+        return tied;
+      }
+      // Undone, and spread as on any other mesh (ties again, the same ones, if that fails).
+      for (std::size_t i = 0; i < region.size(); ++i)
+      {
+        this->Values[region[i]] = before[i];
+      }
       if (revalued)
       {
         revalued->resize(revaluedBefore);
-        revalued->insert(revalued->end(), spreadRevalued.begin(), spreadRevalued.end());
       }
-      return spread;
     }
-    for (std::size_t i = 0; i < region.size(); ++i)
-    {
-      this->Values[region[i]] = withTies[i];
-    }
-    return tied;
+    const Index spread = this->SpreadHarmonically(outlet, region, revalued);
+    return spread >= 0 ? spread : this->RevalueWithTies(outlet, region, revalued);
   }
 
   // Whether v has a neighbour before it and one after it in the sweep's graph.

@@ -61,6 +61,27 @@ PlanarScalarField UnitGrid(int nx, int ny, const std::function<double(int, int)>
   return field;
 }
 
+// The triangles of an nx x ny grid with each square split along a random diagonal (valences 4
+// to 8), grid vertex (i, j) numbered vertexOf(j * nx + i).
+std::vector<Index> RandomDiagonalTriangles(
+  int nx, int ny, std::mt19937_64& random, const std::function<Index(Index)>& vertexOf)
+{
+  std::vector<Index> triangles;
+  std::bernoulli_distribution flip(0.5);
+  for (int j = 0; j + 1 < ny; ++j)
+  {
+    for (int i = 0; i + 1 < nx; ++i)
+    {
+      const Index a = vertexOf(j * nx + i), b = vertexOf(j * nx + i + 1), c = vertexOf((j + 1) * nx + i),
+                  d = vertexOf((j + 1) * nx + i + 1);
+      const std::vector<Index> quad =
+        flip(random) ? std::vector<Index>{ a, b, d, a, d, c } : std::vector<Index>{ a, b, c, b, d, c };
+      triangles.insert(triangles.end(), quad.begin(), quad.end());
+    }
+  }
+  return triangles;
+}
+
 // The sampling case of a smooth field on a grid: its complex and the constraints it gives.
 SamplingCase SamplingCaseOf(const GridField& smooth)
 {
@@ -236,16 +257,7 @@ TEST_CASE(FloodsOnAnIrregularMeshSettle)
         field.Values[v] = std::sin(x / 6.0) * std::cos(y / 7.0) + 0.01 * x;
       }
     }
-    std::bernoulli_distribution flip(0.5);
-    for (int j = 0; j + 1 < ny; ++j)
-    {
-      for (int i = 0; i + 1 < nx; ++i)
-      {
-        const Index a = id[j * nx + i], b = id[j * nx + i + 1], c = id[(j + 1) * nx + i], d = id[(j + 1) * nx + i + 1];
-        const std::vector<Index> quad = flip(random) ? std::vector<Index>{ a, b, d, a, d, c } : std::vector<Index>{ a, b, c, b, d, c };
-        field.Triangles.insert(field.Triangles.end(), quad.begin(), quad.end());
-      }
-    }
+    field.Triangles = RandomDiagonalTriangles(nx, ny, random, [&id](Index v) { return id[v]; });
     TriangleMeshTopology mesh;
     CHECK(mesh.Build(n, field.Triangles, SequentialFor, error));
     MorseSmaleComplex wanted;
@@ -679,17 +691,7 @@ TEST_CASE(RelaxingTowardTargetsKeepsEveryCriticalPoint)
         TriangleMeshTopology mesh;
         if (randomDiagonals)
         {
-          std::bernoulli_distribution flip(0.5);
-          for (int j = 0; j + 1 < ny; ++j)
-          {
-            for (int i = 0; i + 1 < nx; ++i)
-            {
-              const Index a = j * nx + i, b = a + 1, c = a + nx, d = c + 1;
-              const std::vector<Index> quad = flip(random) ? std::vector<Index>{ a, b, d, a, d, c }
-                                                           : std::vector<Index>{ a, b, c, b, d, c };
-              field.Triangles.insert(field.Triangles.end(), quad.begin(), quad.end());
-            }
-          }
+          field.Triangles = RandomDiagonalTriangles(nx, ny, random, [](Index v) { return v; });
           field.GridDimensions[0] = field.GridDimensions[1] = 0;
           CHECK(mesh.Build(nx * ny, field.Triangles, SequentialFor, error));
         }
