@@ -3,8 +3,9 @@ n x n samples (default 1000) at a threshold (default 5 %) through the four filte
 own pvpython process so that the peak resident memory (ru_maxrss of that child, from wait4) is
 that run's.
 Prints, per size: time per stage, peak memory, the memory still resident at the end, the
-simplified counts, the topology verdict, failed 2-cells and unreconstructed vertices; errors are
-printed, not hidden.
+simplified counts, the topology verdict, failed 2-cells, unreconstructed vertices, the critical
+points the verdict found missing and spurious, and the spare saddles topological sampling walked
+onto their nodes; errors are printed, not hidden.
 
 Usage: pvpython benchmarks/benchmark_noise.py [n ...] [--threshold P] [--k K]"""
 import json
@@ -61,8 +62,13 @@ if complex_.GetNumberOfBlocks() > 0 and complex_.GetBlock(0) is not None:
         counts = [values.count(0), values.count(1), values.count(2)]
 # What the process still holds once the pipeline has run (its outputs and what the allocator kept).
 resident = next(int(line.split()[1]) / 1e6 for line in open("/proc/self/status") if line.startswith("VmRSS"))
+def tuples(name):
+    a = fd.GetArray(name)
+    return a.GetNumberOfTuples() if a is not None else None
 print("RESULT " + json.dumps({"times": times, "resident": resident, "counts": counts, "verdict": number("TopologyVerified"),
-                              "failed": number("FailedTwoCells"), "unreconstructed": number("UnreconstructedPoints")}))
+                              "failed": number("FailedTwoCells"), "unreconstructed": number("UnreconstructedPoints"),
+                              "missing": tuples("MissingCriticalPoints"), "spurious": tuples("SpuriousCriticalPoints"),
+                              "walked": number("SamplingWalkedSaddles")}))
 """
 
 
@@ -80,8 +86,8 @@ def main():
     sizes = [int(a) for a in args] or [1000]
     print("uniform noise (seed 2026), threshold %g %%, k = %d, 2 STDThread threads" % (percent, k))
     print("| n x n | complex s | simplify s | smooth s | reconstruct s | total s | peak GB | resident after GB | min/saddle/max "
-          "| verdict | failed 2-cells | unreconstructed |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "| verdict | failed 2-cells | unreconstructed | missing / spurious critical points | saddles walked |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for n in sizes:
         start = time.time()
         with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
@@ -102,9 +108,10 @@ def main():
                                                                 (errors or [stderr.strip()[-300:]])[0]))
             continue
         t = result["times"]
-        print("| %d | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %s | %s | %s | %s |" % (
+        print("| %d | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %s | %s | %s | %s | %s / %s | %s |" % (
             n, t["complex"], t["simplify"], t["smooth"], t["reconstruct"], sum(t.values()), peak, result["resident"],
-            "/".join(map(str, result["counts"] or [])), result["verdict"], result["failed"], result["unreconstructed"]))
+            "/".join(map(str, result["counts"] or [])), result["verdict"], result["failed"], result["unreconstructed"],
+            result.get("missing"), result.get("spurious"), result.get("walked")))
         for e in errors[:3]:
             print("    error: " + e)
         sys.stdout.flush()

@@ -161,6 +161,7 @@ constexpr const char* SamplingDisplacedSaddles = "SamplingDisplacedSaddles";
 constexpr const char* SamplingBlockedWaysUp = "SamplingBlockedWaysUp";
 constexpr const char* SamplingMovedBoundarySaddles = "SamplingMovedBoundarySaddles";
 constexpr const char* SamplingMovedInteriorSaddles = "SamplingMovedInteriorSaddles";
+constexpr const char* SamplingWalkedSaddles = "SamplingWalkedSaddles";
 // Spurious critical points of F o Phi at the input vertices, within two grid spacings of a
 // smoothed 1-cell and farther.
 constexpr const char* RawSpuriousNearOneCells = "RawSpuriousNearOneCells";

@@ -303,6 +303,7 @@ void WriteReport(const topospline::FieldReconstructionReport& report, vtkFieldDa
     AddFieldNumbers(fd, names::SamplingBlockedWaysUp, { static_cast<double>(report.Sampling.BlockedWaysUp.size() / 2) });
     AddFieldNumbers(fd, names::SamplingMovedBoundarySaddles, { static_cast<double>(report.Sampling.MovedBoundarySaddles) });
     AddFieldNumbers(fd, names::SamplingMovedInteriorSaddles, { static_cast<double>(report.Sampling.MovedInteriorSaddles) });
+    AddFieldNumbers(fd, names::SamplingWalkedSaddles, { static_cast<double>(report.Sampling.WalkedSaddles) });
   }
   if (!report.VerificationRan)
   {

@@ -356,68 +356,79 @@ void DiscreteGradient::Compute(const TriangleMeshTopology& mesh, const double* v
   });
 }
 
+LowerStarCriticalCells DiscreteGradient::CriticalCellsOfLowerStar(
+  const TriangleMeshTopology& mesh, const double* values, Index v)
+{
+  const VertexOrder order{ values };
+  LowerStarCriticalCells cells;
+  const Index triangles = mesh.VertexTriangleEnd(v) - mesh.VertexTriangleBegin(v);
+  // Per triangle (v, a, b): its lower link vertices a, b (an interior edge of v is in two
+  // triangles, a boundary edge in one), whether both are lower (a lower link edge), and the
+  // lower ends of v's boundary edges.
+  Index lowerEnds = 0, lowerLinkEdges = 0, boundaryEnds = 0;
+  for (Index i = mesh.VertexTriangleBegin(v); i < mesh.VertexTriangleEnd(v); ++i)
+  {
+    const Index t = mesh.VertexTriangle(i);
+    const auto& tv = mesh.TriangleVertices[t];
+    const auto& te = mesh.TriangleEdges[t];
+    int lower = 0;
+    for (int k = 0; k < 3; ++k)
+    {
+      const Index a = tv[k], b = tv[(k + 1) % 3];
+      if (a != v && b != v)
+      {
+        continue;
+      }
+      const bool below = order.Lower(a == v ? b : a, v);
+      lower += below ? 1 : 0;
+      if (mesh.IsBoundaryEdge(te[k]))
+      {
+        boundaryEnds += below ? 1 : 0;
+      }
+    }
+    lowerEnds += lower;
+    lowerLinkEdges += lower == 2 ? 1 : 0;
+  }
+  const Index lowerLinkVertices = (lowerEnds + boundaryEnds) / 2;
+  const Index runs = lowerLinkVertices - lowerLinkEdges; // the lower link is a forest of paths
+  const bool boundary = mesh.IsBoundaryVertex(v);
+  // The vertex pairs with a lower edge of its own kind (a boundary vertex with a boundary edge).
+  cells.Minimum = boundary ? boundaryEnds == 0 : lowerLinkVertices == 0;
+  // Triangles pair with interior edges only: one is left when the whole star is lower.
+  cells.Maximum = triangles > 0 && lowerLinkEdges == triangles;
+  if (!boundary)
+  {
+    // A minimum (no run), a maximum (the whole cycle) or runs - 1 saddles.
+    cells.Saddles = lowerLinkVertices > 0 && lowerLinkEdges < triangles ? static_cast<int>(runs - 1) : 0;
+  }
+  else if (lowerLinkEdges == triangles)
+  {
+    cells.Saddles = 1; // the whole link: a maximum inside and a saddle along the boundary curve
+  }
+  else
+  {
+    // Runs that reach a boundary neighbour pair from its boundary edge; with both
+    // boundary neighbours lower, v pairs with one boundary edge and the other is a saddle.
+    cells.Saddles = static_cast<int>(runs - boundaryEnds + (boundaryEnds == 2 ? 1 : 0));
+  }
+  return cells;
+}
+
 bool DiscreteGradient::SaddleVertices(const TriangleMeshTopology& mesh, const double* values,
   const ParallelFor& parallelFor, std::vector<Index>& saddles)
 {
   const Index n = mesh.NumberOfVertices();
-  const VertexOrder order{ values };
   std::vector<unsigned char> multiplicity(n, 0);
   std::atomic<bool> valid(true);
   parallelFor(0, n, [&](Index begin, Index end) {
     for (Index v = begin; v < end; ++v)
     {
-      const Index triangles = mesh.VertexTriangleEnd(v) - mesh.VertexTriangleBegin(v);
-      if (!std::isfinite(values[v]) || triangles == 0)
+      if (!std::isfinite(values[v]) || mesh.VertexTriangleEnd(v) == mesh.VertexTriangleBegin(v))
       {
         valid = false;
         return;
       }
-      // Per triangle (v, a, b): its lower link vertices a, b (an interior edge of v is in two
-      // triangles, a boundary edge in one), whether both are lower (a lower link edge), and the
-      // lower ends of v's boundary edges.
-      Index lowerEnds = 0, lowerLinkEdges = 0, boundaryEnds = 0;
-      for (Index i = mesh.VertexTriangleBegin(v); i < mesh.VertexTriangleEnd(v); ++i)
-      {
-        const Index t = mesh.VertexTriangle(i);
-        const auto& tv = mesh.TriangleVertices[t];
-        const auto& te = mesh.TriangleEdges[t];
-        int lower = 0;
-        for (int k = 0; k < 3; ++k)
-        {
-          const Index a = tv[k], b = tv[(k + 1) % 3];
-          if (a != v && b != v)
-          {
-            continue;
-          }
-          const bool below = order.Lower(a == v ? b : a, v);
-          lower += below ? 1 : 0;
-          if (mesh.IsBoundaryEdge(te[k]))
-          {
-            boundaryEnds += below ? 1 : 0;
-          }
-        }
-        lowerEnds += lower;
-        lowerLinkEdges += lower == 2 ? 1 : 0;
-      }
-      const Index lowerLinkVertices = (lowerEnds + boundaryEnds) / 2;
-      const Index runs = lowerLinkVertices - lowerLinkEdges; // the lower link is a forest of paths
-      Index count = 0;
-      if (!mesh.IsBoundaryVertex(v))
-      {
-        // A minimum (no run), a maximum (the whole cycle) or runs - 1 saddles.
-        count = lowerLinkVertices > 0 && lowerLinkEdges < triangles ? runs - 1 : 0;
-      }
-      else if (lowerLinkEdges == triangles)
-      {
-        count = 1; // the whole link: a maximum inside and a saddle along the boundary curve
-      }
-      else
-      {
-        // Runs that reach a boundary neighbour pair from its boundary edge; with both
-        // boundary neighbours lower, v pairs with one boundary edge and the other is a saddle.
-        count = runs - boundaryEnds + (boundaryEnds == 2 ? 1 : 0);
-      }
-      multiplicity[v] = static_cast<unsigned char>(count);
+      multiplicity[v] = static_cast<unsigned char>(CriticalCellsOfLowerStar(mesh, values, v).Saddles);
     }
   });
   saddles.clear();

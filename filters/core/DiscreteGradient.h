@@ -30,6 +30,19 @@ struct VertexOrder
   }
 };
 
+// The critical cells ProcessLowerStars leaves in one vertex's lower star: where stage 1 puts a
+// minimum (the vertex), saddles (edges, with multiplicity) and a maximum (a triangle).
+struct LowerStarCriticalCells
+{
+  bool Minimum = false;
+  int Saddles = 0;
+  bool Maximum = false;
+  bool operator==(const LowerStarCriticalCells& o) const
+  {
+    return this->Minimum == o.Minimum && this->Saddles == o.Saddles && this->Maximum == o.Maximum;
+  }
+};
+
 class DiscreteGradient
 {
 public:
@@ -65,6 +78,11 @@ public:
   // value or a vertex in no triangle.
   static bool SaddleVertices(const TriangleMeshTopology& mesh, const double* values, const ParallelFor& parallelFor,
     std::vector<Index>& saddles);
+  // The critical cells of v's lower star as Compute leaves them, counted from its lower link
+  // alone (the saddles as SaddleVertices counts them; a boundary vertex is a minimum when no
+  // boundary neighbour is lower, a maximum with a saddle when its whole link is). Values must
+  // be finite around v.
+  static LowerStarCriticalCells CriticalCellsOfLowerStar(const TriangleMeshTopology& mesh, const double* values, Index v);
 
   // The vertex whose lower star holds the cell (its highest vertex): where a critical cell
   // is placed in the domain.

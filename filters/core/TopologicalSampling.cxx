@@ -1844,6 +1844,23 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   {
     return report;
   }
+  // Saddles still off their nodes with a spare saddle a few edges away: walked there.
+  int walkedSaddles = 0;
+  if (this->WalkSpareSaddles)
+  {
+    std::vector<CriticalPointLocation> expected = CriticalPointLocations(this->Complex, this->ComplexPoints);
+    for (CriticalPointLocation& location : expected)
+    {
+      location.Vertex = location.Vertex >= 0 ? vertexAt(location.Vertex) : InvalidIndex;
+      if (location.Vertex >= 0 && location.Vertex < mesh.NumberOfVertices())
+      {
+        location.Position[0] = sampling.Points[2 * location.Vertex];
+        location.Position[1] = sampling.Points[2 * location.Vertex + 1];
+      }
+    }
+    walkedSaddles = WalkSpareSaddlesOntoMissing(
+      mesh, sampling.Points, expected, this->Spacing * (1 + 1e-9), values, this->Parallel);
+  }
   // What the carving, the floods and the relocations changed beyond what the critical points
   // need goes back toward F o Phi (the nodes' vertices toward their critical values).
   RelaxTowardTargets(mesh, prepared, values);
@@ -1851,6 +1868,7 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   report.MaximumChange = 0;
   report.MovedBoundarySaddles = movedSaddles;
   report.MovedInteriorSaddles = movedInteriorSaddles;
+  report.WalkedSaddles = walkedSaddles;
   CountChanges(before, values, report);
   this->Hooks.Report(1.0);
   return report;
@@ -2337,6 +2355,280 @@ int PlaceMissingSaddlesByTheirLinks(const PlanarScalarField& field, const Triang
     matcher.Match(values) };
   relocation.TryLinkPatterns(maximumMissing, maximumPatterns);
   return static_cast<int>(relocation.Current.Missing.size());
+}
+
+namespace
+{
+// Mesh edges from `from` to every vertex within `limit` of them (breadth first).
+std::unordered_map<Index, int> HopsFrom(const TriangleMeshTopology& mesh, Index from, int limit)
+{
+  std::unordered_map<Index, int> hops{ { from, 0 } };
+  std::vector<Index> ring{ from }, next;
+  for (int h = 1; h <= limit && !ring.empty(); ++h)
+  {
+    next.clear();
+    for (Index u : ring)
+    {
+      for (Index w : VertexLink(mesh, u))
+      {
+        if (hops.emplace(w, h).second)
+        {
+          next.push_back(w);
+        }
+      }
+    }
+    ring.swap(next);
+  }
+  return hops;
+}
+
+// The walk of one spare saddle toward one missing wanted saddle (WalkSpareSaddlesOntoMissing):
+// the critical cells of every lower star are kept up to date as vertices change.
+struct SpareSaddleWalk
+{
+  const TriangleMeshTopology& Mesh;
+  std::vector<double>& Values;
+  std::vector<LowerStarCriticalCells>& Cells;
+
+  // A vertex and its link: the lower stars a change of the vertex's value can change.
+  std::vector<Index> StarOf(Index c) const
+  {
+    std::vector<Index> star{ c };
+    for (Index w : VertexLink(this->Mesh, c))
+    {
+      star.push_back(w);
+    }
+    return star;
+  }
+
+  // The values c can take, one per gap between its neighbours' values (the one nearest its
+  // own value in each gap), less its own gap.
+  std::vector<double> ValuesToTry(Index c) const
+  {
+    std::vector<double> levels;
+    for (Index w : VertexLink(this->Mesh, c))
+    {
+      levels.push_back(this->Values[w]);
+    }
+    std::sort(levels.begin(), levels.end());
+    levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+    const double infinity = std::numeric_limits<double>::infinity(), own = this->Values[c];
+    std::vector<double> tries;
+    for (std::size_t i = 0; i <= levels.size(); ++i)
+    {
+      const double low = i == 0 ? -infinity : std::nextafter(levels[i - 1], infinity);
+      const double high = i == levels.size() ? infinity : std::nextafter(levels[i], -infinity);
+      const double x = std::clamp(own, low, high);
+      if (low <= high && x != own && std::isfinite(x))
+      {
+        tries.push_back(x);
+      }
+    }
+    return tries;
+  }
+
+  // The vertex the spare saddle at `at` would move to with c at x (one saddle less at `at`, one
+  // more there, every other critical cell of c's star unchanged); InvalidIndex if c at x does
+  // anything else. The values are left as they were.
+  Index SaddleMovedBy(Index c, double x, Index at, const std::vector<Index>& star)
+  {
+    const double own = this->Values[c];
+    this->Values[c] = x;
+    Index gained = InvalidIndex;
+    bool lostAtSpare = false, allowed = true;
+    for (Index u : star)
+    {
+      const LowerStarCriticalCells now = DiscreteGradient::CriticalCellsOfLowerStar(this->Mesh, this->Values.data(), u);
+      const LowerStarCriticalCells& before = this->Cells[u];
+      const int change = now.Saddles - before.Saddles;
+      allowed = allowed && now.Minimum == before.Minimum && now.Maximum == before.Maximum && std::abs(change) <= 1;
+      if (change == -1)
+      {
+        allowed = allowed && u == at && !lostAtSpare;
+        lostAtSpare = true;
+      }
+      else if (change == 1)
+      {
+        allowed = allowed && gained == InvalidIndex;
+        gained = u;
+      }
+    }
+    this->Values[c] = own;
+    return allowed && lostAtSpare && gained != InvalidIndex ? gained : InvalidIndex;
+  }
+
+  void Set(Index c, double x)
+  {
+    this->Values[c] = x;
+    for (Index u : this->StarOf(c))
+    {
+      this->Cells[u] = DiscreteGradient::CriticalCellsOfLowerStar(this->Mesh, this->Values.data(), u);
+    }
+  }
+};
+} // namespace
+
+int WalkSpareSaddlesOntoMissing(const TriangleMeshTopology& mesh, const std::vector<double>& points,
+  const std::vector<CriticalPointLocation>& expected, double tolerance, std::vector<double>& values,
+  const ParallelFor& parallel, int reachHops, int maximumSteps, int maximumTries)
+{
+  const Index n = mesh.NumberOfVertices();
+  if (static_cast<Index>(values.size()) != n ||
+    !std::all_of(values.begin(), values.end(), [](double x) { return std::isfinite(x); }))
+  {
+    return 0;
+  }
+  for (Index v = 0; v < n; ++v)
+  {
+    if (mesh.VertexTriangleEnd(v) == mesh.VertexTriangleBegin(v))
+    {
+      return 0; // stage 1 refuses a vertex in no triangle
+    }
+  }
+  std::vector<LowerStarCriticalCells> cells(static_cast<std::size_t>(n));
+  parallel(0, n, [&](Index begin, Index end) {
+    for (Index v = begin; v < end; ++v)
+    {
+      cells[v] = DiscreteGradient::CriticalCellsOfLowerStar(mesh, values.data(), v);
+    }
+  });
+  std::vector<CriticalPointLocation> found;
+  for (Index v = 0; v < n; ++v)
+  {
+    CriticalPointLocation location;
+    location.Position[0] = points[2 * v];
+    location.Position[1] = points[2 * v + 1];
+    location.Vertex = v;
+    for (int morseIndex = 0; morseIndex < 3; ++morseIndex)
+    {
+      const int count = morseIndex == 0 ? cells[v].Minimum : (morseIndex == 1 ? cells[v].Saddles : cells[v].Maximum);
+      location.MorseIndex = morseIndex;
+      found.insert(found.end(), static_cast<std::size_t>(count), location);
+    }
+  }
+  const std::vector<std::size_t> partner = MatchCriticalPoints(expected, found, tolerance, &mesh, parallel);
+  std::vector<char> used(found.size(), 0);
+  std::vector<std::size_t> missing;
+  std::vector<unsigned char> fixed(static_cast<std::size_t>(n), 0);
+  for (std::size_t e = 0; e < expected.size(); ++e)
+  {
+    if (expected[e].Vertex >= 0 && expected[e].Vertex < n)
+    {
+      fixed[expected[e].Vertex] = 1;
+    }
+    if (partner[e] != UnmatchedCriticalPoint)
+    {
+      used[partner[e]] = 1;
+    }
+    else if (expected[e].MorseIndex == 1 && expected[e].Vertex >= 0 && expected[e].Vertex < n)
+    {
+      missing.push_back(e);
+    }
+  }
+  std::vector<unsigned char> spare(static_cast<std::size_t>(n), 0); // unmatched found saddles per vertex
+  for (std::size_t f = 0; f < found.size(); ++f)
+  {
+    if (!used[f] && found[f].MorseIndex == 1)
+    {
+      ++spare[found[f].Vertex];
+    }
+  }
+  SpareSaddleWalk walk{ mesh, values, cells };
+  int kept = 0;
+  for (std::size_t e : missing)
+  {
+    const CriticalPointLocation& wanted = expected[e];
+    const std::unordered_map<Index, int> hops = HopsFrom(mesh, wanted.Vertex, reachHops);
+    const auto distance = [&](Index v) {
+      return std::hypot(points[2 * v] - wanted.Position[0], points[2 * v + 1] - wanted.Position[1]);
+    };
+    const auto hopsTo = [&hops](Index v) {
+      const auto h = hops.find(v);
+      return h == hops.end() ? std::numeric_limits<int>::max() : h->second;
+    };
+    const auto reached = [&](Index v) {
+      return hopsTo(v) <= wanted.Hops && distance(v) <= tolerance * wanted.Reach;
+    };
+    // The nearest spare saddle in edges (then in distance, then by id).
+    Index nearest = InvalidIndex;
+    for (const auto& [v, h] : hops)
+    {
+      if (spare[v] && (nearest == InvalidIndex ||
+                        std::make_tuple(h, distance(v), v) < std::make_tuple(hopsTo(nearest), distance(nearest), nearest)))
+      {
+        nearest = v;
+      }
+    }
+    if (nearest == InvalidIndex)
+    {
+      continue;
+    }
+    // Depth first, the steps that bring the saddle nearest (in edges, then in distance) first,
+    // then those that change their vertex least; sideways steps (as many edges away) are taken
+    // too, never back onto the walk's own path; a dead end is undone and the next step tried.
+    struct Step
+    {
+      std::tuple<int, double, double> Score;
+      Index Vertex, Gained;
+      double Value;
+      bool operator<(const Step& o) const { return this->Score < o.Score; }
+    };
+    std::vector<Index> path{ nearest };
+    int budget = maximumTries;
+    const std::function<bool()> search = [&]() {
+      const Index at = path.back();
+      if (reached(at))
+      {
+        return true;
+      }
+      if (static_cast<int>(path.size()) > maximumSteps)
+      {
+        return false;
+      }
+      std::vector<Step> steps;
+      for (Index c : walk.StarOf(at))
+      {
+        if (fixed[c])
+        {
+          continue;
+        }
+        const std::vector<Index> star = walk.StarOf(c);
+        for (double x : walk.ValuesToTry(c))
+        {
+          const Index gained = walk.SaddleMovedBy(c, x, at, star);
+          if (gained != InvalidIndex && hopsTo(gained) <= hopsTo(at) &&
+            std::find(path.begin(), path.end(), gained) == path.end())
+          {
+            steps.push_back(Step{ { hopsTo(gained), distance(gained), std::abs(x - values[c]) }, c, gained, x });
+          }
+        }
+      }
+      std::sort(steps.begin(), steps.end());
+      for (const Step& step : steps)
+      {
+        if (budget-- <= 0)
+        {
+          return false;
+        }
+        const double own = values[step.Vertex];
+        walk.Set(step.Vertex, step.Value);
+        path.push_back(step.Gained);
+        if (search())
+        {
+          return true;
+        }
+        path.pop_back();
+        walk.Set(step.Vertex, own);
+      }
+      return false;
+    };
+    if (search())
+    {
+      --spare[nearest];
+      ++kept;
+    }
+  }
+  return kept;
 }
 
 namespace

@@ -15,8 +15,9 @@
 // Before the floods, the complex's smoothed 1-cells are carved into the sampling
 // (CarveOneCells), so that a ridge or valley running between two rows of vertices is not cut
 // into islands; after them, saddles left off their nodes are moved back (RelocateSaddles: their
-// 1-cells carved again, then the patterns of their links, PlaceMissingSaddlesByTheirLinks).
-// Last, every changed vertex moves back toward F o Phi as far as the critical points allow
+// 1-cells carved again, then the patterns of their links, PlaceMissingSaddlesByTheirLinks);
+// a spare saddle still a few edges off is walked there one vertex value at a time
+// (WalkSpareSaddlesOntoMissing). Last, every changed vertex moves back toward F o Phi as far as the critical points allow
 // (RelaxTowardTargets). TopologicalSampling::Apply runs the whole sequence.
 #pragma once
 
@@ -49,6 +50,8 @@ struct TopologicalSamplingReport
   // Interior saddles left off their nodes that the sampling wants one edge away instead
   // (TopologicalSampling::MoveDisplacedSaddles).
   int MovedInteriorSaddles = 0;
+  // Spare saddles walked onto wanted ones still off their nodes (WalkSpareSaddlesOntoMissing).
+  int WalkedSaddles = 0;
   // The sampling stopped between two of its passes because an abort was requested (Hooks):
   // the values are those of the last pass done, not a finished sampling.
   bool Aborted = false;
@@ -135,7 +138,9 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
 // wanted one step along the boundary where that has a way (MoveBlockedBoundarySaddles), and the
 // kept carving runs once more (kept if it leaves fewer saddles off, or as many and fewer
 // blocked). Interior saddles still off their nodes are then wanted one edge away in turn
-// (MoveDisplacedSaddles; kept if fewer wanted points are missing). The complex side is fixed at
+// (MoveDisplacedSaddles; kept if fewer wanted points are missing), and spare saddles a few edges
+// from wanted ones still unmatched are walked onto them (WalkSpareSaddlesOntoMissing), before the
+// changed vertices are relaxed toward F o Phi. The complex side is fixed at
 // construction; Apply samples one sampling of the reconstruction (the input vertices, a finer
 // grid).
 // `complexPoints` (x, y per vertex of `complexMesh`) tells where the nodes are: on a sampling
@@ -146,6 +151,7 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
 // boundary (within 3 spacings), with the field falling into the domain there; a wanted
 // boundary saddle at a domain corner is wanted on the higher corner neighbour (a corner above
 // both its neighbours is also a maximum of stage 1).
+struct CriticalPointLocation; // TopologyVerification.h
 struct VertexGraphs; // the adjacency the floods walk (TopologicalSampling.cxx)
 
 class TopologicalSampling
@@ -174,6 +180,9 @@ public:
   Index MaximumVerticesForSaddleMoves = Index(1) << 16;
   int MaximumSaddlesToMove = 4;
   int MaximumSaddleMoveTries = 24;
+  // Spare saddles walked onto wanted ones still off their nodes, last (WalkSpareSaddlesOntoMissing);
+  // off only to see the other steps alone.
+  bool WalkSpareSaddles = true;
   // A boundary junction's pit is the boundary pit its vertex falls into along the curve; where
   // that descent stops beside a node it may not take (a wanted boundary minimum lower than the
   // vertex it reached, which is then no pit), the junction's own vertex is made the pit.
@@ -254,6 +263,27 @@ int MoveBlockedBoundarySaddles(const TriangleMeshTopology& mesh, const std::vect
 int PlaceMissingSaddlesByTheirLinks(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, double tolerance, std::vector<double>& values, int maximumMissing,
   int maximumPatterns);
+
+// The last step of a sampling: saddles still off their nodes, walked there one vertex value at
+// a time. Where the complex is denser than the vertices (uniform noise, a boundary saddle beside
+// a corner minimum), the passes can leave a wanted saddle unmatched and a spare saddle two or
+// three edges away, with every extremum in place; no 1-cell carving or flood moves it the last
+// step, but one vertex set past a neighbour's value often does. Each step changes one vertex
+// that holds no wanted point, to the value nearest its own within another gap between its
+// neighbours' values, and is taken only if, judged by stage 1's own lower-star rule
+// (DiscreteGradient::CriticalCellsOfLowerStar) on that vertex and its link, no minimum or
+// maximum appears or goes and the spare saddle alone moves, to a vertex no more edges from the
+// missing one. The walk searches depth first (nearest steps first, then the smallest change; at
+// most `maximumSteps` deep and `maximumTries` steps in all) until the saddle is within the
+// missing one's reach as the verdict pairs them (`tolerance` times its Reach, within its Hops);
+// a walk that does not get there is undone. Spare saddles farther than `reachHops` edges are
+// not walked. `expected` is the verdict's list (CriticalPointLocations, with vertices of
+// `mesh`); `points`: x, y per vertex. Every other critical cell stays where it is, so the
+// verdict's matching gains one pair per walk kept (the lower stars and the matching run with
+// `parallel`; the walks themselves are sequential). Returns the number of walks kept.
+int WalkSpareSaddlesOntoMissing(const TriangleMeshTopology& mesh, const std::vector<double>& points,
+  const std::vector<CriticalPointLocation>& expected, double tolerance, std::vector<double>& values,
+  const ParallelFor& parallel = SequentialFor, int reachHops = 6, int maximumSteps = 12, int maximumTries = 200);
 
 // Makes every wanted extremum an extremum again where a step before (a flood of the other
 // kind, a carved 1-cell, a saddle moved back) took that away: the vertex is moved just past its

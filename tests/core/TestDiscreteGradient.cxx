@@ -500,6 +500,21 @@ TEST_CASE(RegularVertexShortcutEqualsProcessLowerStars)
   }
 }
 
+// The meshes above, and four jittered grids of about nx x ny (plain and with random diagonals)
+// with noise of few levels (monkey saddles, plateaus touching the boundary).
+std::vector<MeshField> MeshesWithNoise(int nx, int ny, std::uint64_t gridSeed, std::uint64_t valueSeed)
+{
+  std::vector<MeshField> fields = TestMeshes();
+  for (std::uint64_t seed = 1; seed <= 4; ++seed)
+  {
+    MeshField field =
+      JitteredGrid(nx + static_cast<int>(seed), ny, gridSeed + seed, seed % 2 ? 0.0 : 0.4, seed % 2 == 0);
+    RandomValues(field, valueSeed + seed, seed <= 2 ? 0 : static_cast<int>(seed));
+    fields.push_back(field);
+  }
+  return fields;
+}
+
 TEST_CASE(SaddleVerticesCountedFromLowerLinksAreTheGradientsCriticalEdges)
 {
   // DiscreteGradient::SaddleVertices (used by topological sampling) must list exactly the
@@ -507,13 +522,7 @@ TEST_CASE(SaddleVerticesCountedFromLowerLinksAreTheGradientsCriticalEdges)
   // meshes above (ties, random diagonals, 2 x 2 and 3 x 2 grids), on larger noise with few
   // levels (monkey saddles, plateaus touching the boundary), with both lower-star paths, and
   // with threads.
-  std::vector<MeshField> fields = TestMeshes();
-  for (std::uint64_t seed = 1; seed <= 4; ++seed)
-  {
-    MeshField field = JitteredGrid(40 + static_cast<int>(seed), 37, 500 + seed, seed % 2 ? 0.0 : 0.4, seed % 2 == 0);
-    RandomValues(field, 700 + seed, seed <= 2 ? 0 : static_cast<int>(seed));
-    fields.push_back(field);
-  }
+  const std::vector<MeshField> fields = MeshesWithNoise(40, 37, 500, 700);
   // Three stretches, as threads would take them (the count must not depend on them).
   const ParallelFor inThreeStretches = [](Index begin, Index end, const RangeBody& body) {
     const Index third = (end - begin + 2) / 3;
@@ -560,6 +569,55 @@ TEST_CASE(SaddleVerticesCountedFromLowerLinksAreTheGradientsCriticalEdges)
   broken.Values[broken.Values.size() / 2] = std::nan("");
   std::vector<Index> counted;
   CHECK(!DiscreteGradient::SaddleVertices(MeshOf(broken), broken.Values.data(), SequentialFor, counted));
+}
+
+TEST_CASE(CriticalCellsOfOneLowerStarAreTheGradients)
+{
+  // DiscreteGradient::CriticalCellsOfLowerStar (topological sampling's local moves judge a
+  // changed value by it) must give, vertex by vertex, the gradient's critical vertex, the
+  // number of its critical edges and its critical triangle, boundary vertices included.
+  const std::vector<MeshField> fields = MeshesWithNoise(30, 27, 900, 1700);
+  Index boundaryMinima = 0, boundaryMaxima = 0, vertices = 0;
+  for (const MeshField& field : fields)
+  {
+    const TriangleMeshTopology mesh = MeshOf(field);
+    const DiscreteGradient g = GradientOf(mesh, field);
+    const VertexOrder order{ field.Values.data() };
+    std::vector<LowerStarCriticalCells> expected(static_cast<std::size_t>(mesh.NumberOfVertices()));
+    for (Index v = 0; v < mesh.NumberOfVertices(); ++v)
+    {
+      expected[v].Minimum = g.IsCriticalVertex(v);
+    }
+    for (Index e = 0; e < mesh.NumberOfEdges(); ++e)
+    {
+      expected[DiscreteGradient::EdgeOwner(mesh, order, e)].Saddles += g.IsCriticalEdge(e) ? 1 : 0;
+    }
+    for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
+    {
+      if (g.IsCriticalTriangle(t))
+      {
+        CHECK(!expected[DiscreteGradient::TriangleOwner(mesh, order, t)].Maximum); // one per lower star
+        expected[DiscreteGradient::TriangleOwner(mesh, order, t)].Maximum = true;
+      }
+    }
+    for (Index v = 0; v < mesh.NumberOfVertices(); ++v)
+    {
+      const LowerStarCriticalCells local = DiscreteGradient::CriticalCellsOfLowerStar(mesh, field.Values.data(), v);
+      if (!(local == expected[v]))
+      {
+        std::printf("  %s vertex %lld: local %d/%d/%d, gradient %d/%d/%d\n", field.Name.c_str(),
+          static_cast<long long>(v), local.Minimum, local.Saddles, local.Maximum, expected[v].Minimum,
+          expected[v].Saddles, expected[v].Maximum);
+      }
+      CHECK(local == expected[v]);
+      boundaryMinima += mesh.IsBoundaryVertex(v) && expected[v].Minimum ? 1 : 0;
+      boundaryMaxima += mesh.IsBoundaryVertex(v) && expected[v].Maximum ? 1 : 0;
+      ++vertices;
+    }
+  }
+  CHECK(vertices > 3000);
+  CHECK(boundaryMinima > 10);
+  CHECK(boundaryMaxima > 10);
 }
 
 int main()

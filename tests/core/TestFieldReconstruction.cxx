@@ -1211,14 +1211,15 @@ TEST_CASE(SaddlesStayWithinTwoEdgesOnScatteredPointMeshes)
 // (TopologicalSampling::MoveDisplacedSaddles): beside the boundary a boundary saddle's way up
 // and an interior saddle can compete for the same few vertices, and one vertex along the saddle
 // leaves the way free. Uniform noise at 25 and 50 % (where most verdicts of 0 are), sampled
-// twice from F o Phi: with the moves and without (MaximumSaddlesToMove = 0). The oracle,
+// three times from F o Phi: without the moves (MaximumSaddlesToMove = 0), with them, and with the
+// spare saddles walked after them (WalkSpareSaddlesOntoMissing; the first two without). The oracle,
 // written here: the sampling's saddles by the closed-boundary rule (SaddlesByTheBoundaryRule)
 // paired one to one with the complex's saddles within a grid diagonal (a boundary junction's
 // saddle within three, as the verdict allows), and the saddles left over counted. The moves never leave
-// more and leave fewer in all.
+// more and leave fewer in all; the walks never leave more than the moves.
 TEST_CASE(DisplacedSaddlesAreWantedOneEdgeAway)
 {
-  int cases = 0, unpairedWith = 0, unpairedWithout = 0, improved = 0;
+  int cases = 0, unpairedWith = 0, unpairedWithout = 0, unpairedWalked = 0, improved = 0;
   for (int n : { 24, 32, 48 })
   {
     for (double percent : { 25.0, 50.0 })
@@ -1258,16 +1259,19 @@ TEST_CASE(DisplacedSaddlesAreWantedOneEdgeAway)
           hops.push_back(3);
           distance.push_back(3 * std::sqrt(2.0) * (1 + 1e-9));
         }
-        int unpaired[2] = { 0, 0 };
-        for (int moves : { 0, 1 })
+        // Without the moves, with them, and with them and the walks after them.
+        int unpaired[3] = { 0, 0, 0 };
+        for (int moves : { 0, 1, 2 })
         {
           TopologicalSampling sampling(p.Simplified.Complex, mesh, p.Field.Points, p.Smoothed);
           sampling.Spacing = std::sqrt(2.0) * (1 + 1e-9);
           sampling.MaximumSaddlesToMove = moves == 0 ? 0 : sampling.MaximumSaddlesToMove;
+          sampling.WalkSpareSaddles = moves == 2;
           std::vector<double> values = exact.Values;
           const TopologicalSamplingReport report =
             sampling.Apply(p.Field, mesh, [](Index v) { return v; }, values);
-          CHECK(moves == 1 || report.MovedInteriorSaddles == 0);
+          CHECK(moves > 0 || report.MovedInteriorSaddles == 0);
+          CHECK(moves == 2 || report.WalkedSaddles == 0);
           const std::vector<Index> found = SaddlesByTheBoundaryRule(triangles, values);
           const std::vector<int> partner =
             PairWithinHops(wanted, found, neighbours, 2, &hops, &triangles.Points, &distance);
@@ -1278,18 +1282,20 @@ TEST_CASE(DisplacedSaddlesAreWantedOneEdgeAway)
         ++cases;
         unpairedWithout += unpaired[0];
         unpairedWith += unpaired[1];
+        unpairedWalked += unpaired[2];
         improved += unpaired[1] < unpaired[0] ? 1 : 0;
-        if (unpaired[1] != unpaired[0])
+        if (unpaired[1] != unpaired[0] || unpaired[2] != unpaired[1])
         {
-          std::printf("  noise %d x %d seed %d at %g %%: %d saddles unpaired without the moves, %d with\n", n, n,
-            static_cast<int>(seed), percent, unpaired[0], unpaired[1]);
+          std::printf("  noise %d x %d seed %d at %g %%: %d saddles unpaired without the moves, %d with, %d with "
+                      "the walks too\n", n, n, static_cast<int>(seed), percent, unpaired[0], unpaired[1], unpaired[2]);
         }
         CHECK(unpaired[1] <= unpaired[0]);
+        CHECK(unpaired[2] <= unpaired[1]); // a walk is kept only if it pairs a saddle
       }
     }
   }
   std::printf("  %d noise fields: %d saddles unpaired (the verdict's reach) without the moves, %d with (%d fields "
-              "better)\n", cases, unpairedWithout, unpairedWith, improved);
+              "better), %d with the walks too\n", cases, unpairedWithout, unpairedWith, improved, unpairedWalked);
   CHECK(unpairedWith < unpairedWithout);
 }
 

@@ -7,7 +7,8 @@
 // critical point; a corner saddle with no way up but through a wanted minimum is reported, one
 // whose neighbour along the boundary can rise past it goes up there, and one with a free
 // neighbour along the boundary moves there; a saddle lowered off its vertex comes
-// back by the patterns of its link. Each sampled result is checked by
+// back by the patterns of its link; a saddle walked a few vertex values off its node is walked
+// back. Each sampled result is checked by
 // extracting its critical points again (stage 1) against the wanted complex. (The whole
 // sequence on real reconstructions is tested in TestFieldReconstruction.)
 //
@@ -16,6 +17,7 @@
 #include "MorseSmaleComplexExtraction.h"
 #include "SyntheticFields.h"
 #include "TestHarness.h"
+#include "TestSupport.h"
 #include "TopologicalSampling.h"
 #include "TopologyVerification.h"
 
@@ -1230,6 +1232,251 @@ TEST_CASE(ASaddleLoweredOntoItsLinkComesBackByItsLink)
   std::printf("  %d interior saddles lowered off their vertex (the trigonometric field, 3 seeded Shepard "
               "fields), %d back on it by their links\n", tried, restored);
   CHECK(tried >= 5);
+}
+
+TEST_CASE(ASpareSaddleWalksOntoItsMissingNode)
+{
+  // Seeded noise on grids and on grids split along random diagonals: the field's own critical
+  // points are the wanted ones. An interior saddle is walked two steps away from its vertex
+  // (each step one vertex set into another gap between its neighbours' values, found here by the
+  // test's own count of link pieces: no extremum changes, the saddle alone moves away, farther
+  // than the verdict's pairing reaches). WalkSpareSaddlesOntoMissing must walk it back within
+  // reach, with every other critical point where it was and the wanted points' values
+  // untouched: checked by the test's count and by stage 1. With a reach of one edge it must
+  // leave the values exactly as they were.
+  const double tolerance = std::sqrt(2.0) * (1 + 1e-9); // one grid diagonal, as the verdict
+  int displaced = 0, walked = 0, onRandomDiagonals = 0;
+  for (std::uint64_t seed = 1; seed <= 80 && displaced < 50; ++seed)
+  {
+    const int n = 20;
+    const bool randomDiagonals = seed % 2 == 0;
+    PlanarScalarField field = FieldOnGrid(UniformNoise(n, 3000 + seed));
+    TriangleMeshTopology mesh;
+    std::string error;
+    if (randomDiagonals)
+    {
+      std::mt19937_64 random(seed);
+      field.Triangles = RandomDiagonalTriangles(n, n, random, [](Index v) { return v; });
+      field.GridDimensions[0] = field.GridDimensions[1] = 0; // a triangle mesh, not an image
+      CHECK(mesh.Build(n * n, field.Triangles, SequentialFor, error));
+    }
+    else
+    {
+      mesh.BuildGrid(n, n, SequentialFor);
+      field.Triangles.clear();
+      for (int j = 0; j + 1 < n; ++j)
+      {
+        for (int i = 0; i + 1 < n; ++i)
+        {
+          const Index a = j * n + i; // the grid's split along (i+1, j)-(i, j+1)
+          field.Triangles.insert(field.Triangles.end(), { a, a + 1, a + n, a + 1, a + n + 1, a + n });
+        }
+      }
+    }
+    // The test's own classification of an interior vertex from the triangles (its link walked
+    // round as a cycle; ties by vertex id): -1 minimum, -2 maximum, else the saddles.
+    const std::vector<Index>& triangles = field.Triangles;
+    const auto kindOf = [&triangles](const std::vector<double>& values, Index v) {
+      std::vector<std::pair<Index, Index>> opposite; // each triangle's edge across from v
+      for (std::size_t t = 0; t + 2 < triangles.size(); t += 3)
+      {
+        for (int k = 0; k < 3; ++k)
+        {
+          if (triangles[t + k] == v)
+          {
+            opposite.emplace_back(triangles[t + (k + 1) % 3], triangles[t + (k + 2) % 3]);
+          }
+        }
+      }
+      std::vector<Index> cycle{ opposite.front().first, opposite.front().second };
+      while (cycle.size() < opposite.size())
+      {
+        for (const auto& edge : opposite)
+        {
+          if (edge.first == cycle.back())
+          {
+            cycle.push_back(edge.second);
+            break;
+          }
+        }
+      }
+      int lower = 0, changes = 0;
+      const auto below = [&](Index w) { return values[w] < values[v] || (values[w] == values[v] && w < v); };
+      for (std::size_t k = 0; k < cycle.size(); ++k)
+      {
+        lower += below(cycle[k]) ? 1 : 0;
+        changes += below(cycle[k]) != below(cycle[(k + 1) % cycle.size()]) ? 1 : 0;
+      }
+      return lower == 0 ? -1 : (lower == static_cast<int>(cycle.size()) ? -2 : changes / 2 - 1);
+    };
+    const auto inside = [n](Index v, int margin) {
+      const int i = static_cast<int>(v % n), j = static_cast<int>(v / n);
+      return i >= margin && j >= margin && i < n - margin && j < n - margin;
+    };
+    const auto starOf = [&mesh](Index v) {
+      std::vector<Index> star{ v };
+      for (Index i = mesh.VertexTriangleBegin(v); i < mesh.VertexTriangleEnd(v); ++i)
+      {
+        for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
+        {
+          if (std::find(star.begin(), star.end(), w) == star.end())
+          {
+            star.push_back(w);
+          }
+        }
+      }
+      return star;
+    };
+    const auto gridDistance = [n](Index a, Index b) {
+      return std::hypot(double(a % n) - double(b % n), double(a / n) - double(b / n));
+    };
+    MorseSmaleComplexExtraction extraction;
+    extraction.CriticalPointsOnly = true;
+    MorseSmaleComplex own;
+    CHECK(extraction.Extract(field, own, error));
+    const std::vector<CriticalPointLocation> expected = CriticalPointLocations(own, field.Points);
+    std::vector<unsigned char> critical(field.Values.size(), 0);
+    for (const CriticalPointLocation& p : expected)
+    {
+      critical[p.Vertex] = 1;
+    }
+    // One step of the saddle at `at` away from w (farther from it), by the test's count.
+    const auto stepAway = [&](std::vector<double>& values, Index& at, Index w) {
+      for (Index c : starOf(at))
+      {
+        if (critical[c] || !inside(c, 3))
+        {
+          continue;
+        }
+        std::vector<double> levels;
+        for (Index u : starOf(c))
+        {
+          levels.push_back(values[u]);
+        }
+        for (double level : levels)
+        {
+          for (double x : { std::nextafter(level, 2.0), std::nextafter(level, -1.0) })
+          {
+            const std::vector<Index> star = starOf(c);
+            std::vector<int> before;
+            for (Index u : star)
+            {
+              before.push_back(kindOf(values, u));
+            }
+            const double own = values[c];
+            values[c] = x;
+            Index gained = InvalidIndex;
+            bool lost = false, other = false;
+            for (std::size_t k = 0; k < star.size(); ++k)
+            {
+              const int now = kindOf(values, star[k]);
+              if (now == before[k])
+              {
+                continue;
+              }
+              if (star[k] == at && before[k] == 1 && now == 0)
+              {
+                lost = true;
+              }
+              else if (now == 1 && before[k] == 0 && gained == InvalidIndex)
+              {
+                gained = star[k];
+              }
+              else
+              {
+                other = true;
+              }
+            }
+            if (lost && !other && gained != InvalidIndex && gridDistance(gained, w) > gridDistance(at, w))
+            {
+              at = gained;
+              return true;
+            }
+            values[c] = own;
+          }
+        }
+      }
+      return false;
+    };
+    for (const CriticalPointLocation& p : expected)
+    {
+      const Index w = p.Vertex;
+      if (p.MorseIndex != 1 || !inside(w, 4) || kindOf(field.Values, w) != 1 || displaced >= 50)
+      {
+        continue;
+      }
+      std::vector<double> values = field.Values;
+      Index at = w;
+      if (!stepAway(values, at, w) || !stepAway(values, at, w) || gridDistance(at, w) <= tolerance)
+      {
+        continue;
+      }
+      PlanarScalarField off = field;
+      off.Values = values;
+      MorseSmaleComplex offComplex;
+      CHECK(extraction.Extract(off, offComplex, error));
+      if (CompareCriticalPoints(expected, CriticalPointLocations(offComplex, field.Points), tolerance, &mesh)
+            .Missing.size() != 1)
+      {
+        continue; // the verdict pairs the moved saddle with another node, and w with another saddle
+      }
+      ++displaced;
+      onRandomDiagonals += randomDiagonals ? 1 : 0;
+      // Reached by one edge only: nothing walks, nothing changes.
+      std::vector<double> unchanged = values;
+      CHECK_EQ(WalkSpareSaddlesOntoMissing(mesh, field.Points, expected, tolerance, unchanged, SequentialFor, 1), 0);
+      CHECK(unchanged == values);
+      const int kept = WalkSpareSaddlesOntoMissing(mesh, field.Points, expected, tolerance, values);
+      walked += kept;
+      // The test's count: every interior vertex as in the field, but near w (as many saddles
+      // as there).
+      Index saddleNearW = 0, saddlesNearWBefore = 0, differences = 0;
+      for (Index v = 0; v < mesh.NumberOfVertices(); ++v)
+      {
+        if (critical[v])
+        {
+          CHECK_EQ(values[v], field.Values[v]);
+        }
+        if (!inside(v, 1))
+        {
+          continue;
+        }
+        const int now = kindOf(values, v), before = kindOf(field.Values, v);
+        if (gridDistance(v, w) <= tolerance)
+        {
+          saddleNearW += now > 0 ? now : 0;
+          saddlesNearWBefore += before > 0 ? before : 0;
+        }
+        if (now != before && gridDistance(v, w) > tolerance)
+        {
+          ++differences;
+        }
+      }
+      PlanarScalarField after = field;
+      after.Values = values;
+      MorseSmaleComplex found;
+      CHECK(extraction.Extract(after, found, error));
+      const TopologyComparison comparison =
+        CompareCriticalPoints(expected, CriticalPointLocations(found, field.Points), tolerance, &mesh);
+      if (kept != 1 || saddleNearW != saddlesNearWBefore || differences != 0 || !comparison.Identical())
+      {
+        std::printf("  seed %llu%s, saddle (%lld, %lld) off to (%lld, %lld): walked %d, %lld saddles near it, "
+                    "%lld other changes, %zu missing\n", static_cast<unsigned long long>(seed),
+          randomDiagonals ? " (random diagonals)" : "",
+          static_cast<long long>(w % n), static_cast<long long>(w / n), static_cast<long long>(at % n),
+          static_cast<long long>(at / n), kept, static_cast<long long>(saddleNearW),
+          static_cast<long long>(differences), comparison.Missing.size());
+      }
+      CHECK_EQ(kept, 1);
+      CHECK_EQ(saddleNearW, saddlesNearWBefore);
+      CHECK_EQ(differences, 0);
+      CHECK(comparison.Identical());
+    }
+  }
+  std::printf("  %d saddles walked two steps off their node on seeded noise (%d on random diagonals), %d "
+              "walked back\n", displaced, onRandomDiagonals, walked);
+  CHECK(displaced >= 40);
+  CHECK(onRandomDiagonals >= 15);
 }
 
 int main()
