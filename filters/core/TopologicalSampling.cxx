@@ -1848,15 +1848,12 @@ TopologicalSamplingReport TopologicalSampling::Apply(const PlanarScalarField& sa
   int walkedSaddles = 0;
   if (this->WalkSpareSaddles)
   {
+    // The verdict's list: at the nodes themselves (on a finer grid a node need not be a vertex),
+    // each on its vertex of this sampling.
     std::vector<CriticalPointLocation> expected = CriticalPointLocations(this->Complex, this->ComplexPoints);
     for (CriticalPointLocation& location : expected)
     {
       location.Vertex = location.Vertex >= 0 ? vertexAt(location.Vertex) : InvalidIndex;
-      if (location.Vertex >= 0 && location.Vertex < mesh.NumberOfVertices())
-      {
-        location.Position[0] = sampling.Points[2 * location.Vertex];
-        location.Position[1] = sampling.Points[2 * location.Vertex + 1];
-      }
     }
     walkedSaddles = WalkSpareSaddlesOntoMissing(
       mesh, sampling.Points, expected, this->Spacing * (1 + 1e-9), values, this->Parallel);
