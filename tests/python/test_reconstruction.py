@@ -48,21 +48,16 @@ def field_range_of(fd):
 # crossings between its samples.)
 INTERPOLATION_MISSES = {}
 KNOWN_MISSES = {
-    # TOPOSPLINE_LARGE_TESTS=1 only:
-    "rainier_ned1_1970_full.vti 25% k=4": "topology verdict off (a critical point off its node)",
-    "rainier_ned1_1970_full.vti 25% k=7": "topology verdict off (a critical point off its node)",
-    "argudo_glaciers_sthelens_10m.vti 2% k=4": "one 2-cell not reconstructed (a slit lies outside the outline); "
-    "its minimum is lost",
-    "argudo_glaciers_sthelens_10m.vti 2% k=7": "one 2-cell not reconstructed (a slit lies outside the outline); "
-    "its minimum is lost",
-    "argudo_glaciers_sthelens_10m.vti 5% k=4": "one 2-cell not reconstructed (a slit lies outside the outline); "
-    "its minimum is lost",
-    "argudo_glaciers_sthelens_10m.vti 5% k=7": "one 2-cell not reconstructed (a slit lies outside the outline); "
-    "its minimum is lost",
-    "argudo_glaciers_sthelens_10m.vti 25% k=4": "one 2-cell not reconstructed (a slit lies outside the outline); "
-    "its minimum is lost",
-    "argudo_glaciers_sthelens_10m.vti 25% k=7": "one 2-cell not reconstructed (a slit lies outside the outline); "
-    "its minimum is lost",
+    # TOPOSPLINE_LARGE_TESTS=1 only (measured again in Session 36: every 2-cell is reconstructed,
+    # the verdict misses one saddle next to the boundary, at (1444, 1), whose saddle the sampling
+    # puts two vertices away at (1446, 0), on all six runs; the full Rainier DEM at 25 %, once
+    # listed, verifies at k = 4 and 7, with the version before too).
+    "argudo_glaciers_sthelens_10m.vti 2% k=4": "topology verdict off (a saddle by the boundary two vertices off)",
+    "argudo_glaciers_sthelens_10m.vti 2% k=7": "topology verdict off (a saddle by the boundary two vertices off)",
+    "argudo_glaciers_sthelens_10m.vti 5% k=4": "topology verdict off (a saddle by the boundary two vertices off)",
+    "argudo_glaciers_sthelens_10m.vti 5% k=7": "topology verdict off (a saddle by the boundary two vertices off)",
+    "argudo_glaciers_sthelens_10m.vti 25% k=4": "topology verdict off (a saddle by the boundary two vertices off)",
+    "argudo_glaciers_sthelens_10m.vti 25% k=7": "topology verdict off (a saddle by the boundary two vertices off)",
 }
 
 
