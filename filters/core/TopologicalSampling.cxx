@@ -2390,11 +2390,8 @@ struct SpareSaddleWalk
   // A vertex and its link: the lower stars a change of the vertex's value can change.
   std::vector<Index> StarOf(Index c) const
   {
-    std::vector<Index> star{ c };
-    for (Index w : VertexLink(this->Mesh, c))
-    {
-      star.push_back(w);
-    }
+    std::vector<Index> star = LinkOf(this->Mesh, c);
+    star.insert(star.begin(), c); // c first: the walks' steps are tried in this order among equals
     return star;
   }
 

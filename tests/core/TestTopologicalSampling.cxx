@@ -1264,15 +1264,7 @@ TEST_CASE(ASpareSaddleWalksOntoItsMissingNode)
     else
     {
       mesh.BuildGrid(n, n, SequentialFor);
-      field.Triangles.clear();
-      for (int j = 0; j + 1 < n; ++j)
-      {
-        for (int i = 0; i + 1 < n; ++i)
-        {
-          const Index a = j * n + i; // the grid's split along (i+1, j)-(i, j+1)
-          field.Triangles.insert(field.Triangles.end(), { a, a + 1, a + n, a + 1, a + n + 1, a + n });
-        }
-      }
+      field.Triangles = GridTriangles(n, n); // for the test's own link count; the field stays an image
     }
     // The test's own classification of an interior vertex from the triangles (its link walked
     // round as a cycle; ties by vertex id): -1 minimum, -2 maximum, else the saddles.
