@@ -162,6 +162,7 @@ constexpr const char* SamplingBlockedWaysUp = "SamplingBlockedWaysUp";
 constexpr const char* SamplingMovedBoundarySaddles = "SamplingMovedBoundarySaddles";
 constexpr const char* SamplingMovedInteriorSaddles = "SamplingMovedInteriorSaddles";
 constexpr const char* SamplingWalkedSaddles = "SamplingWalkedSaddles";
+constexpr const char* SamplingKeptExact = "SamplingKeptExact";
 // Spurious critical points of F o Phi at the input vertices, within two grid spacings of a
 // smoothed 1-cell and farther.
 constexpr const char* RawSpuriousNearOneCells = "RawSpuriousNearOneCells";

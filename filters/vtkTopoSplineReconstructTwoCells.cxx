@@ -304,6 +304,7 @@ void WriteReport(const topospline::FieldReconstructionReport& report, vtkFieldDa
     AddFieldNumbers(fd, names::SamplingMovedBoundarySaddles, { static_cast<double>(report.Sampling.MovedBoundarySaddles) });
     AddFieldNumbers(fd, names::SamplingMovedInteriorSaddles, { static_cast<double>(report.Sampling.MovedInteriorSaddles) });
     AddFieldNumbers(fd, names::SamplingWalkedSaddles, { static_cast<double>(report.Sampling.WalkedSaddles) });
+    AddFieldNumbers(fd, names::SamplingKeptExact, { report.Sampling.KeptExact ? 1.0 : 0.0 });
   }
   if (!report.VerificationRan)
   {

@@ -52,6 +52,9 @@ struct TopologicalSamplingReport
   int MovedInteriorSaddles = 0;
   // Spare saddles walked onto wanted ones still off their nodes (WalkSpareSaddlesOntoMissing).
   int WalkedSaddles = 0;
+  // The sampling matched the complex worse than F o Phi at the same vertices, which was kept
+  // unchanged (TopologicalSampling::Apply, last step).
+  bool KeptExact = false;
   // The sampling stopped between two of its passes because an abort was requested (Hooks):
   // the values are those of the last pass done, not a finished sampling.
   bool Aborted = false;
@@ -140,7 +143,8 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
 // blocked). Interior saddles still off their nodes are then wanted one edge away in turn
 // (MoveDisplacedSaddles; kept if fewer wanted points are missing), and spare saddles a few edges
 // from wanted ones still unmatched are walked onto them (WalkSpareSaddlesOntoMissing), before the
-// changed vertices are relaxed toward F o Phi. The complex side is fixed at
+// changed vertices are relaxed toward F o Phi (F o Phi itself is kept where the verdict's
+// matching pairs more of its critical points: KeepExactWhenBetter). The complex side is fixed at
 // construction; Apply samples one sampling of the reconstruction (the input vertices, a finer
 // grid).
 // `complexPoints` (x, y per vertex of `complexMesh`) tells where the nodes are: on a sampling
@@ -183,6 +187,9 @@ public:
   // Spare saddles walked onto wanted ones still off their nodes, last (WalkSpareSaddlesOntoMissing);
   // off only to see the other steps alone.
   bool WalkSpareSaddles = true;
+  // F o Phi kept unchanged where its critical points match the complex better than the
+  // sampling's (by the verdict's matching); off only to see the sampling itself.
+  bool KeepExactWhenBetter = true;
   // A boundary junction's pit is the boundary pit its vertex falls into along the curve; where
   // that descent stops beside a node it may not take (a wanted boundary minimum lower than the
   // vertex it reached, which is then no pit), the junction's own vertex is made the pit.
@@ -284,6 +291,14 @@ int PlaceMissingSaddlesByTheirLinks(const PlanarScalarField& field, const Triang
 int WalkSpareSaddlesOntoMissing(const TriangleMeshTopology& mesh, const std::vector<double>& points,
   const std::vector<CriticalPointLocation>& expected, double tolerance, std::vector<double>& values,
   const ParallelFor& parallel = SequentialFor, int reachHops = 6, int maximumSteps = 12, int maximumTries = 200);
+
+// The critical points of `values` that the verdict's matching leaves unpaired: wanted points of
+// `expected` (CriticalPointLocations, with vertices of `mesh`) without a critical cell of
+// stage 1's lower-star rule within `tolerance` and their Hops, and critical cells without a
+// wanted point. 0: the verdict's comparison is identical.
+Index MismatchedCriticalPoints(const TriangleMeshTopology& mesh, const std::vector<double>& points,
+  const std::vector<CriticalPointLocation>& expected, double tolerance, const std::vector<double>& values,
+  const ParallelFor& parallel = SequentialFor);
 
 // Makes every wanted extremum an extremum again where a step before (a flood of the other
 // kind, a carved 1-cell, a saddle moved back) took that away: the vertex is moved just past its
