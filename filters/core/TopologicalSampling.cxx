@@ -2689,11 +2689,9 @@ Index MismatchedCriticalPoints(const TriangleMeshTopology& mesh, const std::vect
   const std::vector<CriticalPointLocation>& expected, double tolerance, const std::vector<double>& values,
   const ParallelFor& parallel)
 {
-  const std::vector<CriticalPointLocation> found = CriticalPointsOfLowerStars(points, LowerStarsOf(mesh, values, parallel));
-  const std::vector<std::size_t> partner = MatchCriticalPoints(expected, found, tolerance, &mesh, parallel);
-  const auto matched = static_cast<Index>(
-    std::count_if(partner.begin(), partner.end(), [](std::size_t f) { return f != UnmatchedCriticalPoint; }));
-  return static_cast<Index>(expected.size() + found.size()) - 2 * matched;
+  const TopologyComparison comparison = CompareCriticalPoints(
+    expected, CriticalPointsOfLowerStars(points, LowerStarsOf(mesh, values, parallel)), tolerance, &mesh, parallel);
+  return static_cast<Index>(comparison.Missing.size() + comparison.Spurious.size());
 }
 
 namespace

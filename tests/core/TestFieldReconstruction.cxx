@@ -1024,6 +1024,20 @@ std::vector<Index> SaddlesByTheBoundaryRule(
   return saddles;
 }
 
+// What a sampling of `complex` must have, counted as the closed-boundary rule counts: the
+// complex's nodes by index, and a minimum and a saddle per boundary junction.
+std::array<int, 3> WantedCounts(const MorseSmaleComplex& complex)
+{
+  std::array<int, 3> wanted{ { 0, 0, 0 } };
+  for (const CriticalPoint& cp : complex.CriticalPoints)
+  {
+    ++wanted[cp.MorseIndex];
+  }
+  wanted[0] += static_cast<int>(complex.BoundaryJunctions.size());
+  wanted[1] += static_cast<int>(complex.BoundaryJunctions.size());
+  return wanted;
+}
+
 // Minima, saddles (with multiplicity) and maxima of a sampling on a triangle mesh by the
 // closed-boundary rule, as SaddlesByTheBoundaryRule finds saddles: an interior vertex is a
 // minimum with no lower neighbour, a maximum with no higher one; a boundary vertex is a minimum
@@ -1348,13 +1362,7 @@ TEST_CASE(AJunctionBesideAOneTriangleCornerKeepsItsSaddle)
         CHECK(reconstruction.Run(p.Field, p.Simplified.Complex, p.Smoothed, report, error));
         const PlanarScalarField triangles = MeshFieldOnGrid(grid);
         // The counts first: the complex's nodes and a minimum and a saddle per junction.
-        std::array<int, 3> wanted{ { 0, 0, 0 } };
-        for (const CriticalPoint& cp : p.Simplified.Complex.CriticalPoints)
-        {
-          ++wanted[cp.MorseIndex];
-        }
-        wanted[0] += static_cast<int>(p.Simplified.Complex.BoundaryJunctions.size());
-        wanted[1] += static_cast<int>(p.Simplified.Complex.BoundaryJunctions.size());
+        const std::array<int, 3> wanted = WantedCounts(p.Simplified.Complex);
         const std::array<int, 3> counted = CriticalCountsByTheBoundaryRule(triangles, report.Values);
         const std::vector<Index> found = SaddlesByTheBoundaryRule(triangles, report.Values);
         const std::vector<int> hops(besideCorner.size(), 3);
@@ -1526,21 +1534,14 @@ TEST_CASE(StripsAndTinyGridsKeepTheComplexsCriticalPoints)
         }
         ++fields[p5];
         const PlanarScalarField triangles = MeshFieldOnGrid(grid);
-        std::array<int, 3> wanted{ { 0, 0, 0 } };
-        std::vector<Index> wantedSaddles;
+        const std::array<int, 3> wanted = WantedCounts(p.Simplified.Complex);
+        std::vector<Index> wantedSaddles = p.Simplified.Complex.BoundaryJunctions;
         for (const CriticalPoint& cp : p.Simplified.Complex.CriticalPoints)
         {
-          ++wanted[cp.MorseIndex];
           if (cp.MorseIndex == 1)
           {
             wantedSaddles.push_back(cp.Vertex);
           }
-        }
-        for (const Index junction : p.Simplified.Complex.BoundaryJunctions)
-        {
-          ++wanted[0];
-          ++wanted[1];
-          wantedSaddles.push_back(junction);
         }
         const std::array<int, 3> counted = CriticalCountsByTheBoundaryRule(triangles, report.Values);
         const std::vector<Index> found = SaddlesByTheBoundaryRule(triangles, report.Values);
