@@ -43,7 +43,11 @@ public:
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
   //@{
-  /** c: samples per boundary Bezier segment for the triangulation (the paper uses 5). */
+  /**
+   * c: samples per boundary Bezier segment for the triangulation (the paper uses 5); with the
+   * fitted interior, fewer on the short pieces around small 2-cells (at most one per half input
+   * edge, FieldReconstruction::BoundarySampleEdges).
+   */
   vtkSetMacro(BoundarySamples, int);
   vtkGetMacro(BoundarySamples, int);
   //@}

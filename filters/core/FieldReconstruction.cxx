@@ -357,6 +357,10 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
   const double edge = MeanEdgeLength(field);
   this->Cells.MinimumMeshEdgeLength = 2 * edge;
   this->Cells.NegligibleArea = edge * edge;
+  // The paper's interior keeps the paper's c on every segment (Table 1 as the paper defines it).
+  this->Cells.BoundarySampleSpacing = this->Interior == TwoCellInterior::Fitted && this->BoundarySampleEdges > 0
+    ? this->BoundarySampleEdges * edge / std::max(1, this->OutputResolution)
+    : 0;
   this->Cells.Interior = this->Interior;
   this->Cells.AlternativeMapStrength = this->AlternativeMapStrength;
   this->Cells.MemoryBudget = this->MemoryBudget;

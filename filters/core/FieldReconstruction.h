@@ -85,6 +85,10 @@ class FieldReconstruction
 {
 public:
   int BoundarySamples = 5;     // c in the paper: samples per boundary Bezier segment
+  // Fitted interiors: no more boundary samples than one per this fraction of the input's mean
+  // edge length (divided by OutputResolution) where c per segment would put them closer
+  // (TwoCellReconstruction::BoundarySampleSpacing); the paper's interior, or <= 0: c everywhere.
+  double BoundarySampleEdges = 0.5;
   int OutputResolution = 1;    // finer grid: input spacing / OutputResolution; 1: none
   // The 2-cell interiors (TwoCellReconstruction::Interior): fitted to the input by default, the
   // paper's boundary-only construction on request (Table 1 as the paper defines it).

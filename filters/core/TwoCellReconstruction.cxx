@@ -369,6 +369,57 @@ bool AssembleTwoCellSides(const TwoCell& cell, const OneCellSmoothingResult& smo
   return PairEmptySides(sides, error) && PiecesHaveCurves(sides, smoothed, error);
 }
 
+std::vector<int> BoundarySamplesPerPiece(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
+  int c, double spacing, Index fewerVerticesThan)
+{
+  std::vector<int> samples(smoothed.Pieces.size(), c);
+  if (!(spacing > 0))
+  {
+    return samples;
+  }
+  // The most vertices of a 2-cell beside each piece: of the cells its 1-cells bound.
+  std::vector<Index> largestCell(smoothed.Pieces.size(), 0);
+  for (const TwoCell& cell : complex.TwoCells)
+  {
+    for (const Index o : cell.BoundaryOneCells)
+    {
+      if (o >= 0 && o < static_cast<Index>(smoothed.PiecesOfOneCell.size()))
+      {
+        for (const Index p : smoothed.PiecesOfOneCell[o])
+        {
+          if (p >= 0 && p < static_cast<Index>(largestCell.size()))
+          {
+            largestCell[p] = std::max(largestCell[p], cell.NumberOfVertices);
+          }
+        }
+      }
+    }
+  }
+  for (std::size_t p = 0; p < samples.size(); ++p)
+  {
+    const SmoothedPiece& piece = smoothed.Pieces[p];
+    if (largestCell[p] >= fewerVerticesThan || piece.Curve.Dimension != 2)
+    {
+      continue;
+    }
+    double longest = 0;
+    for (int j = 0; j < piece.Curve.Segments; ++j)
+    {
+      const double* b = piece.Curve.Segment(j);
+      double length = 0;
+      for (int m = 0; m < 3; ++m)
+      {
+        length += std::hypot(b[2 * m + 2] - b[2 * m], b[2 * m + 3] - b[2 * m + 1]);
+      }
+      longest = std::max(longest, length);
+    }
+    // Compared as doubles: a curve too long for an int keeps c.
+    const double wanted = std::ceil(longest / spacing);
+    samples[p] = wanted < c ? std::max(1, static_cast<int>(wanted)) : c;
+  }
+  return samples;
+}
+
 int ChooseGridLayout(const std::array<SideSegments, 4>& sides, int maximum, std::array<std::vector<int>, 4>& multipliers)
 {
   int lowest = 1;
@@ -705,14 +756,15 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
 
   // Pass 1 (the paper's "time II"): sides, boundary samples, triangulation, parameterization.
   auto start = Clock::now();
-  const std::vector<int> samplesPerPiece(smoothed.Pieces.size(), this->BoundarySamples);
+  const std::vector<int> samplesPerPiece =
+    BoundarySamplesPerPiece(complex, smoothed, this->BoundarySamples, this->BoundarySampleSpacing, SparseSamplesBelowVertices);
   ForEachCellInSlices(n, this->Parallel, this->Hooks, 0.0, 0.65, [&](Index begin, Index end) {
     for (Index c = begin; c < end && !this->Hooks.Aborted(); ++c)
     {
       this->ParameterizeCell(complex.TwoCells[c], smoothed, samplesPerPiece, *this->Cells[c], boundaries[c]);
     }
   });
-  this->DensifyFailedBoundaries(complex, smoothed, boundaries);
+  this->DensifyFailedBoundaries(complex, smoothed, samplesPerPiece, boundaries);
   if (this->Hooks.Aborted())
   {
     error = "aborted";
@@ -828,10 +880,10 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
 }
 
 void TwoCellReconstruction::DensifyFailedBoundaries(const MorseSmaleComplex& complex,
-  const OneCellSmoothingResult& smoothed, std::vector<MonotoneSurfaceBoundary>& boundaries)
+  const OneCellSmoothingResult& smoothed, std::vector<int> samplesPerPiece,
+  std::vector<MonotoneSurfaceBoundary>& boundaries)
 {
   const Index n = static_cast<Index>(this->Cells.size());
-  std::vector<int> samplesPerPiece(smoothed.Pieces.size(), this->BoundarySamples);
   // Up to 2^BoundaryDensifications times the samples, but no denser than 64 per segment (a
   // failing cell with hundreds of segments would otherwise get millions of samples when c is
   // already large).

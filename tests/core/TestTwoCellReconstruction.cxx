@@ -57,6 +57,47 @@ PlanarScalarField Resample(const TwoCellReconstruction& r, const GridField& grid
   return field;
 }
 
+// The largest difference between the values two cells give the midpoint of a boundary edge
+// they share (edges are matched by their end points, bit for bit); `sharedEdges` counts them.
+double WorstJumpAcrossSharedEdges(const TwoCellReconstruction& r, Index& sharedEdges)
+{
+  std::map<std::array<double, 4>, std::pair<Index, double>> edges;
+  double worstJump = 0;
+  sharedEdges = 0;
+  for (Index c = 0; c < r.NumberOfCells(); ++c)
+  {
+    if (!r.Cell(c).Valid)
+    {
+      continue;
+    }
+    const TwoCellMesh& mesh = r.Cell(c).Parameterization.GetMesh();
+    for (Index i = 0; i < mesh.BoundaryCount; ++i)
+    {
+      const Index j = (i + 1) % mesh.BoundaryCount;
+      std::array<double, 4> key = { mesh.Points[2 * i], mesh.Points[2 * i + 1], mesh.Points[2 * j],
+        mesh.Points[2 * j + 1] };
+      if (std::make_pair(key[2], key[3]) < std::make_pair(key[0], key[1]))
+      {
+        key = { key[2], key[3], key[0], key[1] };
+      }
+      const double u = 0.5 * (mesh.Parameters[2 * i] + mesh.Parameters[2 * j]);
+      const double v = 0.5 * (mesh.Parameters[2 * i + 1] + mesh.Parameters[2 * j + 1]);
+      const double value = r.Cell(c).Surface.Evaluate(u, v);
+      const auto found = edges.find(key);
+      if (found == edges.end())
+      {
+        edges[key] = { c, value };
+      }
+      else if (found->second.first != c)
+      {
+        ++sharedEdges;
+        worstJump = std::max(worstJump, std::abs(found->second.second - value));
+      }
+    }
+  }
+  return worstJump;
+}
+
 // Runs the whole check on one input; returns a one-line summary.
 void CheckReconstruction(const char* name, const GridField& grid, double percent, int k, bool fineCheck,
   bool allCellsRequired = true, bool positionsRequired = false)
@@ -109,40 +150,8 @@ void CheckReconstruction(const char* name, const GridField& grid, double percent
   CHECK(worstCorner <= tolerance);
 
   // Continuity: the midpoint of every boundary edge shared by two cells has one value.
-  std::map<std::array<double, 4>, std::pair<Index, double>> edges;
-  double worstJump = 0;
   Index sharedEdges = 0;
-  for (Index c = 0; c < r.NumberOfCells(); ++c)
-  {
-    if (!r.Cell(c).Valid)
-    {
-      continue;
-    }
-    const TwoCellMesh& mesh = r.Cell(c).Parameterization.GetMesh();
-    for (Index i = 0; i < mesh.BoundaryCount; ++i)
-    {
-      const Index j = (i + 1) % mesh.BoundaryCount;
-      std::array<double, 4> key = { mesh.Points[2 * i], mesh.Points[2 * i + 1], mesh.Points[2 * j],
-        mesh.Points[2 * j + 1] };
-      if (std::make_pair(key[2], key[3]) < std::make_pair(key[0], key[1]))
-      {
-        key = { key[2], key[3], key[0], key[1] };
-      }
-      const double u = 0.5 * (mesh.Parameters[2 * i] + mesh.Parameters[2 * j]);
-      const double v = 0.5 * (mesh.Parameters[2 * i + 1] + mesh.Parameters[2 * j + 1]);
-      const double value = r.Cell(c).Surface.Evaluate(u, v);
-      const auto found = edges.find(key);
-      if (found == edges.end())
-      {
-        edges[key] = { c, value };
-      }
-      else if (found->second.first != c)
-      {
-        ++sharedEdges;
-        worstJump = std::max(worstJump, std::abs(found->second.second - value));
-      }
-    }
-  }
+  const double worstJump = WorstJumpAcrossSharedEdges(r, sharedEdges);
   CHECK(sharedEdges > 0);
   CHECK(worstJump <= tolerance);
 
@@ -618,6 +627,116 @@ TEST_CASE(SurfacesOverTheMemoryBudgetAreRefusedWithTheEstimate)
   error.clear();
   CHECK(enough.Reconstruct(p.Simplified.Complex, p.Smoothed, error));
   CHECK_EQ(enough.Report().BezierTriangles, unlimited.Report().BezierTriangles);
+}
+
+// On noise a 2-cell is a few grid spacings across: c samples per segment put its boundary
+// samples a tenth of a spacing apart. With BoundarySampleSpacing the pieces around small cells
+// get fewer, no further apart along the curve than that spacing (arc lengths measured here by
+// dense sampling), the pieces beside a cell of 64 vertices or more (counted here from
+// TwoCellId) keep c, and the reconstruction stays whole: every cell valid, one value on every
+// boundary edge two cells share, every vertex in a cell, with far fewer mesh triangles.
+TEST_CASE(ShortPiecesAroundSmallCellsGetFewerBoundarySamples)
+{
+  for (const std::uint64_t seed : { 3u, 11u })
+  {
+    // Noise on the right half, a smooth ramp on the left: both kinds of cells in one field.
+    GridField grid = UniformNoise(48, seed);
+    for (int j = 0; j < 48; ++j)
+    {
+      for (int i = 0; i < 20; ++i)
+      {
+        grid.Values[j * 48 + i] = 0.3 * std::sin(0.15 * i) * std::cos(0.13 * j) + 0.01 * grid.Values[j * 48 + i];
+      }
+    }
+    Pipeline p;
+    std::string error;
+    CHECK(RunStages1To3(grid, 2, 4, p, error));
+    const MorseSmaleComplex& complex = p.Simplified.Complex;
+    const int c = 5;
+    const double spacing = 0.5; // half the grid spacing
+    const std::vector<int> samples =
+      BoundarySamplesPerPiece(complex, p.Smoothed, c, spacing, TwoCellReconstruction::SparseSamplesBelowVertices);
+    CHECK_EQ(samples.size(), p.Smoothed.Pieces.size());
+
+    std::vector<Index> verticesOfCell(complex.TwoCells.size(), 0);
+    for (const Index cell : complex.TwoCellId)
+    {
+      if (cell >= 0 && cell < static_cast<Index>(verticesOfCell.size()))
+      {
+        ++verticesOfCell[cell];
+      }
+    }
+    std::vector<char> besideLargeCell(samples.size(), 0);
+    for (std::size_t cell = 0; cell < complex.TwoCells.size(); ++cell)
+    {
+      for (const Index o : complex.TwoCells[cell].BoundaryOneCells)
+      {
+        if (verticesOfCell[cell] >= TwoCellReconstruction::SparseSamplesBelowVertices && o >= 0)
+        {
+          for (const Index piece : p.Smoothed.PiecesOfOneCell[o])
+          {
+            besideLargeCell[piece] = 1;
+          }
+        }
+      }
+    }
+    Index fewer = 0, large = 0, tooFarApart = 0, largeReduced = 0;
+    for (std::size_t piece = 0; piece < samples.size(); ++piece)
+    {
+      CHECK(samples[piece] >= 1 && samples[piece] <= c);
+      fewer += samples[piece] < c ? 1 : 0;
+      large += besideLargeCell[piece];
+      largeReduced += besideLargeCell[piece] && samples[piece] < c ? 1 : 0;
+      const CubicBezierSpline& curve = p.Smoothed.Pieces[piece].Curve;
+      for (int j = 0; j < curve.Segments && samples[piece] < c; ++j)
+      {
+        double length = 0, previous[2], point[2];
+        CubicBezierSpline::EvaluateSegment(curve.Segment(j), 2, 0, previous);
+        for (int m = 1; m <= 256; ++m)
+        {
+          CubicBezierSpline::EvaluateSegment(curve.Segment(j), 2, m / 256.0, point);
+          length += std::hypot(point[0] - previous[0], point[1] - previous[1]);
+          previous[0] = point[0];
+          previous[1] = point[1];
+        }
+        tooFarApart += length / samples[piece] > spacing * (1 + 1e-9) ? 1 : 0;
+      }
+    }
+    std::printf("  seed %llu: %zu pieces, %d with fewer than c samples, %d beside a large cell (%d of them "
+                "reduced), %d segments sampled too sparsely\n",
+      static_cast<unsigned long long>(seed), samples.size(), fewer, large, largeReduced, tooFarApart);
+    CHECK(fewer > static_cast<Index>(samples.size()) / 2);
+    CHECK(large > 0);
+    CHECK_EQ(largeReduced, 0);
+    CHECK_EQ(tooFarApart, 0);
+
+    TwoCellReconstruction dense, sparse;
+    dense.SnapDistance = sparse.SnapDistance = std::sqrt(2.0);
+    sparse.BoundarySampleSpacing = spacing;
+    CHECK(dense.Reconstruct(complex, p.Smoothed, error));
+    CHECK(sparse.Reconstruct(complex, p.Smoothed, error));
+    CHECK_EQ(sparse.Report().FailedCells, 0);
+    CHECK_EQ(sparse.Report().ViolatingPatches, 0);
+    CHECK(2 * sparse.Report().MeshTriangles < dense.Report().MeshTriangles);
+    Index sharedEdges = 0;
+    const double worstJump = WorstJumpAcrossSharedEdges(sparse, sharedEdges);
+    CHECK(sharedEdges > 0);
+    CHECK(worstJump <= 1e-9 * p.Range);
+    Index missed = 0;
+    double largestDifference = 0;
+    for (std::size_t v = 0; v < p.Field.Values.size(); ++v)
+    {
+      const auto a = sparse.Evaluate(p.Field.Points[2 * v], p.Field.Points[2 * v + 1], complex.TwoCellId[v]);
+      const auto b = dense.Evaluate(p.Field.Points[2 * v], p.Field.Points[2 * v + 1], complex.TwoCellId[v]);
+      missed += a.Cell == InvalidIndex ? 1 : 0;
+      largestDifference = std::max(largestDifference, std::abs(a.Value - b.Value));
+    }
+    std::printf("  mesh triangles %d -> %d, %d shared edges (largest jump %.2g), %d vertices in no cell, "
+                "largest difference from c everywhere %.3g of the range\n",
+      dense.Report().MeshTriangles, sparse.Report().MeshTriangles, sharedEdges, worstJump, missed,
+      largestDifference / p.Range);
+    CHECK_EQ(missed, 0);
+  }
 }
 
 int main()
