@@ -786,6 +786,9 @@ bool ReadSmoothedOneCells(vtkMultiBlockDataSet* input, const topospline::MorseSm
         return false;
       }
       smoothed.PiecesOfOneCell[a].push_back(p);
+      // The same relation from the pieces' side, as stage 3 fills it (stage 4 once looked for
+      // a piece's cells through it and found it empty).
+      smoothed.Pieces[p].OneCells.push_back(static_cast<Index>(a));
     }
   }
   return true;
