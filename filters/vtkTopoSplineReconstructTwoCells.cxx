@@ -425,7 +425,7 @@ int vtkTopoSplineReconstructTwoCells::RequestData(
   reconstruction.OutputResolution = this->OutputResolution;
   reconstruction.TopologicalSampling = this->TopologicalSampling != 0;
   reconstruction.VerifyTopology = this->VerifyTopology != 0;
-  // The surfaces' own check, once their grid sizes are known (FitsInMemory counts cells only);
+  // The surfaces' own check, once their grid sizes are known (FitsInMemory counts vertices and cells only);
   // half of what is available: the sampling, verification and outputs come on top.
   reconstruction.MemoryBudget = 0.5 * available;
   reconstruction.Parallel = conversion::SMPParallelFor();
@@ -467,7 +467,7 @@ bool vtkTopoSplineReconstructTwoCells::FitsInMemory(vtkIdType points, std::size_
   const double f = this->OutputResolution;
   const double finer = f > 1 ? static_cast<double>(points) * f * f : 0.0;
   const double cells = static_cast<double>(twoCells);
-  const double needed = topospline::FieldReconstruction::MemoryEstimate(cells, finer);
+  const double needed = topospline::FieldReconstruction::MemoryEstimate(static_cast<double>(points), cells, finer);
   if (available > 0 && needed > 0.8 * available)
   {
     vtkErrorMacro("Reconstruct 2-Cells: " << cells << " 2-cells" << (f > 1 ? " and the finer sampling" : "")

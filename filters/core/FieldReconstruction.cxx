@@ -115,9 +115,9 @@ bool BuildMesh(const PlanarScalarField& field, TriangleMeshTopology& mesh, const
   return mesh.Build(static_cast<Index>(field.Points.size() / 2), field.Triangles, parallel, error);
 }
 
-double FieldReconstruction::MemoryEstimate(double cells, double finerPoints)
+double FieldReconstruction::MemoryEstimate(double vertices, double cells, double finerPoints)
 {
-  return 30e3 * cells + 260.0 * finerPoints;
+  return 800.0 * vertices + 6.5e3 * cells + 260.0 * finerPoints;
 }
 
 GridField FieldReconstruction::FinerGrid(const PlanarScalarField& field) const

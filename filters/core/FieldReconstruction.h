@@ -117,13 +117,21 @@ public:
   // not reuse). Optional.
   std::function<void()> ReleaseFreedMemory;
 
-  // About how many bytes the reconstruction of `cells` 2-cells and a finer grid of
-  // `finerPoints` points take (measured on uniform noise at 5 %, k = 4, 5 000 to 45 000 cells:
-  // 19-25 kB per cell for its triangulation, parameterization and Sibson node data, since the
-  // Bezier elements are made when evaluated; taken as 30 kB. The Bezier Patches output comes on
-  // top, at most MaximumPatchTriangles of about 600 bytes. About 260 bytes per finer point for
-  // its values, mask and critical point check).
-  static double MemoryEstimate(double cells, double finerPoints);
+  // About how many bytes the reconstruction of `cells` 2-cells over an input of `vertices`
+  // vertices and a finer grid of `finerPoints` points take, on top of what is resident before
+  // it: 800 bytes per input vertex (its evaluation and sampling arrays, the mesh, and the
+  // cells' meshes and fits, whose size follows the input where cells are large), 6.5 kB per
+  // cell (a cell's sides, walk, mesh, map and Sibson node data, since the Bezier elements are
+  // made when evaluated) and 260 bytes per finer point (its values, mask and critical point
+  // check). Measured as the peak resident memory of stage 4 above the memory before it
+  // (2026-12-06): uniform noise at 5 %, k = 4 (two vertices per cell), 7.1-7.2 kB per cell at
+  // 300², 500² and 1000² (1000²: 3.63 GB; this estimate 4.09); a jittered-grid mesh of noise
+  // 8.0 kB per cell; smooth inputs 380-960 bytes per vertex (the 2000² terrain at 2 %: 1.53 GB,
+  // estimate 3.2; the Rainier crop at 2 %, k = 7; a Shepard field at 25 %; a 500² jittered-grid
+  // mesh at 2 %: 0.24 GB, estimate 0.21). The filter refuses above 80 % of the available
+  // memory. The Bezier Patches output comes on top, at most MaximumPatchTriangles of about 600
+  // bytes.
+  static double MemoryEstimate(double vertices, double cells, double finerPoints);
 
   // Reconstructs `complex` (smoothed into `smoothed`) over `field` (the input). Works in
   // complex.Frame; the report's positions are in the field's coordinates. Fails only on

@@ -177,4 +177,20 @@ for name, (body, expected, points) in RECONSTRUCTION_CASES.items():
         checks.check("POINTS %d" % points in output, "%s: empty output (%s)" % (name, output[-300:]))
     else:
         checks.check("POINTS 100" in output or "POINTS 16" in output, "%s: output on the input geometry" % name)
+
+# The other side of the up-front refusal: a run the estimate says fits is not refused. 100 x 100
+# uniform noise at 5 % has about 5000 2-cells, and stage 4 holds about 7 kB per such cell (35 MB,
+# docs/Reconstruction.md); with 100 MB counted as available the estimate (800 bytes per vertex,
+# 6.5 kB per cell: 40 MB) stays below the 80 MB it may use. The estimate of 30 kB per cell that
+# it replaced (150 MB) refused this run.
+FITTING = ("import os; os.environ['TOPOSPLINE_MEMORY_LIMIT'] = '1e8'\n"
+           "ms = Reconstruct2Cells(Input=Smooth1Cells(Input=SimplifyMorseSmaleComplex(Input=MorseSmaleComplex("
+           "Input=producer(image(np.random.default_rng(5).uniform(0, 1, 10000), (100, 100, 1)))), "
+           "PersistenceThreshold=5)))")
+result = subprocess.run(["pvpython", "--force-offscreen-rendering", "-c", PRELUDE + FITTING + RECONSTRUCTION_EPILOGUE],
+                        capture_output=True, text=True, timeout=300)
+output = result.stdout + result.stderr
+checks.equal(result.returncode, 0, "within the memory limit: exits cleanly (output: %s)" % output[-500:])
+checks.check("GB available" not in output, "within the memory limit: not refused (output: %s)" % output[-500:])
+checks.check("POINTS 10000" in output, "within the memory limit: output on the input geometry (%s)" % output[-300:])
 checks.finish()
