@@ -269,7 +269,9 @@ bool MonotoneSibsonSurface::Build(
 
   // Values: the Laplace equation, then the paper's fallback where it does not increase.
   this->SolveLaplaceValues();
-  this->LaplaceZ = this->Z;
+  // Kept for the report only (MaximumValueShift), not with the surface: half a million noise
+  // cells held a copy each.
+  const std::vector<double> laplaceZ = this->Z;
   this->LinearizeNonIncreasingDiagonals(construction);
 
   // Derivatives, from minimal choice and estimates, limited per cell then per diagonal.
@@ -294,7 +296,7 @@ bool MonotoneSibsonSurface::Build(
   for (int k = 0; k < nodeCount; ++k)
   {
     this->BuildReport.MaximumValueShift =
-      std::max(this->BuildReport.MaximumValueShift, std::abs(this->Z[k] - this->LaplaceZ[k]));
+      std::max(this->BuildReport.MaximumValueShift, std::abs(this->Z[k] - laplaceZ[k]));
   }
 
   this->BuildReport.ViolatingCells = this->CountViolatingCells();

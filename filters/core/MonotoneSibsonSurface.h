@@ -189,8 +189,6 @@ public:
   double NodeValue(int i, int j) const { return this->Z[this->Node(i, j)]; }
   double NodeP(int i, int j) const { return this->P[this->Node(i, j)]; }
   double NodeQ(int i, int j) const { return this->Q[this->Node(i, j)]; }
-  // The Laplace values before any correction (interior nodes), for diagnostics.
-  double LaplaceValue(int i, int j) const { return this->LaplaceZ[this->Node(i, j)]; }
   SibsonCellData GetCellData(int i, int j) const;
   // The element of grid cell (i, j), made from the node data when asked: storing all N^2 of
   // them took 400 bytes per element, and a cell of a noisy field can need N in the hundreds.
@@ -255,7 +253,7 @@ private:
     std::string& error);
 
   int N = 0;
-  std::vector<double> Z, P, Q, LaplaceZ;
+  std::vector<double> Z, P, Q;
   MonotoneSurfaceFitReport Fit;
   MonotoneSurfaceReport BuildReport;
 };

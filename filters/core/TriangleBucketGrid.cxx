@@ -8,9 +8,13 @@
 
 namespace topospline
 {
-void TriangleBucketGrid::Build(const std::vector<double>& coordinates, const std::vector<Index>& triangleList)
+void TriangleBucketGrid::Build(
+  const std::vector<double>& coordinates, const std::vector<Index>& triangleList, Index scanBelow)
 {
   TriangleBucketGrid& grid = *this;
+  grid.ScanAll = false;
+  grid.Start.clear();
+  grid.Triangles.clear();
   const Index points = static_cast<Index>(coordinates.size() / 2);
   const Index triangles = static_cast<Index>(triangleList.size() / 3);
   double bounds[4] = { coordinates[0], coordinates[0], coordinates[1], coordinates[1] };
@@ -27,12 +31,17 @@ void TriangleBucketGrid::Build(const std::vector<double>& coordinates, const std
   // About one triangle per grid cell, cells roughly square, at most 1024 a side (thin cells
   // get a thin grid).
   const double cellSize = std::sqrt(width * height / std::max<Index>(triangles, 1));
+  grid.ScanAll = triangles <= scanBelow;
   for (int d = 0; d < 2; ++d)
   {
     const double extent = d == 0 ? width : height;
-    grid.Size[d] = static_cast<int>(std::min(1024.0, std::max(1.0, std::ceil(extent / cellSize))));
+    grid.Size[d] = grid.ScanAll ? 1 : static_cast<int>(std::min(1024.0, std::max(1.0, std::ceil(extent / cellSize))));
     grid.Origin[d] = bounds[2 * d] - grid.Tolerance;
     grid.CellSize[d] = (extent + 2 * grid.Tolerance) / grid.Size[d];
+  }
+  if (grid.ScanAll)
+  {
+    return;
   }
   auto cellOf = [&grid](double value, int d) {
     const double c = std::floor((value - grid.Origin[d]) / grid.CellSize[d]);
@@ -161,12 +170,14 @@ bool TriangleBucketGrid::Locate(const std::vector<double>& coordinates, const st
     cell[d] = static_cast<int>(c);
   }
   const std::size_t c = static_cast<std::size_t>(cell[1]) * grid.Size[0] + cell[0];
+  const Index first = grid.ScanAll ? 0 : grid.Start[c];
+  const Index last = grid.ScanAll ? static_cast<Index>(triangleList.size() / 3) : grid.Start[c + 1];
   // The triangle in which (x, y) is deepest (largest smallest barycentric coordinate, scaled
   // to a distance) wins, so that points on shared edges get a definite answer.
   double best = -std::numeric_limits<double>::infinity();
-  for (Index k = grid.Start[c]; k < grid.Start[c + 1]; ++k)
+  for (Index k = first; k < last; ++k)
   {
-    const Index t = grid.Triangles[k];
+    const Index t = grid.ScanAll ? k : grid.Triangles[k];
     const Index* tri = &triangleList[3 * t];
     const double* a = &coordinates[2 * tri[0]];
     const double* b = &coordinates[2 * tri[1]];

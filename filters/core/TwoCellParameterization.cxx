@@ -1442,7 +1442,9 @@ bool TwoCellParameterization::Parameterize(
   mesh.Points.shrink_to_fit();
   mesh.Parameters.shrink_to_fit();
   mesh.Triangles.shrink_to_fit();
-  this->PointGrid.Build(mesh.Points, mesh.Triangles);
+  // Small meshes are scanned whole (TriangleBucketGrid::ScanAll): a cell of uniform noise has a
+  // few dozen triangles and is located a few times, at its own vertices.
+  this->PointGrid.Build(mesh.Points, mesh.Triangles, ScannedMeshTriangles);
   return true;
 }
 

@@ -156,6 +156,9 @@ public:
   };
   Inverse MakeInverse() const { return Inverse(this->Mesh); }
 
+  // Meshes of at most this many triangles get no buckets for Locate: every triangle is tried.
+  static constexpr Index ScannedMeshTriangles = 64;
+
 private:
   TwoCellMesh Mesh;
   TriangleBucketGrid PointGrid; // over (x, y): Locate, Evaluate

@@ -6,6 +6,7 @@
 #include "DeterministicRandom.h"
 #include "PiecewiseLinearField.h"
 #include "TestHarness.h"
+#include "TriangleBucketGrid.h"
 #include "TwoCellParameterization.h"
 
 #include <algorithm>
@@ -1949,6 +1950,92 @@ TEST_CASE(FieldGradientWeightedMapsAreOneToOne)
               "map %.4f, along the level sets %.4f, along the gradient %.4f\n",
     before, after[0], after[1]);
   CHECK(after[1] < 0.5 * before);
+}
+
+// A small mesh is located by trying every triangle (TriangleBucketGrid::ScanAll, the 2-cells of
+// noise since 2026-12-06) instead of its buckets: the answer must be the buckets' own, bit for
+// bit, for points inside, on vertices and edges, just outside by rounding and beyond the
+// tolerance, in (x, y) and in the (mirrored) parameter square.
+TEST_CASE(SmallMeshesScannedWholeLocateAsTheirBuckets)
+{
+  Random random(77);
+  int meshes = 0, queries = 0, found = 0;
+  for (int n : { 8, 12, 20, 40, 90 })
+  {
+    for (const bool mirrored : { false, true })
+    {
+      const Cell cell = MakeCell(PerturbedCirclePoints(n, random), mirrored);
+      TwoCellParameterization tcp;
+      std::string error;
+      CHECK(tcp.Parameterize(cell.Points, cell.Parameters, error));
+      const TwoCellMesh& mesh = tcp.GetMesh();
+      for (const bool inSquare : { false, true })
+      {
+        const std::vector<double>& coordinates = inSquare ? mesh.Parameters : mesh.Points;
+        const int orientation = inSquare ? mesh.Orientation : 1;
+        TriangleBucketGrid buckets, scanned;
+        buckets.Build(coordinates, mesh.Triangles);
+        scanned.Build(coordinates, mesh.Triangles, mesh.NumberOfTriangles());
+        CHECK(!buckets.ScanAll && scanned.ScanAll && scanned.Triangles.empty());
+        ++meshes;
+        double box[4] = { coordinates[0], coordinates[0], coordinates[1], coordinates[1] };
+        for (Index v = 0; v < mesh.NumberOfPoints(); ++v)
+        {
+          box[0] = std::min(box[0], coordinates[2 * v]);
+          box[1] = std::max(box[1], coordinates[2 * v]);
+          box[2] = std::min(box[2], coordinates[2 * v + 1]);
+          box[3] = std::max(box[3], coordinates[2 * v + 1]);
+        }
+        const double size = std::max(box[1] - box[0], box[3] - box[2]);
+        std::vector<std::array<double, 2>> points;
+        for (int k = 0; k < 400; ++k)
+        {
+          points.push_back({ random.Uniform(box[0] - 0.1 * size, box[1] + 0.1 * size),
+            random.Uniform(box[2] - 0.1 * size, box[3] + 0.1 * size) });
+        }
+        for (Index t = 0; t < mesh.NumberOfTriangles(); ++t)
+        {
+          for (int e = 0; e < 3; ++e)
+          {
+            const double* a = &coordinates[2 * mesh.Triangles[3 * t + e]];
+            const double* b = &coordinates[2 * mesh.Triangles[3 * t + (e + 1) % 3]];
+            const double f = random.Uniform();
+            points.push_back({ a[0], a[1] });
+            points.push_back({ a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]) });
+            // Off the edge's line by rounding, by a little less and a little more than the
+            // tolerance (1e-9 of the size), and by far more.
+            const double length = std::hypot(b[0] - a[0], b[1] - a[1]);
+            for (double off : { 1e-15, 0.9e-9, 1.1e-9, 1e-3 })
+            {
+              for (double side : { -1.0, 1.0 })
+              {
+                const double d = side * off * size / length;
+                points.push_back({ a[0] + f * (b[0] - a[0]) - d * (b[1] - a[1]), a[1] + f * (b[1] - a[1]) + d * (b[0] - a[0]) });
+              }
+            }
+          }
+        }
+        for (const auto& p : points)
+        {
+          Index t0 = -7, t1 = -7;
+          double l0[3] = { -1, -1, -1 }, l1[3] = { -1, -1, -1 };
+          const bool f0 = buckets.Locate(coordinates, mesh.Triangles, orientation, p[0], p[1], t0, l0);
+          const bool f1 = scanned.Locate(coordinates, mesh.Triangles, orientation, p[0], p[1], t1, l1);
+          CHECK_EQ(f0, f1);
+          CHECK_EQ(t0, t1);
+          if (f0 && f1)
+          {
+            CHECK(l0[0] == l1[0] && l0[1] == l1[1] && l0[2] == l1[2]);
+          }
+          ++queries;
+          found += f0 ? 1 : 0;
+        }
+      }
+    }
+  }
+  std::printf("  %d meshes, %d points located, %d inside: the same triangle and coordinates either way\n", meshes,
+    queries, found);
+  CHECK(found > queries / 4 && found < queries);
 }
 
 int main()
