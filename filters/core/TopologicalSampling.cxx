@@ -1419,12 +1419,15 @@ SamplingConstraints ComplexConstraints(const MorseSmaleComplex& complex, const T
 
 namespace
 {
-// The smoothed 1-cells of the complex, each sampled from its saddle out to `radius`, at
-// least 16 points per cubic segment and at most `step` apart.
+// Samples per cubic segment of a smoothed piece, at least, where 1-cells are sampled for the
+// carving and for moving saddles back.
+constexpr int OneCellSamplesPerSegment = 16;
+
+// The smoothed 1-cells of the complex, each sampled from its saddle out to `radius`,
+// OneCellSamplesPerSegment points per cubic segment.
 std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
-  const std::function<Index(Index)>& vertexAt, double radius, double step, const ParallelFor& parallel)
+  const std::function<Index(Index)>& vertexAt, double radius, const ParallelFor& parallel)
 {
-  constexpr int samplesPerSegment = 16;
   const Index oneCells =
     std::min(static_cast<Index>(complex.OneCells.size()), static_cast<Index>(smoothed.PiecesOfOneCell.size()));
   // Each 1-cell is sampled on its own: in parallel over stretches of them, joined in order.
@@ -1449,18 +1452,7 @@ std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, cons
     for (std::size_t k = 0; k < pieces.size() && !outside; ++k)
     {
       const SmoothedPiece& piece = smoothed.Pieces[pieces[k]];
-      int count = std::max(1, piece.Segments) * samplesPerSegment;
-      if (std::isfinite(step))
-      {
-        double length = 0, previous[2], xy[2];
-        piece.Curve.Evaluate(0, previous);
-        for (int s = 1; s <= count; ++s, previous[0] = xy[0], previous[1] = xy[1])
-        {
-          piece.Curve.Evaluate(static_cast<double>(s) / count, xy);
-          length += std::hypot(xy[0] - previous[0], xy[1] - previous[1]);
-        }
-        count = std::max(count, static_cast<int>(std::ceil(length / step)));
-      }
+      const int count = std::max(1, piece.Segments) * OneCellSamplesPerSegment;
       for (int s = (k == 0 ? 0 : 1); s <= count && !outside; ++s)
       {
         const double t = ascending ? static_cast<double>(s) / count : 1 - static_cast<double>(s) / count;
@@ -1472,12 +1464,138 @@ std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, cons
     }
     if (cell.Points.size() >= 6)
     {
-      // Every 1-cell's samples are kept through the sampling (a third of stage 4's peak on
-      // noise); they grew by doubling.
       cell.Points.shrink_to_fit();
       cells.push_back(std::move(cell));
     }
   });
+}
+
+// Every smoothed 1-cell of the complex, whole, at least OneCellSamplesPerSegment points per cubic
+// segment and at most `step` apart, as runs of one store in which each piece is sampled once
+// per direction (from its lower end for ascending 1-cells, from its upper end for descending
+// ones). The points are those a 1-cell sampled on its own gets, bit for bit: the same count per
+// piece and the same parameters (s / count, 1 - s / count); a piece after the first contributes
+// from its second point on.
+std::vector<SaddleOneCell> SampleOneCellsSharingPieces(const MorseSmaleComplex& complex,
+  const OneCellSmoothingResult& smoothed, const std::function<Index(Index)>& vertexAt, double step,
+  const ParallelFor& parallel, std::vector<double>& store)
+{
+  const Index oneCells =
+    std::min(static_cast<Index>(complex.OneCells.size()), static_cast<Index>(smoothed.PiecesOfOneCell.size()));
+  const Index pieceCount = static_cast<Index>(smoothed.Pieces.size());
+  std::vector<Index> saddleOf(oneCells, InvalidIndex);
+  std::vector<char> used(2 * static_cast<std::size_t>(pieceCount), 0); // [2 p + ascending]
+  for (Index a = 0; a < oneCells; ++a)
+  {
+    const OneCell& oneCell = complex.OneCells[a];
+    const bool ascending = oneCell.Type == OneCell::Ascending;
+    saddleOf[a] = vertexAt(complex.CriticalPoints[ascending ? oneCell.Source : oneCell.Destination].Vertex);
+    if (saddleOf[a] == InvalidIndex)
+    {
+      continue;
+    }
+    for (Index p : smoothed.PiecesOfOneCell[a])
+    {
+      used[2 * static_cast<std::size_t>(p) + (ascending ? 1 : 0)] = 1;
+    }
+  }
+  // Points per piece: OneCellSamplesPerSegment per segment, more where the curve is longer
+  // than that many steps (its length measured along those samples).
+  std::vector<int> count(pieceCount, 0);
+  parallel(0, pieceCount, [&](Index begin, Index end) {
+    for (Index p = begin; p < end; ++p)
+    {
+      if (!used[2 * p] && !used[2 * p + 1])
+      {
+        continue;
+      }
+      const SmoothedPiece& piece = smoothed.Pieces[p];
+      count[p] = std::max(1, piece.Segments) * OneCellSamplesPerSegment;
+      double length = 0, previous[2], xy[2];
+      piece.Curve.Evaluate(0, previous);
+      for (int s = 1; s <= count[p]; ++s, previous[0] = xy[0], previous[1] = xy[1])
+      {
+        piece.Curve.Evaluate(static_cast<double>(s) / count[p], xy);
+        length += std::hypot(xy[0] - previous[0], xy[1] - previous[1]);
+      }
+      count[p] = std::max(count[p], static_cast<int>(std::ceil(length / step)));
+    }
+  });
+  std::vector<std::size_t> offset(2 * static_cast<std::size_t>(pieceCount) + 1, 0);
+  for (std::size_t k = 0; k < used.size(); ++k)
+  {
+    offset[k + 1] = offset[k] + (used[k] ? 3 * (static_cast<std::size_t>(count[k / 2]) + 1) : 0);
+  }
+  store.assign(offset.back(), 0.0);
+  parallel(0, pieceCount, [&](Index begin, Index end) {
+    for (Index p = begin; p < end; ++p)
+    {
+      const SmoothedPiece& piece = smoothed.Pieces[p];
+      for (const bool ascending : { false, true })
+      {
+        const std::size_t k = 2 * static_cast<std::size_t>(p) + (ascending ? 1 : 0);
+        double* out = store.data() + offset[k];
+        for (int s = 0; used[k] && s <= count[p]; ++s, out += 3)
+        {
+          const double t = ascending ? static_cast<double>(s) / count[p] : 1 - static_cast<double>(s) / count[p];
+          piece.Curve.Evaluate(t, out);
+          out[2] = piece.Height.Value(t);
+        }
+      }
+    }
+  });
+  std::vector<SaddleOneCell> cells;
+  for (Index a = 0; a < oneCells; ++a)
+  {
+    if (saddleOf[a] == InvalidIndex)
+    {
+      continue;
+    }
+    SaddleOneCell cell;
+    cell.Saddle = saddleOf[a];
+    cell.Ascending = complex.OneCells[a].Type == OneCell::Ascending;
+    // Pieces run from the lower end to the higher one: away from the saddle along an ascending
+    // 1-cell, towards it along a descending one.
+    std::vector<Index> pieces = smoothed.PiecesOfOneCell[a];
+    if (!cell.Ascending)
+    {
+      std::reverse(pieces.begin(), pieces.end());
+    }
+    std::size_t doubles = 0;
+    for (std::size_t i = 0; i < pieces.size(); ++i)
+    {
+      const std::size_t k = 2 * static_cast<std::size_t>(pieces[i]) + (cell.Ascending ? 1 : 0);
+      cell.Runs.emplace_back(offset[k] + (i == 0 ? 0 : 3), offset[k + 1]);
+      doubles += cell.Runs.back().second - cell.Runs.back().first;
+    }
+    if (doubles >= 6)
+    {
+      cells.push_back(std::move(cell));
+    }
+  }
+  return cells;
+}
+
+// visit(point) for every point (x, y, height) of `cell`, in order: its own Points, or its Runs
+// of `shared`.
+template <typename Visit>
+void ForEachOneCellPoint(const SaddleOneCell& cell, const std::vector<double>* shared, const Visit& visit)
+{
+  if (cell.Runs.empty())
+  {
+    for (std::size_t i = 0; i + 2 < cell.Points.size(); i += 3)
+    {
+      visit(&cell.Points[i]);
+    }
+    return;
+  }
+  for (const auto& [first, last] : cell.Runs)
+  {
+    for (std::size_t i = first; i + 2 < last; i += 3)
+    {
+      visit(shared->data() + i);
+    }
+  }
 }
 } // namespace
 
@@ -1487,8 +1605,7 @@ void AddSaddleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingR
   const std::function<Index(Index)>& vertexAt, double radius, SamplingConstraints& constraints,
   const ParallelFor& parallel)
 {
-  std::vector<SaddleOneCell> cells =
-    SampleOneCells(complex, smoothed, vertexAt, radius, std::numeric_limits<double>::infinity(), parallel);
+  std::vector<SaddleOneCell> cells = SampleOneCells(complex, smoothed, vertexAt, radius, parallel);
   std::move(cells.begin(), cells.end(), std::back_inserter(constraints.SaddleOneCells));
 }
 } // namespace
@@ -1499,9 +1616,11 @@ void AddOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult&
   const std::function<Index(Index)>& vertexAt, double step, SamplingConstraints& constraints,
   const ParallelFor& parallel)
 {
-  std::vector<SaddleOneCell> cells =
-    SampleOneCells(complex, smoothed, vertexAt, std::numeric_limits<double>::infinity(), step, parallel);
-  std::move(cells.begin(), cells.end(), std::back_inserter(constraints.OneCells));
+  // One store for all: constraints.OneCells holds no 1-cell of its own points before this.
+  auto store = std::make_shared<std::vector<double>>();
+  std::vector<SaddleOneCell> cells = SampleOneCellsSharingPieces(complex, smoothed, vertexAt, step, parallel, *store);
+  constraints.OneCells = std::move(cells);
+  constraints.SharedOneCellSamples = std::move(store);
 }
 } // namespace
 
@@ -3171,30 +3290,29 @@ double Ask(OneCellCarving carving, Index v, double height, double previous, bool
 // neighbour is nearer to it, and asks each vertex walked onto for the 1-cell's height there.
 // Vertices `avoided` claims (if given) are walked round; the vertices asked and the heights
 // asked of them go to `out`.
-void AskAlongOneCell(const CarvingGround& ground, const SaddleOneCell& cell, const std::vector<double>& values,
-  OneCellCarving carving, const CarvingClaims* avoided, WalkedRequests& out)
+void AskAlongOneCell(const CarvingGround& ground, const SaddleOneCell& cell, const std::vector<double>* shared,
+  const std::vector<double>& values, OneCellCarving carving, const CarvingClaims* avoided, WalkedRequests& out)
 {
-  const std::vector<double>& q = cell.Points;
-  const double* start = &q[0];
+  const double* start = nullptr;
   Index current = cell.Saddle;
   double previous = values[cell.Saddle];
-  for (std::size_t i = 0; i + 2 < q.size(); i += 3)
-  {
+  ForEachOneCellPoint(cell, shared, [&](const double* q) {
+    start = start ? start : q;
     for (;;)
     {
-      const Index nearest = ground.NearerNeighbour(current, &q[i], cell.Ascending, avoided);
+      const Index nearest = ground.NearerNeighbour(current, q, cell.Ascending, avoided);
       if (nearest == current)
       {
         break;
       }
       current = nearest;
       if (!ground.LeftAlone(current, start) &&
-        !(carving != OneCellCarving::Everywhere && cell.Ascending && ground.BoundaryCarries(current, q[i + 2], values)))
+        !(carving != OneCellCarving::Everywhere && cell.Ascending && ground.BoundaryCarries(current, q[2], values)))
       {
-        previous = Ask(carving, current, q[i + 2], previous, cell.Ascending, values, out.Asked);
+        previous = Ask(carving, current, q[2], previous, cell.Ascending, values, out.Asked);
       }
     }
-  }
+  });
   out.Start.push_back(static_cast<Index>(out.Asked.size()));
 }
 
@@ -3204,13 +3322,14 @@ void AskAlongOneCell(const CarvingGround& ground, const SaddleOneCell& cell, con
 // (nullptr: none). Returns the stretches in the order of the cells.
 template <typename Avoided>
 std::vector<WalkedRequests> WalkOneCells(const CarvingGround& ground, const std::vector<SaddleOneCell>& cells,
-  const std::vector<double>& values, OneCellCarving carving, const Avoided& avoidedOf, const ParallelFor& parallel)
+  const std::vector<double>* shared, const std::vector<double>& values, OneCellCarving carving,
+  const Avoided& avoidedOf, const ParallelFor& parallel)
 {
   constexpr Index stretch = 256;
   const Index count = static_cast<Index>(cells.size());
   std::vector<WalkedRequests> stretches(static_cast<std::size_t>(StretchesOf(count, stretch)));
   ForEachInStretches(count, stretch, parallel, [&](Index c, Index part) {
-    AskAlongOneCell(ground, cells[c], values, carving, avoidedOf(cells[c]), stretches[part]);
+    AskAlongOneCell(ground, cells[c], shared, values, carving, avoidedOf(cells[c]), stretches[part]);
   });
   return stretches;
 }
@@ -3261,9 +3380,10 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
     }
   }
   const std::vector<SaddleOneCell>& cells = constraints.OneCells;
+  const std::vector<double>* shared = constraints.SharedOneCellSamples.get();
   CarvingClaims raiseTo(true, vertices), lowerTo(false, vertices);
   const auto none = [](const SaddleOneCell&) -> const CarvingClaims* { return nullptr; };
-  const std::vector<WalkedRequests> walks = WalkOneCells(ground, cells, values, carving, none, parallel);
+  const std::vector<WalkedRequests> walks = WalkOneCells(ground, cells, shared, values, carving, none, parallel);
   ClaimWalked(cells, walks, raiseTo, lowerTo);
   // Where a ridge and a valley run within a spacing of each other (nearly flat data, a thin
   // 2-cell between them), one vertex can be the nearest to both: both claim it, it keeps its
@@ -3288,7 +3408,7 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
     const auto avoided = [&](const SaddleOneCell& cell) -> const CarvingClaims* {
       return !rewalk[&cell - cells.data()] ? nullptr : cell.Ascending ? &lowerTo : &raiseTo;
     };
-    ClaimWalked(cells, WalkOneCells(ground, cells, values, carving, avoided, parallel), againRaise, againLower);
+    ClaimWalked(cells, WalkOneCells(ground, cells, shared, values, carving, avoided, parallel), againRaise, againLower);
   }
   CarvingClaims& raise = anyRewalk ? againRaise : raiseTo;
   CarvingClaims& lower = anyRewalk ? againLower : lowerTo;

@@ -27,6 +27,8 @@
 #include "TriangleMeshTopology.h"
 
 #include <functional>
+#include <memory>
+#include <utility>
 #include <vector>
 
 namespace topospline
@@ -67,6 +69,11 @@ struct SaddleOneCell
   Index Saddle = InvalidIndex; // the saddle's vertex in the sampling
   bool Ascending = false;
   std::vector<double> Points;
+  // Or, with Points empty, the same points as runs [first, last) of a store that 1-cells
+  // sharing smoothed pieces share (SamplingConstraints::SharedOneCellSamples, offsets in
+  // doubles), in order: merged 1-cells share their first pieces, and on uniform noise their
+  // own copies of those samples were a third of stage 4's peak.
+  std::vector<std::pair<std::size_t, std::size_t>> Runs;
 };
 
 struct SamplingConstraints
@@ -82,6 +89,8 @@ struct SamplingConstraints
   std::vector<SaddleOneCell> SaddleOneCells;
   // Optional, for CarveOneCells: every smoothed 1-cell of the complex, whole (AddOneCells).
   std::vector<SaddleOneCell> OneCells;
+  // The store of the OneCells given as Runs (each smoothed piece sampled once per direction).
+  std::shared_ptr<const std::vector<double>> SharedOneCellSamples;
 };
 
 

@@ -27,6 +27,7 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <random>
 #include <string>
@@ -1041,6 +1042,87 @@ TEST_CASE(ABlockedBoundarySaddleMovesOneStepAlongTheBoundary)
   CHECK(found[2] == std::vector<Index>{ top });
   CHECK(std::find(found[1].begin(), found[1].end(), free) != found[1].end());
   CHECK(std::find(found[1].begin(), found[1].end(), saddle) == found[1].end());
+}
+
+TEST_CASE(OneCellsAsRunsOfASharedStoreCarveAsTheirOwnPoints)
+{
+  // Stage 4 gives CarveOneCells every smoothed 1-cell as runs of one store in which each piece
+  // is sampled once (merged 1-cells share their first pieces), not as points of its own. Here
+  // a family of 1-cells on noise, several of them sharing a first stretch (a merged stem), is
+  // carved once as points and once as runs that point into one store for the shared stretches:
+  // every vertex must end with the same value, bit for bit, for every carving.
+  const int nx = 60, ny = 48;
+  std::mt19937 generator(2026);
+  std::uniform_real_distribution<double> noise(0, 1);
+  PlanarScalarField field = UnitGrid(nx, ny, [&](int, int) { return noise(generator); });
+  TriangleMeshTopology mesh;
+  mesh.BuildGrid(nx, ny, SequentialFor);
+  auto vertexNear = [&](double x, double y) { return static_cast<Index>(std::lround(y)) * nx + std::lround(x); };
+  SamplingConstraints own, shared;
+  auto store = std::make_shared<std::vector<double>>();
+  for (int family = 0; family < 6; ++family)
+  {
+    const bool up = family % 2 == 1;
+    const double y0 = 6 + 7 * family, phase = 0.7 * family;
+    // The stem: from the saddle at x = 4 to x = 20, shared by three branches.
+    std::vector<double> stem;
+    for (double x = 4; x <= 20 + 1e-9; x += 0.45)
+    {
+      stem.insert(stem.end(), { x, y0 + 0.8 * std::sin(0.3 * x + phase), (up ? 1e-2 : -1e-2) * x });
+    }
+    const std::size_t stemFirst = store->size();
+    store->insert(store->end(), stem.begin(), stem.end());
+    const std::size_t stemLast = store->size();
+    for (int branch = 0; branch < 3; ++branch)
+    {
+      std::vector<double> rest;
+      const double yEnd = stem[stem.size() - 2];
+      for (double x = 20.4; x <= 50 + 1e-9; x += 0.45)
+      {
+        rest.insert(rest.end(), { x, yEnd + (branch - 1) * 0.12 * (x - 20), (up ? 1e-2 : -1e-2) * x });
+      }
+      SaddleOneCell points;
+      points.Ascending = up;
+      points.Saddle = vertexNear(stem[0], stem[1]);
+      points.Points = stem;
+      points.Points.insert(points.Points.end(), rest.begin(), rest.end());
+      SaddleOneCell runs = points;
+      runs.Points.clear();
+      // The stem and then the branch's own stretch, each in runs of a few points (pieces of a
+      // few samples): a walk that lost or repeated a point at a run's end would go elsewhere.
+      for (std::size_t first = stemFirst; first < stemLast; first += 9)
+      {
+        runs.Runs.emplace_back(first, std::min(first + 9, stemLast));
+      }
+      const std::size_t restFirst = store->size();
+      store->insert(store->end(), rest.begin(), rest.end());
+      for (std::size_t first = restFirst; first < store->size(); first += 12)
+      {
+        runs.Runs.emplace_back(first, std::min(first + 12, store->size()));
+      }
+      own.OneCells.push_back(points);
+      shared.OneCells.push_back(runs);
+      const Index end = vertexNear(rest[rest.size() - 3], rest[rest.size() - 2]);
+      for (SamplingConstraints* c : { &own, &shared })
+      {
+        c->Saddles.push_back(points.Saddle);
+        (up ? c->Maxima : c->Minima).push_back(end);
+      }
+    }
+  }
+  shared.SharedOneCellSamples = store;
+  for (const OneCellCarving carving :
+    { OneCellCarving::JustPastTheWalk, OneCellCarving::WhereNeeded, OneCellCarving::Everywhere })
+  {
+    std::vector<double> a = field.Values, b = field.Values;
+    const Index changedA = CarveOneCells(field, mesh, own, 1.0, a, carving);
+    const Index changedB = CarveOneCells(field, mesh, shared, 1.0, b, carving);
+    std::printf("  carving %d: %d vertices changed from the points, %d from the runs\n", static_cast<int>(carving),
+      static_cast<int>(changedA), static_cast<int>(changedB));
+    CHECK(changedA > 100);
+    CHECK_EQ(changedA, changedB);
+    CHECK(a == b);
+  }
 }
 
 TEST_CASE(AValleyBesideARidgeGoesRoundTheVerticesBothClaim)
