@@ -125,7 +125,8 @@ public:
   // made when evaluated) and 260 bytes per finer point (its values, mask and critical point
   // check). Measured as the peak resident memory of stage 4 above the memory before it
   // (2026-12-06): uniform noise at 5 %, k = 4 (two vertices per cell), 7.1-7.2 kB per cell at
-  // 300², 500² and 1000² (1000²: 3.63 GB; this estimate 4.09); a jittered-grid mesh of noise
+  // 300², 500² and 1000² (1000²: 3.63 GB; this estimate 4.09), 5.8 kB at 1000² since stage 4
+  // holds less (2.94 GB; docs/Reconstruction.md, "Where the rest of stage 4 goes"); a jittered-grid mesh of noise
   // 8.0 kB per cell; smooth inputs 380-960 bytes per vertex (the 2000² terrain at 2 %: 1.53 GB,
   // estimate 3.2; the Rainier crop at 2 %, k = 7; a Shepard field at 25 %; a 500² jittered-grid
   // mesh at 2 %: 0.24 GB, estimate 0.21). The filter refuses above 80 % of the available
