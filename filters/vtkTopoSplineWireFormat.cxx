@@ -739,24 +739,10 @@ bool ReadSmoothedOneCells(vtkMultiBlockDataSet* input, const topospline::MorseSm
   }
   smoothed = topospline::OneCellSmoothingResult();
   smoothed.Pieces.resize(pieces);
-  // Every piece's arrays at their final sizes: grown segment by segment, half a million pieces
-  // of 1000 x 1000 noise made tens of millions of allocations and kept a third more than needed.
-  std::vector<Index> segmentsOf(pieces, 0);
-  for (vtkIdType c = 0; c < block->GetNumberOfCells(); ++c)
+  for (auto& p : smoothed.Pieces)
   {
-    const Index p = static_cast<Index>(piece->GetComponent(c, 0));
-    if (p >= 0)
-    {
-      ++segmentsOf[p];
-    }
-  }
-  for (Index p = 0; p < pieces; ++p)
-  {
-    auto& smoothedPiece = smoothed.Pieces[p];
-    smoothedPiece.Curve.Dimension = 2;
-    smoothedPiece.Height.Dimension = 1;
-    smoothedPiece.Curve.ControlPoints.reserve(8 * static_cast<std::size_t>(segmentsOf[p]));
-    smoothedPiece.Height.ControlPoints.reserve(4 * static_cast<std::size_t>(segmentsOf[p]));
+    p.Curve.Dimension = 2;
+    p.Height.Dimension = 1;
   }
   const auto plane = conversion::PlaneOf(SegmentationOf(input));
   vtkNew<vtkIdList> ids;
@@ -787,24 +773,10 @@ bool ReadSmoothedOneCells(vtkMultiBlockDataSet* input, const topospline::MorseSm
     ++smoothedPiece.Height.Segments;
   }
   smoothed.PiecesOfOneCell.resize(oneCells);
-  std::vector<Index> oneCellsOf(pieces, 0);
-  for (vtkIdType i = 0; i < list->GetNumberOfTuples(); ++i)
-  {
-    const Index p = static_cast<Index>(list->GetComponent(i, 0));
-    if (p >= 0 && p < pieces)
-    {
-      ++oneCellsOf[p];
-    }
-  }
-  for (Index p = 0; p < pieces; ++p)
-  {
-    smoothed.Pieces[p].OneCells.reserve(oneCellsOf[p]);
-  }
   for (vtkIdType a = 0; a < oneCells; ++a)
   {
     const vtkIdType begin = static_cast<vtkIdType>(offsets->GetComponent(a, 0));
     const vtkIdType end = static_cast<vtkIdType>(offsets->GetComponent(a + 1, 0));
-    smoothed.PiecesOfOneCell[a].reserve(static_cast<std::size_t>(std::max<vtkIdType>(0, std::min(end, list->GetNumberOfTuples()) - begin)));
     for (vtkIdType i = begin; i < end && i < list->GetNumberOfTuples(); ++i)
     {
       const Index p = static_cast<Index>(list->GetComponent(i, 0));

@@ -1423,6 +1423,25 @@ namespace
 // carving and for moving saddles back.
 constexpr int OneCellSamplesPerSegment = 16;
 
+// 1-cell a's pieces from its lower end to its higher one: away from the saddle along an
+// ascending 1-cell, towards it along a descending one.
+std::vector<Index> PiecesFromLowerEnd(const OneCellSmoothingResult& smoothed, Index a, bool ascending)
+{
+  std::vector<Index> pieces = smoothed.PiecesOfOneCell[a];
+  if (!ascending)
+  {
+    std::reverse(pieces.begin(), pieces.end());
+  }
+  return pieces;
+}
+
+// The curve parameter of sample s of `count` along a piece, walked from the 1-cell's saddle:
+// both samplers below use it, so that a piece's samples are the same bit for bit in either.
+double WalkParameter(int s, int count, bool ascending)
+{
+  return ascending ? static_cast<double>(s) / count : 1 - static_cast<double>(s) / count;
+}
+
 // The smoothed 1-cells of the complex, each sampled from its saddle out to `radius`,
 // OneCellSamplesPerSegment points per cubic segment.
 std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, const OneCellSmoothingResult& smoothed,
@@ -1441,13 +1460,7 @@ std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, cons
     {
       return;
     }
-    // Pieces run from the lower end to the higher one: away from the saddle along an ascending
-    // 1-cell, towards it along a descending one.
-    std::vector<Index> pieces = smoothed.PiecesOfOneCell[a];
-    if (!ascending)
-    {
-      std::reverse(pieces.begin(), pieces.end());
-    }
+    const std::vector<Index> pieces = PiecesFromLowerEnd(smoothed, a, ascending);
     bool outside = false;
     for (std::size_t k = 0; k < pieces.size() && !outside; ++k)
     {
@@ -1455,7 +1468,7 @@ std::vector<SaddleOneCell> SampleOneCells(const MorseSmaleComplex& complex, cons
       const int count = std::max(1, piece.Segments) * OneCellSamplesPerSegment;
       for (int s = (k == 0 ? 0 : 1); s <= count && !outside; ++s)
       {
-        const double t = ascending ? static_cast<double>(s) / count : 1 - static_cast<double>(s) / count;
+        const double t = WalkParameter(s, count, ascending);
         double xy[2];
         piece.Curve.Evaluate(t, xy);
         cell.Points.insert(cell.Points.end(), { xy[0], xy[1], piece.Height.Value(t) });
@@ -1537,7 +1550,7 @@ std::vector<SaddleOneCell> SampleOneCellsSharingPieces(const MorseSmaleComplex& 
         double* out = store.data() + offset[k];
         for (int s = 0; used[k] && s <= count[p]; ++s, out += 3)
         {
-          const double t = ascending ? static_cast<double>(s) / count[p] : 1 - static_cast<double>(s) / count[p];
+          const double t = WalkParameter(s, count[p], ascending);
           piece.Curve.Evaluate(t, out);
           out[2] = piece.Height.Value(t);
         }
@@ -1554,13 +1567,7 @@ std::vector<SaddleOneCell> SampleOneCellsSharingPieces(const MorseSmaleComplex& 
     SaddleOneCell cell;
     cell.Saddle = saddleOf[a];
     cell.Ascending = complex.OneCells[a].Type == OneCell::Ascending;
-    // Pieces run from the lower end to the higher one: away from the saddle along an ascending
-    // 1-cell, towards it along a descending one.
-    std::vector<Index> pieces = smoothed.PiecesOfOneCell[a];
-    if (!cell.Ascending)
-    {
-      std::reverse(pieces.begin(), pieces.end());
-    }
+    const std::vector<Index> pieces = PiecesFromLowerEnd(smoothed, a, cell.Ascending);
     std::size_t doubles = 0;
     for (std::size_t i = 0; i < pieces.size(); ++i)
     {
