@@ -18,10 +18,13 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkSMPThreadLocalObject.h>
+#include <vtkSMPTools.h>
 #include <vtkStringArray.h>
 #include <vtkUnstructuredGrid.h>
 
 #include <algorithm>
+#include <atomic>
 
 namespace names = vtkTopoSplineArrayNames;
 namespace conversion = vtkTopoSplineDomainConversion;
@@ -360,34 +363,50 @@ bool ReadCriticalPoints(const ComplexArrays& in, topospline::MorseSmaleComplex& 
 bool ReadOneCells(const ComplexArrays& in, const conversion::DomainPlane& embedding, const PositionOfId& local,
   topospline::MorseSmaleComplex& complex, std::string& error)
 {
+  // Every 1-cell on its own, in parallel (1000^2 noise: about a million 1-cells, 1.5 s on one
+  // thread).
   vtkCellArray* lines = in.OneCells->GetLines();
-  vtkNew<vtkIdList> ids;
-  lines->InitTraversal();
-  for (vtkIdType a = 0; lines->GetNextCell(ids); ++a)
-  {
-    topospline::OneCell oneCell;
-    oneCell.Type = in.Type->GetComponent(a, 0) == 0 ? topospline::OneCell::Descending : topospline::OneCell::Ascending;
-    oneCell.Source = local(in.Source->GetComponent(a, 0));
-    oneCell.Destination = local(in.Destination->GetComponent(a, 0));
-    for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k)
+  const vtkIdType count = lines->GetNumberOfCells();
+  complex.OneCells.resize(static_cast<std::size_t>(count));
+  std::atomic<bool> missingEnd(false);
+  vtkSMPThreadLocalObject<vtkIdList> scratch;
+  vtkSMPTools::For(0, count, [&](vtkIdType begin, vtkIdType end) {
+    vtkIdList* copied = scratch.Local();
+    for (vtkIdType a = begin; a < end; ++a)
     {
-      double xyz[3];
-      in.OneCells->GetPoint(ids->GetId(k), xyz);
-      oneCell.Points.push_back(xyz[embedding.U]);
-      oneCell.Points.push_back(xyz[embedding.V]);
-      oneCell.Values.push_back(in.Along->GetComponent(ids->GetId(k), 0));
-      const auto c = static_cast<Index>(in.MeshCell->GetComponent(ids->GetId(k), 0));
-      if (c >= 0)
+      vtkIdType size = 0;
+      const vtkIdType* ids = nullptr;
+      lines->GetCellAtId(a, size, ids, copied);
+      topospline::OneCell& oneCell = complex.OneCells[a];
+      oneCell.Type = in.Type->GetComponent(a, 0) == 0 ? topospline::OneCell::Descending : topospline::OneCell::Ascending;
+      oneCell.Source = local(in.Source->GetComponent(a, 0));
+      oneCell.Destination = local(in.Destination->GetComponent(a, 0));
+      oneCell.Points.reserve(2 * size);
+      oneCell.Values.reserve(size);
+      oneCell.MeshCells.reserve(size);
+      for (vtkIdType k = 0; k < size; ++k)
       {
-        oneCell.MeshCells.push_back(c);
+        double xyz[3];
+        in.OneCells->GetPoint(ids[k], xyz);
+        oneCell.Points.push_back(xyz[embedding.U]);
+        oneCell.Points.push_back(xyz[embedding.V]);
+        oneCell.Values.push_back(in.Along->GetComponent(ids[k], 0));
+        const auto c = static_cast<Index>(in.MeshCell->GetComponent(ids[k], 0));
+        if (c >= 0)
+        {
+          oneCell.MeshCells.push_back(c);
+        }
+      }
+      if (oneCell.Source == topospline::InvalidIndex || oneCell.Destination == topospline::InvalidIndex)
+      {
+        missingEnd = true;
       }
     }
-    if (oneCell.Source == topospline::InvalidIndex || oneCell.Destination == topospline::InvalidIndex)
-    {
-      error = "the input is not a Morse-Smale complex: a 1-cell refers to a missing critical point";
-      return false;
-    }
-    complex.OneCells.push_back(std::move(oneCell));
+  });
+  if (missingEnd)
+  {
+    error = "the input is not a Morse-Smale complex: a 1-cell refers to a missing critical point";
+    return false;
   }
   return true;
 }
@@ -744,34 +763,46 @@ bool ReadSmoothedOneCells(vtkMultiBlockDataSet* input, const topospline::MorseSm
     p.Curve.Dimension = 2;
     p.Height.Dimension = 1;
   }
-  const auto plane = conversion::PlaneOf(SegmentationOf(input));
-  vtkNew<vtkIdList> ids;
-  for (vtkIdType c = 0; c < block->GetNumberOfCells(); ++c)
+  // Each Bezier cell's place in its piece: its piece's cells come in the order of the block.
+  // Then the cells in parallel, each to its own place (1000^2 noise: 3.3 million cells).
+  const vtkIdType cells = block->GetNumberOfCells();
+  std::vector<Index> pieceOf(static_cast<std::size_t>(cells));
+  std::vector<int> slotOf(static_cast<std::size_t>(cells));
+  for (vtkIdType c = 0; c < cells; ++c)
   {
-    block->GetCellPoints(c, ids);
-    const Index p = static_cast<Index>(piece->GetComponent(c, 0));
-    if (block->GetCellType(c) != VTK_BEZIER_CURVE || ids->GetNumberOfIds() != 4 || p < 0)
+    pieceOf[c] = static_cast<Index>(piece->GetComponent(c, 0));
+    if (pieceOf[c] < 0 || block->GetCellType(c) != VTK_BEZIER_CURVE || block->GetCellSize(c) != 4)
     {
       error = "the smoothed 1-cells are not cubic Bezier curves";
       return false;
     }
-    double uv[4][2], h[4];
-    for (int m = 0; m < 4; ++m)
-    {
-      double xyz[3];
-      block->GetPoint(ids->GetId(m), xyz);
-      plane.ToPlanar(xyz, uv[CurvePointOfVtkPoint[m]]);
-      h[CurvePointOfVtkPoint[m]] = height->GetComponent(ids->GetId(m), 0);
-    }
-    auto& smoothedPiece = smoothed.Pieces[p];
-    for (int k = 0; k < 4; ++k)
-    {
-      smoothedPiece.Curve.ControlPoints.insert(smoothedPiece.Curve.ControlPoints.end(), uv[k], uv[k] + 2);
-      smoothedPiece.Height.ControlPoints.push_back(h[k]);
-    }
-    ++smoothedPiece.Curve.Segments;
-    ++smoothedPiece.Height.Segments;
+    slotOf[c] = smoothed.Pieces[pieceOf[c]].Curve.Segments++;
   }
+  for (auto& p : smoothed.Pieces)
+  {
+    p.Height.Segments = p.Curve.Segments;
+    p.Curve.ControlPoints.resize(8 * static_cast<std::size_t>(p.Curve.Segments));
+    p.Height.ControlPoints.resize(4 * static_cast<std::size_t>(p.Height.Segments));
+  }
+  const auto plane = conversion::PlaneOf(SegmentationOf(input));
+  vtkSMPThreadLocalObject<vtkIdList> scratch;
+  vtkSMPTools::For(0, cells, [&](vtkIdType begin, vtkIdType end) {
+    vtkIdList* ids = scratch.Local();
+    for (vtkIdType c = begin; c < end; ++c)
+    {
+      block->GetCellPoints(c, ids);
+      auto& smoothedPiece = smoothed.Pieces[pieceOf[c]];
+      double* uv = smoothedPiece.Curve.ControlPoints.data() + 8 * static_cast<std::size_t>(slotOf[c]);
+      double* h = smoothedPiece.Height.ControlPoints.data() + 4 * static_cast<std::size_t>(slotOf[c]);
+      for (int m = 0; m < 4; ++m)
+      {
+        double xyz[3];
+        block->GetPoint(ids->GetId(m), xyz);
+        plane.ToPlanar(xyz, uv + 2 * CurvePointOfVtkPoint[m]);
+        h[CurvePointOfVtkPoint[m]] = height->GetComponent(ids->GetId(m), 0);
+      }
+    }
+  });
   smoothed.PiecesOfOneCell.resize(oneCells);
   for (vtkIdType a = 0; a < oneCells; ++a)
   {

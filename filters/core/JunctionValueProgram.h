@@ -48,6 +48,8 @@ public:
   // form (its value clamped to the bounds set by its fixed neighbours). The optimum is that
   // of the single global program; false builds that single program instead (for testing).
   bool SplitIntoComponents = true;
+  // The components' programs are independent: solved on these threads (the same values).
+  ParallelFor Parallel = SequentialFor;
 
   // values receives one value per node. Fixed nodes keep theirs exactly, unless two of them
   // are closer along a chain of d relations than d * SpreadingGap of the value scale (equal

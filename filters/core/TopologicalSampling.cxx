@@ -3323,53 +3323,57 @@ void AskAlongOneCell(const CarvingGround& ground, const SaddleOneCell& cell, con
   out.Start.push_back(static_cast<Index>(out.Asked.size()));
 }
 
-// The walks of `cells`, in parallel over stretches of them: a walk only reads the values, so the
-// walks are independent, and the claims made from them (the highest or lowest height per vertex)
-// do not depend on their order. `avoidedOf(cell)` gives the claims a walk goes round
-// (nullptr: none). Returns the stretches in the order of the cells.
+// The walks of the 1-cells cells[which[i]], in parallel over stretches of them: a walk only
+// reads the values, so the walks are independent, and the claims made from them (the highest or
+// lowest height per vertex) do not depend on their order. `avoidedOf(cell)` gives the claims a
+// walk goes round (nullptr: none). Returns the stretches in the order of `which`.
 template <typename Avoided>
 std::vector<WalkedRequests> WalkOneCells(const CarvingGround& ground, const std::vector<SaddleOneCell>& cells,
-  const std::vector<double>* shared, const std::vector<double>& values, OneCellCarving carving,
-  const Avoided& avoidedOf, const ParallelFor& parallel)
+  const std::vector<Index>& which, const std::vector<double>* shared, const std::vector<double>& values,
+  OneCellCarving carving, const Avoided& avoidedOf, const ParallelFor& parallel)
 {
   constexpr Index stretch = 256;
-  const Index count = static_cast<Index>(cells.size());
+  const Index count = static_cast<Index>(which.size());
   std::vector<WalkedRequests> stretches(static_cast<std::size_t>(StretchesOf(count, stretch)));
-  ForEachInStretches(count, stretch, parallel, [&](Index c, Index part) {
-    AskAlongOneCell(ground, cells[c], shared, values, carving, avoidedOf(cells[c]), stretches[part]);
+  ForEachInStretches(count, stretch, parallel, [&](Index i, Index part) {
+    const SaddleOneCell& cell = cells[which[i]];
+    AskAlongOneCell(ground, cell, shared, values, carving, avoidedOf(cell), stretches[part]);
   });
   return stretches;
 }
 
-// visit(c, first, last) for the walk of 1-cell c, [first, last) being what it asked, in the
-// order of the 1-cells.
-template <typename Visit>
-void ForEachWalk(const std::vector<WalkedRequests>& stretches, const Visit& visit)
+// What each walk asked, [first, last) per walk, in the order of the walks.
+using WalkedRange = std::pair<std::vector<std::pair<Index, double>>::const_iterator,
+  std::vector<std::pair<Index, double>>::const_iterator>;
+std::vector<WalkedRange> WalkedRanges(const std::vector<WalkedRequests>& stretches)
 {
-  std::size_t c = 0;
+  std::vector<WalkedRange> ranges;
   for (const WalkedRequests& walks : stretches)
   {
-    for (std::size_t w = 0; w + 1 < walks.Start.size(); ++w, ++c)
+    for (std::size_t w = 0; w + 1 < walks.Start.size(); ++w)
     {
-      visit(c, walks.Asked.begin() + walks.Start[w], walks.Asked.begin() + walks.Start[w + 1]);
+      ranges.emplace_back(walks.Asked.begin() + walks.Start[w], walks.Asked.begin() + walks.Start[w + 1]);
     }
   }
+  return ranges;
 }
 
-// The claims of the walks, each walk's to the claims of its 1-cell's kind.
-void ClaimWalked(const std::vector<SaddleOneCell>& cells, const std::vector<WalkedRequests>& stretches,
+// The claims of the walks (ranges[c] is 1-cell c's), each walk's to the claims of its 1-cell's
+// kind.
+void ClaimWalked(const std::vector<SaddleOneCell>& cells, const std::vector<WalkedRange>& ranges,
   CarvingClaims& raise, CarvingClaims& lower)
 {
-  ForEachWalk(stretches, [&](std::size_t c, auto first, auto last) {
+  for (std::size_t c = 0; c < ranges.size(); ++c)
+  {
     CarvingClaims& claims = cells[c].Ascending ? raise : lower;
-    for (auto ask = first; ask != last; ++ask)
+    for (auto ask = ranges[c].first; ask != ranges[c].second; ++ask)
     {
       if (!std::isnan(ask->second))
       {
         claims.Claim(ask->first, ask->second);
       }
     }
-  });
+  }
 }
 } // namespace
 
@@ -3390,8 +3394,11 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
   const std::vector<double>* shared = constraints.SharedOneCellSamples.get();
   CarvingClaims raiseTo(true, vertices), lowerTo(false, vertices);
   const auto none = [](const SaddleOneCell&) -> const CarvingClaims* { return nullptr; };
-  const std::vector<WalkedRequests> walks = WalkOneCells(ground, cells, shared, values, carving, none, parallel);
-  ClaimWalked(cells, walks, raiseTo, lowerTo);
+  std::vector<Index> all(cells.size());
+  std::iota(all.begin(), all.end(), 0);
+  const std::vector<WalkedRequests> walks = WalkOneCells(ground, cells, all, shared, values, carving, none, parallel);
+  std::vector<WalkedRange> walked = WalkedRanges(walks);
+  ClaimWalked(cells, walked, raiseTo, lowerTo);
   // Where a ridge and a valley run within a spacing of each other (nearly flat data, a thin
   // 2-cell between them), one vertex can be the nearest to both: both claim it, it keeps its
   // value, and the chains of both break there; the floods then drain the valley (cut the
@@ -3403,19 +3410,31 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
   auto claimedByBoth = [&](const std::pair<Index, double>& ask) {
     return raiseTo.Has(ask.first) && lowerTo.Has(ask.first);
   };
-  std::vector<char> rewalk(cells.size(), 0);
-  bool anyRewalk = false;
-  ForEachWalk(walks, [&](std::size_t c, auto first, auto last) {
-    rewalk[c] = std::any_of(first, last, claimedByBoth);
-    anyRewalk = anyRewalk || rewalk[c];
-  });
+  // The other walks would ask the same again (the values do not change until the claims are
+  // made): their requests are kept.
+  std::vector<Index> again;
+  for (std::size_t c = 0; c < cells.size(); ++c)
+  {
+    if (std::any_of(walked[c].first, walked[c].second, claimedByBoth))
+    {
+      again.push_back(static_cast<Index>(c));
+    }
+  }
+  const bool anyRewalk = !again.empty();
   CarvingClaims againRaise(true, anyRewalk ? vertices : 0), againLower(false, anyRewalk ? vertices : 0);
   if (anyRewalk)
   {
     const auto avoided = [&](const SaddleOneCell& cell) -> const CarvingClaims* {
-      return !rewalk[&cell - cells.data()] ? nullptr : cell.Ascending ? &lowerTo : &raiseTo;
+      return cell.Ascending ? &lowerTo : &raiseTo;
     };
-    ClaimWalked(cells, WalkOneCells(ground, cells, shared, values, carving, avoided, parallel), againRaise, againLower);
+    const std::vector<WalkedRequests> walksAgain =
+      WalkOneCells(ground, cells, again, shared, values, carving, avoided, parallel);
+    const std::vector<WalkedRange> walkedAgain = WalkedRanges(walksAgain);
+    for (std::size_t i = 0; i < again.size(); ++i)
+    {
+      walked[again[i]] = walkedAgain[i];
+    }
+    ClaimWalked(cells, walked, againRaise, againLower);
   }
   CarvingClaims& raise = anyRewalk ? againRaise : raiseTo;
   CarvingClaims& lower = anyRewalk ? againLower : lowerTo;

@@ -8,6 +8,7 @@
 // Prints the error messages and timings, then "N passed, N failed"; returns nonzero on failure.
 #include "JunctionValueProgram.h"
 #include "TestHarness.h"
+#include "TestSupport.h"
 
 #include <algorithm>
 #include <array>
@@ -157,6 +158,13 @@ TEST_CASE(JunctionValues)
     }
     CHECK(SatisfiesRelations(split, relations) && SatisfiesRelations(single, relations));
     CHECK(std::abs(splitChange - program.TotalChange) <= 1e-6 * 100.0);
+    // The components' programs solved on several threads: the same values, bit for bit.
+    {
+      JunctionValueProgram threaded;
+      threaded.Parallel = ThreadedFor;
+      std::vector<double> again;
+      CHECK(threaded.Solve(nodes, relations, again, error) && again == split);
+    }
     for (std::size_t n = 0; n < nodes.size(); ++n)
     {
       if (nodes[n].Fixed)

@@ -171,6 +171,21 @@ bool SameResult(const OneCellSmoothingResult& x, const OneCellSmoothingResult& y
   }
   return true;
 }
+
+// Stages 1 to 3 (k = 4) on seeded n x n uniform noise at `percent`; false with the error printed.
+bool SmoothNoise(int n, std::uint64_t seed, double percent, Stage3Input& input, OneCellSmoothing& smoothing,
+  OneCellSmoothingResult& result)
+{
+  std::string error;
+  smoothing.Segments = 4;
+  const bool ok = RunStages1And2(UniformNoise(n, seed), percent, input, error) &&
+    smoothing.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, result, error);
+  if (!ok)
+  {
+    std::printf("  noise %d^2, seed %llu, %g %%: %s\n", n, static_cast<unsigned long long>(seed), percent, error.c_str());
+  }
+  return ok;
+}
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -216,6 +231,31 @@ TEST_CASE(SmoothedOneCellsOfSyntheticFields)
     OneCellSmoothingResult again;
     CHECK(threaded.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, again, error));
     CHECK(SameResult(result, again));
+  }
+}
+
+//------------------------------------------------------------------------------
+// Uniform noise: thousands of junction programs and a crossing repair over thousands of pieces,
+// both in parallel (the programs, the crossing grid's bands): the same result on several threads
+// as on one.
+TEST_CASE(NoiseSmoothsTheSameOnAnyNumberOfThreads)
+{
+  for (const double percent : { 2.0, 10.0 })
+  {
+    Stage3Input input;
+    OneCellSmoothing smoothing;
+    OneCellSmoothingResult result;
+    CHECK(SmoothNoise(90, 1234, percent, input, smoothing, result));
+    CheckSmoothedOneCells(input, result, 4);
+    OneCellSmoothing threaded = smoothing;
+    threaded.Parallel = ThreadedFor;
+    OneCellSmoothingResult again;
+    std::string error;
+    CHECK(threaded.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, again, error));
+    CHECK(SameResult(result, again));
+    CHECK(result.PiecesOfOneCell == again.PiecesOfOneCell && result.DroppedCuts == again.DroppedCuts);
+    std::printf("  noise 90^2 at %g %%: %zu pieces, %d adapted, %d crossings left\n", percent, result.Pieces.size(),
+      result.AdaptedPieces, result.RemainingCrossings);
   }
 }
 
@@ -630,14 +670,10 @@ TEST_CASE(MergedOneCellsShareTheirPiecesOnNoise)
   {
     for (std::uint64_t seed = 1; seed <= 3; ++seed)
     {
-      const GridField noise = UniformNoise(48, seed);
       Stage3Input input;
-      std::string error;
-      CHECK(RunStages1And2(noise, percent, input, error));
       OneCellSmoothing smoothing;
-      smoothing.Segments = 4;
       OneCellSmoothingResult result;
-      CHECK(smoothing.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, result, error));
+      CHECK(SmoothNoise(48, seed, percent, input, smoothing, result));
       // The pieces on every edge of the jagged 1-cells (either direction).
       std::map<std::array<double, 4>, std::set<Index>> piecesOfEdge;
       for (Index p = 0; p < static_cast<Index>(result.Pieces.size()); ++p)
