@@ -751,23 +751,11 @@ bool ReadSmoothedOneCells(vtkMultiBlockDataSet* input, const topospline::MorseSm
     error = "the smoothed 1-cells do not match the complex";
     return false;
   }
-  Index pieces = 0;
-  for (vtkIdType c = 0; c < block->GetNumberOfCells(); ++c)
-  {
-    pieces = std::max(pieces, static_cast<Index>(piece->GetComponent(c, 0)) + 1);
-  }
-  smoothed = topospline::OneCellSmoothingResult();
-  smoothed.Pieces.resize(pieces);
-  for (auto& p : smoothed.Pieces)
-  {
-    p.Curve.Dimension = 2;
-    p.Height.Dimension = 1;
-  }
-  // Each Bezier cell's place in its piece: its piece's cells come in the order of the block.
-  // Then the cells in parallel, each to its own place (1000^2 noise: 3.3 million cells).
+  // Each Bezier cell's piece and its place in it (its piece's cells come in the order of the
+  // block); then the cells in parallel, each to its own place (1000^2 noise: 3.2 million cells).
   const vtkIdType cells = block->GetNumberOfCells();
   std::vector<Index> pieceOf(static_cast<std::size_t>(cells));
-  std::vector<int> slotOf(static_cast<std::size_t>(cells));
+  Index pieces = 0;
   for (vtkIdType c = 0; c < cells; ++c)
   {
     pieceOf[c] = static_cast<Index>(piece->GetComponent(c, 0));
@@ -776,10 +764,19 @@ bool ReadSmoothedOneCells(vtkMultiBlockDataSet* input, const topospline::MorseSm
       error = "the smoothed 1-cells are not cubic Bezier curves";
       return false;
     }
+    pieces = std::max(pieces, pieceOf[c] + 1);
+  }
+  smoothed = topospline::OneCellSmoothingResult();
+  smoothed.Pieces.resize(pieces);
+  std::vector<int> slotOf(static_cast<std::size_t>(cells));
+  for (vtkIdType c = 0; c < cells; ++c)
+  {
     slotOf[c] = smoothed.Pieces[pieceOf[c]].Curve.Segments++;
   }
   for (auto& p : smoothed.Pieces)
   {
+    p.Curve.Dimension = 2;
+    p.Height.Dimension = 1;
     p.Height.Segments = p.Curve.Segments;
     p.Curve.ControlPoints.resize(8 * static_cast<std::size_t>(p.Curve.Segments));
     p.Height.ControlPoints.resize(4 * static_cast<std::size_t>(p.Height.Segments));
@@ -787,19 +784,21 @@ bool ReadSmoothedOneCells(vtkMultiBlockDataSet* input, const topospline::MorseSm
   const auto plane = conversion::PlaneOf(SegmentationOf(input));
   vtkSMPThreadLocalObject<vtkIdList> scratch;
   vtkSMPTools::For(0, cells, [&](vtkIdType begin, vtkIdType end) {
-    vtkIdList* ids = scratch.Local();
+    vtkIdList* copied = scratch.Local();
     for (vtkIdType c = begin; c < end; ++c)
     {
-      block->GetCellPoints(c, ids);
+      vtkIdType size = 0;
+      const vtkIdType* ids = nullptr;
+      block->GetCellPoints(c, size, ids, copied); // the overload that is safe on several threads
       auto& smoothedPiece = smoothed.Pieces[pieceOf[c]];
       double* uv = smoothedPiece.Curve.ControlPoints.data() + 8 * static_cast<std::size_t>(slotOf[c]);
       double* h = smoothedPiece.Height.ControlPoints.data() + 4 * static_cast<std::size_t>(slotOf[c]);
       for (int m = 0; m < 4; ++m)
       {
         double xyz[3];
-        block->GetPoint(ids->GetId(m), xyz);
+        block->GetPoint(ids[m], xyz);
         plane.ToPlanar(xyz, uv + 2 * CurvePointOfVtkPoint[m]);
-        h[CurvePointOfVtkPoint[m]] = height->GetComponent(ids->GetId(m), 0);
+        h[CurvePointOfVtkPoint[m]] = height->GetComponent(ids[m], 0);
       }
     }
   });
