@@ -360,47 +360,56 @@ bool ReadCriticalPoints(const ComplexArrays& in, topospline::MorseSmaleComplex& 
   return true;
 }
 
+// visit(c, size, ids) for every cell c of `cells`, in parallel (vtkSMPTools), with the overload of
+// GetCellAtId that is safe on several threads.
+template <typename Visit>
+void ForEachCellInParallel(vtkCellArray* cells, const Visit& visit)
+{
+  vtkSMPThreadLocalObject<vtkIdList> scratch;
+  vtkSMPTools::For(0, cells->GetNumberOfCells(), [&](vtkIdType begin, vtkIdType end) {
+    vtkIdList* copied = scratch.Local();
+    for (vtkIdType c = begin; c < end; ++c)
+    {
+      vtkIdType size = 0;
+      const vtkIdType* ids = nullptr;
+      cells->GetCellAtId(c, size, ids, copied);
+      visit(c, size, ids);
+    }
+  });
+}
+
 bool ReadOneCells(const ComplexArrays& in, const conversion::DomainPlane& embedding, const PositionOfId& local,
   topospline::MorseSmaleComplex& complex, std::string& error)
 {
   // Every 1-cell on its own, in parallel (1000^2 noise: about a million 1-cells, 1.5 s on one
   // thread).
   vtkCellArray* lines = in.OneCells->GetLines();
-  const vtkIdType count = lines->GetNumberOfCells();
-  complex.OneCells.resize(static_cast<std::size_t>(count));
+  complex.OneCells.resize(static_cast<std::size_t>(lines->GetNumberOfCells()));
   std::atomic<bool> missingEnd(false);
-  vtkSMPThreadLocalObject<vtkIdList> scratch;
-  vtkSMPTools::For(0, count, [&](vtkIdType begin, vtkIdType end) {
-    vtkIdList* copied = scratch.Local();
-    for (vtkIdType a = begin; a < end; ++a)
+  ForEachCellInParallel(lines, [&](vtkIdType a, vtkIdType size, const vtkIdType* ids) {
+    topospline::OneCell& oneCell = complex.OneCells[a];
+    oneCell.Type = in.Type->GetComponent(a, 0) == 0 ? topospline::OneCell::Descending : topospline::OneCell::Ascending;
+    oneCell.Source = local(in.Source->GetComponent(a, 0));
+    oneCell.Destination = local(in.Destination->GetComponent(a, 0));
+    oneCell.Points.reserve(2 * size);
+    oneCell.Values.reserve(size);
+    oneCell.MeshCells.reserve(size);
+    for (vtkIdType k = 0; k < size; ++k)
     {
-      vtkIdType size = 0;
-      const vtkIdType* ids = nullptr;
-      lines->GetCellAtId(a, size, ids, copied);
-      topospline::OneCell& oneCell = complex.OneCells[a];
-      oneCell.Type = in.Type->GetComponent(a, 0) == 0 ? topospline::OneCell::Descending : topospline::OneCell::Ascending;
-      oneCell.Source = local(in.Source->GetComponent(a, 0));
-      oneCell.Destination = local(in.Destination->GetComponent(a, 0));
-      oneCell.Points.reserve(2 * size);
-      oneCell.Values.reserve(size);
-      oneCell.MeshCells.reserve(size);
-      for (vtkIdType k = 0; k < size; ++k)
+      double xyz[3];
+      in.OneCells->GetPoint(ids[k], xyz);
+      oneCell.Points.push_back(xyz[embedding.U]);
+      oneCell.Points.push_back(xyz[embedding.V]);
+      oneCell.Values.push_back(in.Along->GetComponent(ids[k], 0));
+      const auto c = static_cast<Index>(in.MeshCell->GetComponent(ids[k], 0));
+      if (c >= 0)
       {
-        double xyz[3];
-        in.OneCells->GetPoint(ids[k], xyz);
-        oneCell.Points.push_back(xyz[embedding.U]);
-        oneCell.Points.push_back(xyz[embedding.V]);
-        oneCell.Values.push_back(in.Along->GetComponent(ids[k], 0));
-        const auto c = static_cast<Index>(in.MeshCell->GetComponent(ids[k], 0));
-        if (c >= 0)
-        {
-          oneCell.MeshCells.push_back(c);
-        }
+        oneCell.MeshCells.push_back(c);
       }
-      if (oneCell.Source == topospline::InvalidIndex || oneCell.Destination == topospline::InvalidIndex)
-      {
-        missingEnd = true;
-      }
+    }
+    if (oneCell.Source == topospline::InvalidIndex || oneCell.Destination == topospline::InvalidIndex)
+    {
+      missingEnd = true;
     }
   });
   if (missingEnd)
@@ -782,24 +791,16 @@ bool ReadSmoothedOneCells(vtkMultiBlockDataSet* input, const topospline::MorseSm
     p.Height.ControlPoints.resize(4 * static_cast<std::size_t>(p.Height.Segments));
   }
   const auto plane = conversion::PlaneOf(SegmentationOf(input));
-  vtkSMPThreadLocalObject<vtkIdList> scratch;
-  vtkSMPTools::For(0, cells, [&](vtkIdType begin, vtkIdType end) {
-    vtkIdList* copied = scratch.Local();
-    for (vtkIdType c = begin; c < end; ++c)
+  ForEachCellInParallel(block->GetCells(), [&](vtkIdType c, vtkIdType, const vtkIdType* ids) {
+    auto& smoothedPiece = smoothed.Pieces[pieceOf[c]];
+    double* uv = smoothedPiece.Curve.ControlPoints.data() + 8 * static_cast<std::size_t>(slotOf[c]);
+    double* h = smoothedPiece.Height.ControlPoints.data() + 4 * static_cast<std::size_t>(slotOf[c]);
+    for (int m = 0; m < 4; ++m)
     {
-      vtkIdType size = 0;
-      const vtkIdType* ids = nullptr;
-      block->GetCellPoints(c, size, ids, copied); // the overload that is safe on several threads
-      auto& smoothedPiece = smoothed.Pieces[pieceOf[c]];
-      double* uv = smoothedPiece.Curve.ControlPoints.data() + 8 * static_cast<std::size_t>(slotOf[c]);
-      double* h = smoothedPiece.Height.ControlPoints.data() + 4 * static_cast<std::size_t>(slotOf[c]);
-      for (int m = 0; m < 4; ++m)
-      {
-        double xyz[3];
-        block->GetPoint(ids[m], xyz);
-        plane.ToPlanar(xyz, uv + 2 * CurvePointOfVtkPoint[m]);
-        h[CurvePointOfVtkPoint[m]] = height->GetComponent(ids[m], 0);
-      }
+      double xyz[3];
+      block->GetPoint(ids[m], xyz);
+      plane.ToPlanar(xyz, uv + 2 * CurvePointOfVtkPoint[m]);
+      h[CurvePointOfVtkPoint[m]] = height->GetComponent(ids[m], 0);
     }
   });
   smoothed.PiecesOfOneCell.resize(oneCells);
