@@ -1,5 +1,6 @@
 #include "JunctionValueProgram.h"
 
+#include "CompressedGraph.h"
 #include "DisjointSets.h"
 #include "GlpkLinearProgram.h"
 
@@ -7,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <utility>
 
 namespace topospline
 {
@@ -74,19 +76,9 @@ void BuildRelationGraph(Index count, const std::vector<std::array<Index, 2>>& lo
   std::sort(relations.begin(), relations.end());
   relations.erase(std::unique(relations.begin(), relations.end()), relations.end());
 
-  std::vector<Index>& offsets = graph.Offsets;
-  offsets.assign(static_cast<std::size_t>(count) + 1, 0);
-  for (const auto& r : relations)
-  {
-    ++offsets[r[0] + 1];
-  }
-  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-  graph.Successors.resize(relations.size());
-  std::vector<Index> cursor(offsets.begin(), offsets.end() - 1);
-  for (const auto& r : relations)
-  {
-    graph.Successors[cursor[r[0]]++] = r[1];
-  }
+  CompressedGraph compressed(count, relations);
+  graph.Offsets = std::move(compressed.Offsets);
+  graph.Successors = std::move(compressed.Targets);
 }
 
 // Every leftover node of Kahn's algorithm (inDegree > 0) has a leftover predecessor: walking
@@ -436,7 +428,8 @@ bool SolveComponentProgram(const std::vector<Index>& component, const std::vecto
 
 // The values of the free nodes: a lone junction in closed form, every other component by its
 // program, in parallel (each writes its own nodes' values only; the junction values of 1000^2
-// noise took 3.1 s with the programs one after the other). Counts the programs solved and the free nodes in the largest.
+// noise took 3.1 s with the programs one after the other). Counts the programs solved and the
+// free nodes in the largest.
 bool SolveFreeNodes(const std::vector<JunctionValueNode>& nodes, const RelationGraph& graph,
   const FreeNodeProblems& problems, double margin, const ValueRange& range, const ParallelFor& parallel,
   std::vector<double>& values, int& numberOfPrograms, int& largestProgram, std::string& error)

@@ -1,5 +1,6 @@
 #include "OneCellSmoothing.h"
 
+#include "CompressedGraph.h"
 #include "JunctionValueProgram.h"
 #include "PlanarGeometry.h"
 #include "TriangleMeshTopology.h"
@@ -141,34 +142,6 @@ void KeepRisingCuts(std::vector<Cut>& at, const std::vector<Index>& rank)
   std::reverse(kept.begin(), kept.end());
   at = std::move(kept);
 }
-
-// A directed graph as compressed rows: node n's successors are Targets[Offsets[n] ..
-// Offsets[n + 1]), in the order their edges were given (a vector per node cost a second on
-// 1000^2 noise in allocations).
-struct CompressedGraph
-{
-  std::vector<Index> Offsets, Targets;
-
-  // edges: (from, to) pairs.
-  CompressedGraph(Index nodes, const std::vector<std::array<Index, 2>>& edges)
-    : Offsets(static_cast<std::size_t>(nodes) + 1, 0)
-    , Targets(edges.size())
-  {
-    for (const auto& edge : edges)
-    {
-      ++this->Offsets[edge[0] + 1];
-    }
-    std::partial_sum(this->Offsets.begin(), this->Offsets.end(), this->Offsets.begin());
-    std::vector<Index> fill(this->Offsets.begin(), this->Offsets.end() - 1);
-    for (const auto& edge : edges)
-    {
-      this->Targets[fill[edge[0]]++] = edge[1];
-    }
-  }
-  Index Nodes() const { return static_cast<Index>(this->Offsets.size()) - 1; }
-  std::size_t Degree(Index n) const { return static_cast<std::size_t>(this->Offsets[n + 1] - this->Offsets[n]); }
-  Index Successor(Index n, std::size_t k) const { return this->Targets[this->Offsets[n] + k]; }
-};
 
 // The strongly connected components of a directed graph (Tarjan, without recursion: noise
 // gives chains of hundreds of thousands of nodes); component ids per node.
@@ -919,19 +892,6 @@ void ClampCurveIntoDomain(SmoothedPiece& piece, const double bounds[4])
   }
 }
 
-// Finds the pairs of pieces whose smoothed curves cross: samples every curve as a polyline,
-// buckets its segments in a uniform grid, and tests pairs of segments of different pieces (and
-// non-adjacent segments of one piece). Pieces meeting at a node may touch there.
-// Curves that end at one point (the same node, or two nodes on one vertex: a boundary
-// saddle and a maximum share their vertex, and the 1-cell between them is a loop) meet
-// there: within two samples of such a shared end, a contact through that point (to rounding)
-// is their meeting. Any other contact is a crossing, however close to the node: two 1-cells
-// that leave a saddle almost tangentially and cross there leave a 2-cell without a simple
-// boundary.
-// Incremental: the repair refits a few pieces per round, so after the first full pass only
-// the refitted pieces are sampled, re-bucketed and tested again (against all pieces); a pair
-// of pieces neither of which changed keeps its answer. On 300^2 noise the repair runs rounds
-// with a few hundred of 120 000 pieces each.
 // A uniform grid of square cells over a box, numbered row by row (consecutive pieces run
 // along x, and their cells then lie close together in the grid's arrays).
 struct UniformGrid
@@ -987,6 +947,19 @@ struct UniformGrid
   }
 };
 
+// Finds the pairs of pieces whose smoothed curves cross: samples every curve as a polyline,
+// buckets its segments in a uniform grid, and tests pairs of segments of different pieces (and
+// non-adjacent segments of one piece). Pieces meeting at a node may touch there.
+// Curves that end at one point (the same node, or two nodes on one vertex: a boundary
+// saddle and a maximum share their vertex, and the 1-cell between them is a loop) meet
+// there: within two samples of such a shared end, a contact through that point (to rounding)
+// is their meeting. Any other contact is a crossing, however close to the node: two 1-cells
+// that leave a saddle almost tangentially and cross there leave a 2-cell without a simple
+// boundary.
+// Incremental: the repair refits a few pieces per round, so after the first full pass only
+// the refitted pieces are sampled, re-bucketed and tested again (against all pieces); a pair
+// of pieces neither of which changed keeps its answer. On 300^2 noise the repair runs rounds
+// with a few hundred of 120 000 pieces each.
 class CrossingDetector
 {
 public:
@@ -1075,7 +1048,8 @@ public:
     this->Parallel(0, bands, [&](Index begin, Index end) {
       for (Index band = begin; band < end; ++band)
       {
-        forEachInBand(band, [&](Index p, int segment, std::size_t cell) { this->Entries[fill[cell]++] = { p, segment }; });
+        forEachInBand(
+          band, [&](Index p, int segment, std::size_t cell) { this->Entries[fill[cell]++] = { p, segment }; });
       }
     });
     // Each grid cell's pairs, cells split among threads.

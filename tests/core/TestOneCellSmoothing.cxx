@@ -182,7 +182,8 @@ bool SmoothNoise(int n, std::uint64_t seed, double percent, Stage3Input& input, 
     smoothing.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, result, error);
   if (!ok)
   {
-    std::printf("  noise %d^2, seed %llu, %g %%: %s\n", n, static_cast<unsigned long long>(seed), percent, error.c_str());
+    std::printf(
+      "  noise %d^2, seed %llu, %g %%: %s\n", n, static_cast<unsigned long long>(seed), percent, error.c_str());
   }
   return ok;
 }
