@@ -12,6 +12,7 @@
 #include <functional>
 #include <iterator>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <queue>
 #include <unordered_map>
@@ -825,6 +826,114 @@ void CountChanges(const std::vector<double>& before, const std::vector<double>& 
 std::vector<Index> UnmatchedSaddles(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const std::vector<Index>& saddles, double tolerance, const ParallelFor& parallel, const std::vector<double>& values);
 
+// The wanted saddles with no found saddle within the tolerance, and the found saddles no wanted
+// one claims.
+struct SaddleMatch
+{
+  std::vector<Index> Missing, Spare;
+
+  // More wanted saddles matched without adding saddles: found saddles beyond the wanted ones
+  // would come with an extremum the enforcement could not remove.
+  bool IsBetterThan(const SaddleMatch& current) const
+  {
+    return this->Missing.size() < current.Missing.size() &&
+      this->Spare.size() + current.Missing.size() <= current.Spare.size() + this->Missing.size();
+  }
+};
+
+// Counts the saddles of a sampling's values (as stage 1 finds them) and matches them to the
+// wanted ones within the tolerance, as the verdict does. The first match is MatchCriticalPoints';
+// a second one finds the pairs the wanted saddles can make (CriticalPointMatcher), and every
+// match after it only picks those whose vertex holds a saddle (the same partners).
+class SaddleMatcher
+{
+public:
+  SaddleMatcher(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+    const std::vector<Index>& wantedSaddles, double tolerance, const ParallelFor& parallel)
+    : Points(field.Points)
+    , Mesh(mesh)
+    , WantedSaddles(wantedSaddles)
+    , Wanted(this->Locations(wantedSaddles))
+    , Tolerance(tolerance)
+    , Parallel(parallel)
+  {
+  }
+
+  SaddleMatch Match(const std::vector<double>& values)
+  {
+    SaddleMatch match;
+    std::vector<Index> saddles;
+    if (!this->CountSaddles(values, saddles))
+    {
+      match.Missing = this->WantedSaddles;
+      return match;
+    }
+    // Matched as the verdict matches them (MatchCriticalPoints: one to one, as many as can be,
+    // within the tolerance and within two edges of the mesh). Without the mesh, on a Delaunay
+    // mesh of scattered points whose hull edges span the domain (the tolerance is the longest
+    // edge), a saddle several edges from its node counted as on it, and nothing moved it back.
+    const std::vector<CriticalPointLocation> found = this->Locations(saddles);
+    if (this->Matches++ == 1)
+    {
+      this->Pairs = std::make_unique<CriticalPointMatcher>(this->Wanted, this->Points, this->Tolerance, this->Mesh,
+        this->Parallel);
+    }
+    const std::vector<std::size_t> partner = this->Pairs
+      ? this->Pairs->Match(found)
+      : MatchCriticalPoints(this->Wanted, found, this->Tolerance, &this->Mesh, this->Parallel);
+    std::vector<char> used(saddles.size(), 0);
+    for (std::size_t i = 0; i < this->WantedSaddles.size(); ++i)
+    {
+      if (partner[i] == UnmatchedCriticalPoint)
+      {
+        match.Missing.push_back(this->WantedSaddles[i]);
+      }
+      else
+      {
+        used[partner[i]] = 1;
+      }
+    }
+    for (std::size_t i = 0; i < saddles.size(); ++i)
+    {
+      if (!used[i])
+      {
+        match.Spare.push_back(saddles[i]);
+      }
+    }
+    return match;
+  }
+
+private:
+  std::vector<CriticalPointLocation> Locations(const std::vector<Index>& vertices) const
+  {
+    std::vector<CriticalPointLocation> result(vertices.size());
+    for (std::size_t i = 0; i < vertices.size(); ++i)
+    {
+      result[i].MorseIndex = 1;
+      result[i].Position[0] = this->Points[2 * vertices[i]];
+      result[i].Position[1] = this->Points[2 * vertices[i] + 1];
+      result[i].Vertex = vertices[i];
+    }
+    return result;
+  }
+
+  // The saddle vertices of the sampling with `values` (stage 1's, counted from the lower links:
+  // DiscreteGradient::SaddleVertices); false on a value stage 1 refuses.
+  bool CountSaddles(const std::vector<double>& values, std::vector<Index>& saddles)
+  {
+    return DiscreteGradient::SaddleVertices(this->Mesh, values.data(), this->Parallel, saddles);
+  }
+
+  const std::vector<double>& Points;
+  const TriangleMeshTopology& Mesh;
+  const std::vector<Index>& WantedSaddles;
+  const std::vector<CriticalPointLocation> Wanted; // the same, as MatchCriticalPoints takes them
+  const double Tolerance;
+  const ParallelFor& Parallel;
+  int Matches = 0;
+  std::unique_ptr<const CriticalPointMatcher> Pairs; // from the second match on
+};
+
 // RelocateSaddles tries the patterns of the links (PlaceMissingSaddlesByTheirLinks) of at most
 // this many saddles left off their nodes by the carving, and this many patterns per saddle: each
 // costs a flood and a saddle count, and 10 saddles with 16 patterns each gained no verdict more
@@ -849,6 +958,11 @@ constexpr int LinkPatternsPerSaddle = 6;
 int RelocateSaddles(const VertexGraphs& graphs, const PlanarScalarField& field, const TriangleMeshTopology& mesh,
   const SamplingConstraints& constraints, double tolerance, double reach, std::vector<double>& values,
   int maximumRounds = 3, int maximumMissing = 10, const ParallelFor& parallel = SequentialFor);
+// The same with a matcher of constraints.Saddles kept by the caller: Settle relocates up to five
+// times per pass against the same wanted saddles.
+int RelocateSaddles(const VertexGraphs& graphs, const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, SaddleMatcher& matcher, double reach, std::vector<double>& values,
+  int maximumRounds, int maximumMissing, const ParallelFor& parallel);
 // Makes the wanted saddle `saddle` a saddle of the sampling with its own 1-cells
 // (constraints.SaddleOneCells): each 1-cell gets a vertex of the saddle's link, in the order
 // in which they leave it, raised above the saddle's value for an ascending 1-cell and lowered
@@ -2142,11 +2256,11 @@ TopologicalSamplingReport TopologicalSampling::Settle(const VertexGraphs& graphs
   // relocation can take a wanted extremum away (a carved chain running down past a wanted
   // minimum beside it), and equal counts come before saddles on their nodes.
   constexpr int restoreRounds = 4;
+  SaddleMatcher matcher(sampling, mesh, constraints.Saddles, this->Spacing * (1 + 1e-9), this->Parallel);
   for (int round = 0; round <= restoreRounds; ++round)
   {
     report.DisplacedSaddles =
-      RelocateSaddles(graphs, sampling, mesh, constraints, this->Spacing * (1 + 1e-9), reach, values, 3, 10,
-        this->Parallel);
+      RelocateSaddles(graphs, sampling, mesh, constraints, matcher, reach, values, 3, 10, this->Parallel);
     if (RestoreWantedExtrema(graphs, mesh, constraints, values) == 0)
     {
       break;
@@ -2199,103 +2313,6 @@ std::size_t NearestWithin(const std::vector<double>& p, Index w, const std::vect
   }
   return best;
 }
-
-// The wanted saddles with no found saddle within the tolerance, and the found saddles no wanted
-// one claims.
-struct SaddleMatch
-{
-  std::vector<Index> Missing, Spare;
-
-  // More wanted saddles matched without adding saddles: found saddles beyond the wanted ones
-  // would come with an extremum the enforcement could not remove.
-  bool IsBetterThan(const SaddleMatch& current) const
-  {
-    return this->Missing.size() < current.Missing.size() &&
-      this->Spare.size() + current.Missing.size() <= current.Spare.size() + this->Missing.size();
-  }
-};
-
-// Counts the saddles of a sampling's values (as stage 1 finds them) and matches them to the
-// wanted ones within the tolerance, as the verdict does.
-class SaddleMatcher
-{
-public:
-  SaddleMatcher(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
-    const std::vector<Index>& wantedSaddles, double tolerance, const ParallelFor& parallel)
-    : Points(field.Points)
-    , Mesh(mesh)
-    , WantedSaddles(wantedSaddles)
-    , Wanted(this->Locations(wantedSaddles))
-    , Tolerance(tolerance)
-    , Parallel(parallel)
-  {
-  }
-
-  SaddleMatch Match(const std::vector<double>& values)
-  {
-    SaddleMatch match;
-    std::vector<Index> saddles;
-    if (!this->CountSaddles(values, saddles))
-    {
-      match.Missing = this->WantedSaddles;
-      return match;
-    }
-    // Matched as the verdict matches them (MatchCriticalPoints: one to one, as many as can be,
-    // within the tolerance and within two edges of the mesh). Without the mesh, on a Delaunay
-    // mesh of scattered points whose hull edges span the domain (the tolerance is the longest
-    // edge), a saddle several edges from its node counted as on it, and nothing moved it back.
-    const std::vector<std::size_t> partner =
-      MatchCriticalPoints(this->Wanted, this->Locations(saddles), this->Tolerance, &this->Mesh, this->Parallel);
-    std::vector<char> used(saddles.size(), 0);
-    for (std::size_t i = 0; i < this->WantedSaddles.size(); ++i)
-    {
-      if (partner[i] == UnmatchedCriticalPoint)
-      {
-        match.Missing.push_back(this->WantedSaddles[i]);
-      }
-      else
-      {
-        used[partner[i]] = 1;
-      }
-    }
-    for (std::size_t i = 0; i < saddles.size(); ++i)
-    {
-      if (!used[i])
-      {
-        match.Spare.push_back(saddles[i]);
-      }
-    }
-    return match;
-  }
-
-private:
-  std::vector<CriticalPointLocation> Locations(const std::vector<Index>& vertices) const
-  {
-    std::vector<CriticalPointLocation> result(vertices.size());
-    for (std::size_t i = 0; i < vertices.size(); ++i)
-    {
-      result[i].MorseIndex = 1;
-      result[i].Position[0] = this->Points[2 * vertices[i]];
-      result[i].Position[1] = this->Points[2 * vertices[i] + 1];
-      result[i].Vertex = vertices[i];
-    }
-    return result;
-  }
-
-  // The saddle vertices of the sampling with `values` (stage 1's, counted from the lower links:
-  // DiscreteGradient::SaddleVertices); false on a value stage 1 refuses.
-  bool CountSaddles(const std::vector<double>& values, std::vector<Index>& saddles)
-  {
-    return DiscreteGradient::SaddleVertices(this->Mesh, values.data(), this->Parallel, saddles);
-  }
-
-  const std::vector<double>& Points;
-  const TriangleMeshTopology& Mesh;
-  const std::vector<Index>& WantedSaddles;
-  const std::vector<CriticalPointLocation> Wanted; // the same, as MatchCriticalPoints takes them
-  const double Tolerance;
-  const ParallelFor& Parallel;
-};
 
 // The sampling whose saddles RelocateSaddles moves, with its current match; trials are kept
 // only if they match better.
@@ -2478,6 +2495,14 @@ int RelocateSaddles(const VertexGraphs& graphs, const PlanarScalarField& field, 
   int maximumRounds, int maximumMissing, const ParallelFor& parallel)
 {
   SaddleMatcher matcher(field, mesh, constraints.Saddles, tolerance, parallel);
+  return RelocateSaddles(graphs, field, mesh, constraints, matcher, reach, values, maximumRounds, maximumMissing,
+    parallel);
+}
+
+int RelocateSaddles(const VertexGraphs& graphs, const PlanarScalarField& field, const TriangleMeshTopology& mesh,
+  const SamplingConstraints& constraints, SaddleMatcher& matcher, double reach, std::vector<double>& values,
+  int maximumRounds, int maximumMissing, const ParallelFor& parallel)
+{
   SaddleRelocation relocation{ graphs, parallel, field, mesh, constraints, reach, matcher, values,
     matcher.Match(values) };
   const std::vector<Index>& missing = relocation.Current.Missing;

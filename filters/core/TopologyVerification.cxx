@@ -126,6 +126,47 @@ std::vector<std::size_t> MatchAsManyAsPossible(
   return partnerOfExpected;
 }
 
+// The distance between a pair's points if it is within `limit`: the squared distance first
+// (with a margin for its rounding) tells most pairs apart before std::hypot, which gives the
+// pairs' order.
+bool WithinReach(const double* a, const double* b, double limit, double& distance)
+{
+  const double dx = a[0] - b[0];
+  const double dy = a[1] - b[1];
+  if (dx * dx + dy * dy > limit * limit * (1 + 1e-9))
+  {
+    return false;
+  }
+  distance = std::hypot(dx, dy);
+  return distance <= limit;
+}
+
+// The vertices within `hops` edges of a (a first), each once: the vertices b for which
+// WithinHops(mesh, a, b, hops) holds.
+void VerticesWithinHops(const TriangleMeshTopology& mesh, Index a, int hops, std::vector<Index>& out)
+{
+  out.assign(1, a);
+  for (std::size_t ringBegin = 0, ringEnd = 1; hops > 0 && ringBegin < ringEnd; --hops)
+  {
+    for (std::size_t k = ringBegin; k < ringEnd; ++k)
+    {
+      const Index u = out[k];
+      for (Index i = mesh.VertexTriangleBegin(u); i < mesh.VertexTriangleEnd(u); ++i)
+      {
+        for (Index w : mesh.TriangleVertices[mesh.VertexTriangle(i)])
+        {
+          if (std::find(out.begin(), out.end(), w) == out.end())
+          {
+            out.push_back(w);
+          }
+        }
+      }
+    }
+    ringBegin = ringEnd;
+    ringEnd = out.size();
+  }
+}
+
 // Whether b is within `hops` edges of a: a walk over the triangles around each vertex, with
 // nothing allocated. The topological sampling matches its saddles many times per run with the
 // mesh: a sorted neighbourhood per expected point made stage 4 take 2 s of 16 more on 300 x 300
@@ -207,17 +248,9 @@ std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLoca
         {
           continue;
         }
-        // Most points of the nine buckets are beyond the reach: told by their squared distance
-        // (with a margin for its rounding) before std::hypot, which gives the pair's order.
-        const double dx = expected[e].Position[0] - found[f].Position[0];
-        const double dy = expected[e].Position[1] - found[f].Position[1];
-        const double limit = tolerance * expected[e].Reach;
-        if (dx * dx + dy * dy > limit * limit * (1 + 1e-9))
-        {
-          continue;
-        }
-        const double d = std::hypot(dx, dy);
-        if (d <= limit &&
+        // Most points of the nine buckets are beyond the reach.
+        double d = 0;
+        if (WithinReach(expected[e].Position, found[f].Position, tolerance * expected[e].Reach, d) &&
           (!onMesh(expected[e]) || !onMesh(found[f]) ||
             WithinHops(*mesh, expected[e].Vertex, found[f].Vertex, expected[e].Hops)))
         {
@@ -229,6 +262,90 @@ std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLoca
   std::vector<Pair> pairs = CollectInStretches<Pair>(count, 4096, parallel, candidatesOf);
   std::sort(pairs.begin(), pairs.end());
   return MatchAsManyAsPossible(pairs, expected.size(), found.size());
+}
+
+CriticalPointMatcher::CriticalPointMatcher(const std::vector<CriticalPointLocation>& expected,
+  const std::vector<double>& points, double tolerance, const TriangleMeshTopology& mesh, const ParallelFor& parallel)
+  : Expected(expected)
+  , Points(points)
+  , Tolerance(tolerance)
+  , Mesh(mesh)
+  , Parallel(parallel)
+{
+  for (const CriticalPointLocation& cp : expected)
+  {
+    this->OnVertices = this->OnVertices && cp.Vertex != InvalidIndex && cp.Vertex >= 0 &&
+      cp.Vertex < mesh.NumberOfVertices() && 2 * static_cast<std::size_t>(cp.Vertex) + 1 < points.size();
+  }
+  if (!this->OnVertices)
+  {
+    return;
+  }
+  this->Candidates = CollectInStretches<Candidate>(
+    static_cast<Index>(expected.size()), 4096, parallel, [&](Index e, std::vector<Candidate>& candidates) {
+      const CriticalPointLocation& cp = expected[e];
+      thread_local std::vector<Index> within;
+      VerticesWithinHops(mesh, cp.Vertex, cp.Hops, within);
+      for (Index v : within)
+      {
+        double d = 0;
+        if (WithinReach(cp.Position, &points[2 * static_cast<std::size_t>(v)], tolerance * cp.Reach, d))
+        {
+          candidates.push_back({ d, e, v });
+        }
+      }
+    });
+  std::sort(this->Candidates.begin(), this->Candidates.end(), [](const Candidate& a, const Candidate& b) {
+    return std::tie(a.Distance, a.Expected, a.Vertex) < std::tie(b.Distance, b.Expected, b.Vertex);
+  });
+}
+
+std::vector<std::size_t> CriticalPointMatcher::Match(const std::vector<CriticalPointLocation>& found) const
+{
+  bool atVertices = this->OnVertices;
+  for (std::size_t f = 0; f < found.size() && atVertices; ++f)
+  {
+    const Index v = found[f].Vertex;
+    atVertices = v != InvalidIndex && v >= 0 && v < this->Mesh.NumberOfVertices() &&
+      2 * static_cast<std::size_t>(v) + 1 < this->Points.size() && found[f].Position[0] == this->Points[2 * v] &&
+      found[f].Position[1] == this->Points[2 * v + 1];
+  }
+  if (!atVertices)
+  {
+    return MatchCriticalPoints(this->Expected, found, this->Tolerance, &this->Mesh, this->Parallel);
+  }
+  // The found points on each vertex, in increasing order: a list through `next` from `first`.
+  constexpr std::size_t none = Unmatched;
+  std::vector<std::size_t> first(static_cast<std::size_t>(this->Mesh.NumberOfVertices()), none), next(found.size());
+  for (std::size_t f = found.size(); f-- > 0;)
+  {
+    next[f] = first[found[f].Vertex];
+    first[found[f].Vertex] = f;
+  }
+  // MatchCriticalPoints' pairs sort by (distance, expected, found); the candidates are in that
+  // order but for the found points of one run of equal distance and expected point, which may
+  // lie on several vertices in another order than their numbers.
+  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
+  for (std::size_t i = 0; i < this->Candidates.size();)
+  {
+    const Candidate& head = this->Candidates[i];
+    const std::size_t runStart = pairs.size();
+    for (; i < this->Candidates.size() && this->Candidates[i].Distance == head.Distance &&
+         this->Candidates[i].Expected == head.Expected;
+         ++i)
+    {
+      const std::size_t e = static_cast<std::size_t>(head.Expected);
+      for (std::size_t f = first[this->Candidates[i].Vertex]; f != none; f = next[f])
+      {
+        if (found[f].MorseIndex == this->Expected[e].MorseIndex)
+        {
+          pairs.emplace_back(head.Distance, e, f);
+        }
+      }
+    }
+    std::sort(pairs.begin() + static_cast<std::ptrdiff_t>(runStart), pairs.end());
+  }
+  return MatchAsManyAsPossible(pairs, this->Expected.size(), found.size());
 }
 
 TopologyComparison CompareCriticalPoints(const std::vector<CriticalPointLocation>& expected,

@@ -5,6 +5,7 @@
 // Usage: TestTopologyVerification
 // Prints "N passed, N failed"; returns nonzero on failure.
 #include "TestHarness.h"
+#include "TestSupport.h"
 #include "TopologyVerification.h"
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <functional>
 #include <random>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 using namespace topospline;
@@ -150,6 +152,91 @@ TEST_CASE(TopologyComparisonEqualsAllPairs)
     CHECK_EQ(c.Spurious.size(), found.size() - matched);
     CHECK(c.MaximumDistance <= 3 * tolerance);
   }
+}
+
+// Topological sampling matches many found sets against one wanted set with a
+// CriticalPointMatcher, whose pairs are found once: its partners must be MatchCriticalPoints'
+// own, on a grid (integer coordinates: many pairs at equal distances, whose order decides the
+// closest-first matching) and on a Delaunay mesh, with reaches of 1 and 3, hops of 2 and 3, two
+// points on one vertex, found sets listed out of vertex order, on one thread and on four, and
+// with a found point off its vertex (which Match hands to MatchCriticalPoints).
+TEST_CASE(MatcherOfManyFoundSetsEqualsMatchCriticalPoints)
+{
+  std::mt19937_64 random(23);
+  const int nx = 30, ny = 24;
+  TriangleMeshTopology grid;
+  grid.BuildGrid(nx, ny, SequentialFor);
+  std::vector<double> gridPoints;
+  for (int j = 0; j < ny; ++j)
+  {
+    for (int i = 0; i < nx; ++i)
+    {
+      gridPoints.insert(gridPoints.end(), { double(i), double(j) });
+    }
+  }
+  const PlanarScalarField scattered = RandomDelaunayField(5, 400);
+  TriangleMeshTopology delaunay;
+  std::string error;
+  CHECK(delaunay.Build(static_cast<Index>(scattered.Points.size() / 2), scattered.Triangles, SequentialFor, error));
+  const auto at = [](const std::vector<double>& points, Index v, int morseIndex) {
+    CriticalPointLocation cp;
+    cp.MorseIndex = morseIndex;
+    cp.Position[0] = points[2 * v];
+    cp.Position[1] = points[2 * v + 1];
+    cp.Vertex = v;
+    return cp;
+  };
+  int compared = 0, matched = 0;
+  for (const auto& [mesh, points, tolerance] :
+    { std::make_tuple(&grid, &std::as_const(gridPoints), 1.0 + 1e-9),
+      std::make_tuple(&grid, &std::as_const(gridPoints), 1.5), std::make_tuple(&delaunay, &scattered.Points, 0.06) })
+  {
+    const Index vertices = mesh->NumberOfVertices();
+    std::vector<CriticalPointLocation> expected;
+    for (int k = 0; k < vertices / 5; ++k)
+    {
+      const Index v = static_cast<Index>(random() % vertices);
+      expected.push_back(at(*points, v, static_cast<int>(random() % 3)));
+      if (random() % 6 == 0)
+      {
+        expected.back().Reach = BoundaryJunctionReach;
+        expected.back().Hops = BoundaryJunctionHops;
+        expected.push_back(at(*points, v, 1)); // a second point on the vertex
+      }
+    }
+    const CriticalPointMatcher sequential(expected, *points, tolerance, *mesh);
+    const CriticalPointMatcher threaded(expected, *points, tolerance, *mesh, ThreadedFor);
+    for (int set = 0; set < 8; ++set)
+    {
+      std::vector<CriticalPointLocation> found;
+      for (int k = 0; k < vertices / 4; ++k)
+      {
+        const Index v = static_cast<Index>(random() % vertices);
+        found.push_back(at(*points, v, static_cast<int>(random() % 3)));
+        if (random() % 8 == 0)
+        {
+          found.push_back(found.back()); // a saddle of multiplicity 2
+        }
+      }
+      if (set % 2 == 1)
+      {
+        std::sort(found.begin(), found.end(),
+          [](const CriticalPointLocation& a, const CriticalPointLocation& b) { return a.Vertex < b.Vertex; });
+      }
+      if (set == 7)
+      {
+        found[0].Position[0] += 0.25 * tolerance; // off its vertex
+      }
+      const std::vector<std::size_t> reference = MatchCriticalPoints(expected, found, tolerance, mesh);
+      CHECK(sequential.Match(found) == reference);
+      CHECK(threaded.Match(found) == reference);
+      ++compared;
+      matched += static_cast<int>(
+        std::count_if(reference.begin(), reference.end(), [](std::size_t f) { return f != UnmatchedCriticalPoint; }));
+    }
+  }
+  CHECK_EQ(compared, 24);
+  CHECK(matched > 500); // the sets do overlap
 }
 
 int main()
