@@ -1462,30 +1462,39 @@ void TwoCellReconstruction::BuildCellLocator()
   this->Origin[1] = box[2];
   this->BucketSize[0] = std::max((box[1] - box[0]) / side, 1e-300);
   this->BucketSize[1] = std::max((box[3] - box[2]) / side, 1e-300);
-  std::vector<std::vector<Index>> lists(static_cast<std::size_t>(side) * side);
-  for (Index c = 0; c < this->NumberOfCells(); ++c)
-  {
-    const auto& cell = *this->Cells[c];
-    if (!cell.Valid)
-    {
-      continue;
-    }
-    const int i0 = std::clamp(static_cast<int>((cell.Bounds[0] - this->Snap - box[0]) / this->BucketSize[0]), 0, side - 1);
-    const int i1 = std::clamp(static_cast<int>((cell.Bounds[1] + this->Snap - box[0]) / this->BucketSize[0]), 0, side - 1);
-    const int j0 = std::clamp(static_cast<int>((cell.Bounds[2] - this->Snap - box[2]) / this->BucketSize[1]), 0, side - 1);
-    const int j1 = std::clamp(static_cast<int>((cell.Bounds[3] + this->Snap - box[2]) / this->BucketSize[1]), 0, side - 1);
+  // Compressed rows, counted then filled in the order of the cells (a vector per bucket, four
+  // per cell, was most of this on noise).
+  const auto bucketAlong = [&](double coordinate, int axis) {
+    return std::clamp(static_cast<int>((coordinate - box[2 * axis]) / this->BucketSize[axis]), 0, side - 1);
+  };
+  const auto forEachBucketOf = [&](const auto& cell, auto&& visit) {
+    const int i0 = bucketAlong(cell.Bounds[0] - this->Snap, 0), i1 = bucketAlong(cell.Bounds[1] + this->Snap, 0);
+    const int j0 = bucketAlong(cell.Bounds[2] - this->Snap, 1), j1 = bucketAlong(cell.Bounds[3] + this->Snap, 1);
     for (int j = j0; j <= j1; ++j)
     {
       for (int i = i0; i <= i1; ++i)
       {
-        lists[static_cast<std::size_t>(j) * side + i].push_back(c);
+        visit(static_cast<std::size_t>(j) * side + i);
       }
     }
-  }
-  for (const auto& list : lists)
+  };
+  this->BucketStart.assign(static_cast<std::size_t>(side) * side + 1, 0);
+  for (Index c = 0; c < this->NumberOfCells(); ++c)
   {
-    this->BucketCells.insert(this->BucketCells.end(), list.begin(), list.end());
-    this->BucketStart.push_back(static_cast<Index>(this->BucketCells.size()));
+    if (this->Cells[c]->Valid)
+    {
+      forEachBucketOf(*this->Cells[c], [&](std::size_t b) { ++this->BucketStart[b + 1]; });
+    }
+  }
+  std::partial_sum(this->BucketStart.begin(), this->BucketStart.end(), this->BucketStart.begin());
+  this->BucketCells.resize(static_cast<std::size_t>(this->BucketStart.back()));
+  std::vector<Index> fill(this->BucketStart.begin(), this->BucketStart.end() - 1);
+  for (Index c = 0; c < this->NumberOfCells(); ++c)
+  {
+    if (this->Cells[c]->Valid)
+    {
+      forEachBucketOf(*this->Cells[c], [&](std::size_t b) { this->BucketCells[fill[b]++] = c; });
+    }
   }
 }
 
