@@ -671,41 +671,41 @@ vtkSmartPointer<vtkPolyData> SampledOneCellsBlock(const topospline::MorseSmaleCo
   }
   for (Index a = 0; a < static_cast<Index>(complex.OneCells.size()); ++a)
   {
-  ids.clear();
-  for (Index p : smoothed.PiecesOfOneCell[a])
-  {
-    const auto& piece = smoothed.Pieces[p];
-    const int count = piece.Curve.Segments * samplesPerSegment;
-    for (int s = ids.empty() ? 0 : 1; s <= count; ++s)
+    ids.clear();
+    for (Index p : smoothed.PiecesOfOneCell[a])
     {
-      const double t = static_cast<double>(s) / count;
-      double uv[2], xyz[3];
-      piece.Curve.Evaluate(t, uv);
-      plane.To3D(uv, xyz);
-      ids.push_back(points->InsertNextPoint(xyz));
-      height->InsertNextValue(piece.Height.Value(t));
+      const auto& piece = smoothed.Pieces[p];
+      const int count = piece.Curve.Segments * samplesPerSegment;
+      for (int s = ids.empty() ? 0 : 1; s <= count; ++s)
+      {
+        const double t = static_cast<double>(s) / count;
+        double uv[2], xyz[3];
+        piece.Curve.Evaluate(t, uv);
+        plane.To3D(uv, xyz);
+        ids.push_back(points->InsertNextPoint(xyz));
+        height->InsertNextValue(piece.Height.Value(t));
+      }
     }
+    const auto& oneCell = complex.OneCells[a];
+    if (ids.empty())
+    {
+      // A 1-cell of one point (a saddle on its minimum's vertex, zero persistence).
+      double xyz[3];
+      plane.To3D(oneCell.Points.data(), xyz);
+      ids.push_back(points->InsertNextPoint(xyz));
+      height->InsertNextValue(oneCell.Values.front());
+    }
+    lines->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
+    id->InsertNextValue(a);
+    source->InsertNextValue(complex.CriticalPoints[oneCell.Source].Id);
+    destination->InsertNextValue(complex.CriticalPoints[oneCell.Destination].Id);
+    type->InsertNextValue(oneCell.Type);
   }
-  const auto& oneCell = complex.OneCells[a];
-  if (ids.empty())
-  {
-    // A 1-cell of one point (a saddle on its minimum's vertex, zero persistence).
-    double xyz[3];
-    plane.To3D(oneCell.Points.data(), xyz);
-    ids.push_back(points->InsertNextPoint(xyz));
-    height->InsertNextValue(oneCell.Values.front());
-  }
-  lines->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
-  id->InsertNextValue(a);
-  source->InsertNextValue(complex.CriticalPoints[oneCell.Source].Id);
-  destination->InsertNextValue(complex.CriticalPoints[oneCell.Destination].Id);
-  type->InsertNextValue(oneCell.Type);
-}
-sampled->SetPoints(points);
-sampled->SetLines(lines);
-sampled->GetPointData()->AddArray(height);
-sampled->GetPointData()->SetActiveScalars(names::Height);
-conversion::AddArrays(sampled->GetCellData(), { id, source, destination, type });
+  sampled->SetPoints(points);
+  sampled->SetLines(lines);
+  sampled->GetPointData()->AddArray(height);
+  sampled->GetPointData()->SetActiveScalars(names::Height);
+  conversion::AddArrays(sampled->GetCellData(), { id, source, destination, type });
   return sampled;
 }
 } // namespace

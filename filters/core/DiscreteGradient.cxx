@@ -4,6 +4,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 
 namespace topospline
 {
@@ -439,6 +440,85 @@ bool DiscreteGradient::SaddleVertices(const TriangleMeshTopology& mesh, const do
   for (Index v = 0; v < n; ++v)
   {
     saddles.insert(saddles.end(), multiplicity[v], v);
+  }
+  return true;
+}
+
+SaddleVertexCount::SaddleVertexCount(const TriangleMeshTopology& mesh, const ParallelFor& parallelFor)
+  : Mesh(mesh)
+  , Parallel(parallelFor)
+{
+}
+
+bool SaddleVertexCount::Count(const std::vector<double>& values, std::vector<Index>& saddles)
+{
+  const Index n = this->Mesh.NumberOfVertices();
+  if (this->Counted.size() != values.size())
+  {
+    if (!DiscreteGradient::SaddleVertices(this->Mesh, values.data(), this->Parallel, saddles))
+    {
+      return false;
+    }
+    this->Counted = values;
+    this->Multiplicity.assign(static_cast<std::size_t>(n), 0);
+    for (Index v : saddles)
+    {
+      ++this->Multiplicity[v];
+    }
+    return true;
+  }
+  const auto differs = [](double a, double b) { return std::memcmp(&a, &b, sizeof(double)) != 0; };
+  const std::vector<Index> changed =
+    CollectInStretches<Index>(n, Index(1) << 16, this->Parallel, [&](Index v, std::vector<Index>& list) {
+      if (differs(values[v], this->Counted[v]))
+      {
+        list.push_back(v);
+      }
+    });
+  for (Index c : changed)
+  {
+    if (!std::isfinite(values[c]))
+    {
+      return false; // as SaddleVertices; the last count stays the reference
+    }
+  }
+  // The changed vertices and their links: the lower stars whose lower links can differ.
+  std::vector<Index> stars;
+  this->Stale.resize(static_cast<std::size_t>(n), 0);
+  for (Index c : changed)
+  {
+    for (Index i = this->Mesh.VertexTriangleBegin(c); i < this->Mesh.VertexTriangleEnd(c); ++i)
+    {
+      for (Index w : this->Mesh.TriangleVertices[this->Mesh.VertexTriangle(i)])
+      {
+        if (!this->Stale[w])
+        {
+          this->Stale[w] = 1;
+          stars.push_back(w);
+        }
+      }
+    }
+  }
+  this->Parallel(0, static_cast<Index>(stars.size()), [&](Index begin, Index end) {
+    for (Index k = begin; k < end; ++k)
+    {
+      const Index v = stars[k];
+      this->Multiplicity[v] =
+        static_cast<unsigned char>(DiscreteGradient::CriticalCellsOfLowerStar(this->Mesh, values.data(), v).Saddles);
+    }
+  });
+  for (Index v : stars)
+  {
+    this->Stale[v] = 0;
+  }
+  for (Index c : changed)
+  {
+    this->Counted[c] = values[c];
+  }
+  saddles.clear();
+  for (Index v = 0; v < n; ++v)
+  {
+    saddles.insert(saddles.end(), this->Multiplicity[v], v);
   }
   return true;
 }

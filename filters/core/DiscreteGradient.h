@@ -89,4 +89,23 @@ public:
   static Index EdgeOwner(const TriangleMeshTopology& mesh, const VertexOrder& order, Index e);
   static Index TriangleOwner(const TriangleMeshTopology& mesh, const VertexOrder& order, Index t);
 };
+
+// DiscreteGradient::SaddleVertices for value arrays on one mesh that differ in a few vertices
+// from one count to the next (topological sampling's relocation rounds change a few hundred
+// vertices of a million): after a count that succeeded, only the lower stars a changed value
+// can change are counted again, those of the vertices whose value differs bit for bit from that
+// count's and of their neighbours. The same saddles as SaddleVertices, and false where it is.
+class SaddleVertexCount
+{
+public:
+  SaddleVertexCount(const TriangleMeshTopology& mesh, const ParallelFor& parallelFor);
+  bool Count(const std::vector<double>& values, std::vector<Index>& saddles);
+
+private:
+  const TriangleMeshTopology& Mesh;
+  const ParallelFor Parallel;
+  std::vector<double> Counted;             // the values of the last count that succeeded
+  std::vector<unsigned char> Multiplicity; // its saddles per vertex
+  std::vector<char> Stale;                 // scratch: the lower stars to count again
+};
 } // namespace topospline

@@ -857,6 +857,7 @@ public:
     , Wanted(this->Locations(wantedSaddles))
     , Tolerance(tolerance)
     , Parallel(parallel)
+    , Saddles(mesh, parallel)
   {
   }
 
@@ -919,10 +920,11 @@ private:
   }
 
   // The saddle vertices of the sampling with `values` (stage 1's, counted from the lower links:
-  // DiscreteGradient::SaddleVertices); false on a value stage 1 refuses.
+  // DiscreteGradient::SaddleVertices, again only where the values changed); false on a value
+  // stage 1 refuses.
   bool CountSaddles(const std::vector<double>& values, std::vector<Index>& saddles)
   {
-    return DiscreteGradient::SaddleVertices(this->Mesh, values.data(), this->Parallel, saddles);
+    return this->Saddles.Count(values, saddles);
   }
 
   const std::vector<double>& Points;
@@ -932,7 +934,8 @@ private:
   const double Tolerance;
   const ParallelFor& Parallel;
   int Matches = 0;
-  std::unique_ptr<const CriticalPointMatcher> Pairs; // from the second match on
+  std::unique_ptr<CriticalPointMatcher> Pairs; // from the second match on
+  SaddleVertexCount Saddles;
 };
 
 // RelocateSaddles tries the patterns of the links (PlaceMissingSaddlesByTheirLinks) of at most

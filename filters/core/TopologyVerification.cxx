@@ -300,7 +300,7 @@ CriticalPointMatcher::CriticalPointMatcher(const std::vector<CriticalPointLocati
   });
 }
 
-std::vector<std::size_t> CriticalPointMatcher::Match(const std::vector<CriticalPointLocation>& found) const
+std::vector<std::size_t> CriticalPointMatcher::Match(const std::vector<CriticalPointLocation>& found)
 {
   bool atVertices = this->OnVertices;
   for (std::size_t f = 0; f < found.size() && atVertices; ++f)
@@ -316,7 +316,9 @@ std::vector<std::size_t> CriticalPointMatcher::Match(const std::vector<CriticalP
   }
   // The found points on each vertex, in increasing order: a list through `next` from `first`.
   constexpr std::size_t none = Unmatched;
-  std::vector<std::size_t> first(static_cast<std::size_t>(this->Mesh.NumberOfVertices()), none), next(found.size());
+  std::vector<std::size_t>& first = this->FirstFoundAt;
+  first.resize(static_cast<std::size_t>(this->Mesh.NumberOfVertices()), none);
+  std::vector<std::size_t> next(found.size());
   for (std::size_t f = found.size(); f-- > 0;)
   {
     next[f] = first[found[f].Vertex];
@@ -344,6 +346,10 @@ std::vector<std::size_t> CriticalPointMatcher::Match(const std::vector<CriticalP
       }
     }
     std::sort(pairs.begin() + static_cast<std::ptrdiff_t>(runStart), pairs.end());
+  }
+  for (const CriticalPointLocation& cp : found)
+  {
+    first[cp.Vertex] = none;
   }
   return MatchAsManyAsPossible(pairs, this->Expected.size(), found.size());
 }

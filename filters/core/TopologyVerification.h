@@ -79,7 +79,8 @@ public:
     double tolerance, const TriangleMeshTopology& mesh, const ParallelFor& parallel = SequentialFor);
 
   // The found point of each expected one (UnmatchedCriticalPoint: none), as MatchCriticalPoints.
-  std::vector<std::size_t> Match(const std::vector<CriticalPointLocation>& found) const;
+  // Not for two threads at once: the found points are listed per vertex in this object.
+  std::vector<std::size_t> Match(const std::vector<CriticalPointLocation>& found);
 
 private:
   struct Candidate
@@ -95,6 +96,10 @@ private:
   const ParallelFor Parallel; // a copy: the default argument is a temporary
   bool OnVertices = true; // every expected point on a vertex of the mesh
   std::vector<Candidate> Candidates; // by distance, then expected point, then vertex
+  // Per vertex, the first found point on it in a Match (cleared again after it): a list the
+  // size of the mesh made each match cost a pass over every vertex, 4 million on a terrain
+  // with a few hundred saddles.
+  std::vector<std::size_t> FirstFoundAt;
 };
 
 // The comparison of MatchCriticalPoints: counts, the points left over on either side.

@@ -38,6 +38,13 @@ void SampleSide(const SideSegments& side, const std::vector<int>& multipliers, i
 {
   double point[2];
   int segment = 0, offset = 0;
+  std::size_t count = 1;
+  for (std::size_t i = 0; i < side.Pieces.size(); ++i)
+  {
+    count += static_cast<std::size_t>(side.Pieces[i]) * (side.Samples.empty() ? c : side.Samples[i]);
+  }
+  xy.reserve(xy.size() + 2 * count);
+  tau.reserve(tau.size() + count);
   for (std::size_t i = 0; i < side.Pieces.size(); ++i)
   {
     const int samples = side.Samples.empty() ? c : side.Samples[i];
@@ -100,6 +107,13 @@ bool BuildBoundaryWalk(const std::array<SideSegments, 4>& segments, int c, int m
   }
   walk.clear();
   parameters.clear();
+  std::size_t points = 0;
+  for (const std::vector<double>& side : tau)
+  {
+    points += side.size() - 1;
+  }
+  walk.reserve(2 * points);
+  parameters.reserve(2 * points);
   auto append = [&](int s, bool forward, double u0, double v0, double du, double dv) {
     const std::size_t count = tau[s].size();
     for (std::size_t k = 0; k + 1 < count; ++k)

@@ -571,6 +571,70 @@ TEST_CASE(SaddleVerticesCountedFromLowerLinksAreTheGradientsCriticalEdges)
   CHECK(!DiscreteGradient::SaddleVertices(MeshOf(broken), broken.Values.data(), SequentialFor, counted));
 }
 
+// SaddleVertexCount counts again only the lower stars around changed values: after every step
+// of a sequence of changes (a few vertices to new values, to a neighbour's value, the sign of a
+// zero flipped, a NaN that fails the count and is then taken back) its saddles must be
+// SaddleVertices' of the same values, on the meshes above, in stretches as threads take them.
+TEST_CASE(SaddleVertexCountFollowsChangedValues)
+{
+  const std::vector<MeshField> fields = MeshesWithNoise(30, 27, 300, 400);
+  const ParallelFor inTwoStretches = [](Index begin, Index end, const RangeBody& body) {
+    const Index half = std::max<Index>((end - begin + 1) / 2, 1);
+    for (Index b = begin; b < end; b += half)
+    {
+      body(b, std::min(end, b + half));
+    }
+  };
+  DeterministicRandom random(41);
+  Index steps = 0, changedSaddles = 0;
+  for (const MeshField& field : fields)
+  {
+    const TriangleMeshTopology mesh = MeshOf(field);
+    std::vector<double> values = field.Values;
+    const Index n = mesh.NumberOfVertices();
+    SaddleVertexCount count(mesh, inTwoStretches);
+    std::vector<Index> counted, expected, before;
+    CHECK(count.Count(values, counted));
+    for (int step = 0; step < 25; ++step)
+    {
+      const std::vector<double> last = values;
+      const int changes = 1 + static_cast<int>(random.Uniform() * 6);
+      for (int c = 0; c < changes; ++c)
+      {
+        const Index v = std::min<Index>(n - 1, static_cast<Index>(random.Uniform() * n));
+        const double kind = random.Uniform();
+        if (kind < 0.4)
+        {
+          values[v] = random.Uniform();
+        }
+        else if (kind < 0.8)
+        {
+          const Index t = mesh.VertexTriangle(mesh.VertexTriangleBegin(v));
+          values[v] = values[mesh.TriangleVertices[t][0] == v ? mesh.TriangleVertices[t][1] : mesh.TriangleVertices[t][0]];
+        }
+        else
+        {
+          values[v] = values[v] == 0 ? -values[v] : 0.0;
+        }
+      }
+      if (step == 10)
+      {
+        std::vector<double> broken = values;
+        broken[n / 2] = std::nan("");
+        CHECK(!count.Count(broken, counted));
+      }
+      before = expected;
+      CHECK(DiscreteGradient::SaddleVertices(mesh, values.data(), SequentialFor, expected));
+      CHECK(count.Count(values, counted));
+      CHECK(counted == expected);
+      changedSaddles += before != expected ? 1 : 0;
+      ++steps;
+    }
+  }
+  CHECK(steps > 100);
+  CHECK(changedSaddles > steps / 4); // the changes do move saddles
+}
+
 TEST_CASE(CriticalCellsOfOneLowerStarAreTheGradients)
 {
   // DiscreteGradient::CriticalCellsOfLowerStar (topological sampling's local moves judge a

@@ -204,8 +204,8 @@ TEST_CASE(MatcherOfManyFoundSetsEqualsMatchCriticalPoints)
         expected.push_back(at(*points, v, 1)); // a second point on the vertex
       }
     }
-    const CriticalPointMatcher sequential(expected, *points, tolerance, *mesh);
-    const CriticalPointMatcher threaded(expected, *points, tolerance, *mesh, ThreadedFor);
+    CriticalPointMatcher sequential(expected, *points, tolerance, *mesh);
+    CriticalPointMatcher threaded(expected, *points, tolerance, *mesh, ThreadedFor);
     for (int set = 0; set < 8; ++set)
     {
       std::vector<CriticalPointLocation> found;
