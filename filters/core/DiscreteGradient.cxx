@@ -415,11 +415,15 @@ LowerStarCriticalCells DiscreteGradient::CriticalCellsOfLowerStar(
   return cells;
 }
 
-bool DiscreteGradient::SaddleVertices(const TriangleMeshTopology& mesh, const double* values,
-  const ParallelFor& parallelFor, std::vector<Index>& saddles)
+namespace
+{
+// Every vertex's saddle multiplicity (its lower star's critical edges); false on a non-finite
+// value or a vertex in no triangle, as Compute's callers fail.
+bool SaddleMultiplicities(const TriangleMeshTopology& mesh, const double* values, const ParallelFor& parallelFor,
+  std::vector<unsigned char>& multiplicity)
 {
   const Index n = mesh.NumberOfVertices();
-  std::vector<unsigned char> multiplicity(n, 0);
+  multiplicity.assign(static_cast<std::size_t>(n), 0);
   std::atomic<bool> valid(true);
   parallelFor(0, n, [&](Index begin, Index end) {
     for (Index v = begin; v < end; ++v)
@@ -429,18 +433,34 @@ bool DiscreteGradient::SaddleVertices(const TriangleMeshTopology& mesh, const do
         valid = false;
         return;
       }
-      multiplicity[v] = static_cast<unsigned char>(CriticalCellsOfLowerStar(mesh, values, v).Saddles);
+      multiplicity[v] =
+        static_cast<unsigned char>(DiscreteGradient::CriticalCellsOfLowerStar(mesh, values, v).Saddles);
     }
   });
+  return valid;
+}
+
+// The saddle vertices in increasing order, each as often as its multiplicity.
+void ListSaddles(const std::vector<unsigned char>& multiplicity, std::vector<Index>& saddles)
+{
   saddles.clear();
-  if (!valid)
+  for (std::size_t v = 0; v < multiplicity.size(); ++v)
   {
+    saddles.insert(saddles.end(), multiplicity[v], static_cast<Index>(v));
+  }
+}
+} // namespace
+
+bool DiscreteGradient::SaddleVertices(const TriangleMeshTopology& mesh, const double* values,
+  const ParallelFor& parallelFor, std::vector<Index>& saddles)
+{
+  std::vector<unsigned char> multiplicity;
+  if (!SaddleMultiplicities(mesh, values, parallelFor, multiplicity))
+  {
+    saddles.clear();
     return false;
   }
-  for (Index v = 0; v < n; ++v)
-  {
-    saddles.insert(saddles.end(), multiplicity[v], v);
-  }
+  ListSaddles(multiplicity, saddles);
   return true;
 }
 
@@ -455,16 +475,14 @@ bool SaddleVertexCount::Count(const std::vector<double>& values, std::vector<Ind
   const Index n = this->Mesh.NumberOfVertices();
   if (this->Counted.size() != values.size())
   {
-    if (!DiscreteGradient::SaddleVertices(this->Mesh, values.data(), this->Parallel, saddles))
+    if (!SaddleMultiplicities(this->Mesh, values.data(), this->Parallel, this->Multiplicity))
     {
+      this->Multiplicity.clear();
+      saddles.clear();
       return false;
     }
     this->Counted = values;
-    this->Multiplicity.assign(static_cast<std::size_t>(n), 0);
-    for (Index v : saddles)
-    {
-      ++this->Multiplicity[v];
-    }
+    ListSaddles(this->Multiplicity, saddles);
     return true;
   }
   const auto differs = [](double a, double b) { return std::memcmp(&a, &b, sizeof(double)) != 0; };
@@ -515,11 +533,7 @@ bool SaddleVertexCount::Count(const std::vector<double>& values, std::vector<Ind
   {
     this->Counted[c] = values[c];
   }
-  saddles.clear();
-  for (Index v = 0; v < n; ++v)
-  {
-    saddles.insert(saddles.end(), this->Multiplicity[v], v);
-  }
+  ListSaddles(this->Multiplicity, saddles);
   return true;
 }
 } // namespace topospline

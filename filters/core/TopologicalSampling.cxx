@@ -865,7 +865,7 @@ public:
   {
     SaddleMatch match;
     std::vector<Index> saddles;
-    if (!this->CountSaddles(values, saddles))
+    if (!this->Saddles.Count(values, saddles))
     {
       match.Missing = this->WantedSaddles;
       return match;
@@ -919,14 +919,6 @@ private:
     return result;
   }
 
-  // The saddle vertices of the sampling with `values` (stage 1's, counted from the lower links:
-  // DiscreteGradient::SaddleVertices, again only where the values changed); false on a value
-  // stage 1 refuses.
-  bool CountSaddles(const std::vector<double>& values, std::vector<Index>& saddles)
-  {
-    return this->Saddles.Count(values, saddles);
-  }
-
   const std::vector<double>& Points;
   const TriangleMeshTopology& Mesh;
   const std::vector<Index>& WantedSaddles;
@@ -935,6 +927,8 @@ private:
   const ParallelFor& Parallel;
   int Matches = 0;
   std::unique_ptr<CriticalPointMatcher> Pairs; // from the second match on
+  // The sampling's saddles as stage 1 finds them (counted from the lower links, again only
+  // where the values changed); false on a value stage 1 refuses.
   SaddleVertexCount Saddles;
 };
 

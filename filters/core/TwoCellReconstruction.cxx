@@ -1,6 +1,7 @@
 #include "TwoCellReconstruction.h"
 
 #include "BezierSpline.h"
+#include "CompressedGraph.h"
 
 #include "PiecewiseLinearField.h"
 
@@ -1476,40 +1477,32 @@ void TwoCellReconstruction::BuildCellLocator()
   this->Origin[1] = box[2];
   this->BucketSize[0] = std::max((box[1] - box[0]) / side, 1e-300);
   this->BucketSize[1] = std::max((box[3] - box[2]) / side, 1e-300);
-  // Compressed rows, counted then filled in the order of the cells (a vector per bucket, four
-  // per cell, was most of this on noise).
+  // The (bucket, cell) pairs in the order of the cells, as compressed rows (a vector per bucket,
+  // four per cell, was most of this on noise).
   const auto bucketAlong = [&](double coordinate, int axis) {
     return std::clamp(static_cast<int>((coordinate - box[2 * axis]) / this->BucketSize[axis]), 0, side - 1);
   };
-  const auto forEachBucketOf = [&](const auto& cell, auto&& visit) {
+  std::vector<std::array<Index, 2>> cellInBucket;
+  for (Index c = 0; c < this->NumberOfCells(); ++c)
+  {
+    const auto& cell = *this->Cells[c];
+    if (!cell.Valid)
+    {
+      continue;
+    }
     const int i0 = bucketAlong(cell.Bounds[0] - this->Snap, 0), i1 = bucketAlong(cell.Bounds[1] + this->Snap, 0);
     const int j0 = bucketAlong(cell.Bounds[2] - this->Snap, 1), j1 = bucketAlong(cell.Bounds[3] + this->Snap, 1);
     for (int j = j0; j <= j1; ++j)
     {
       for (int i = i0; i <= i1; ++i)
       {
-        visit(static_cast<std::size_t>(j) * side + i);
+        cellInBucket.push_back({ j * side + i, c });
       }
     }
-  };
-  this->BucketStart.assign(static_cast<std::size_t>(side) * side + 1, 0);
-  for (Index c = 0; c < this->NumberOfCells(); ++c)
-  {
-    if (this->Cells[c]->Valid)
-    {
-      forEachBucketOf(*this->Cells[c], [&](std::size_t b) { ++this->BucketStart[b + 1]; });
-    }
   }
-  std::partial_sum(this->BucketStart.begin(), this->BucketStart.end(), this->BucketStart.begin());
-  this->BucketCells.resize(static_cast<std::size_t>(this->BucketStart.back()));
-  std::vector<Index> fill(this->BucketStart.begin(), this->BucketStart.end() - 1);
-  for (Index c = 0; c < this->NumberOfCells(); ++c)
-  {
-    if (this->Cells[c]->Valid)
-    {
-      forEachBucketOf(*this->Cells[c], [&](std::size_t b) { this->BucketCells[fill[b]++] = c; });
-    }
-  }
+  CompressedGraph buckets(side * side, cellInBucket);
+  this->BucketStart = std::move(buckets.Offsets);
+  this->BucketCells = std::move(buckets.Targets);
 }
 
 bool TwoCellReconstruction::LocateInCell(Index c, double x, double y, double uv[2]) const
