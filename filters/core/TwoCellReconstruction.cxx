@@ -449,6 +449,10 @@ int ChooseGridLayout(const std::array<SideSegments, 4>& sides, int maximum, std:
   std::array<std::vector<int>, 4> reach;
   const auto reachable = [&](int s, int extra) {
     std::vector<int>& table = reach[s];
+    if (table.capacity() == 0)
+    {
+      table.reserve(std::max<std::size_t>(64, static_cast<std::size_t>(extra) + 1));
+    }
     while (static_cast<int>(table.size()) <= extra)
     {
       const int r = static_cast<int>(table.size());

@@ -769,6 +769,25 @@ TEST_CASE(CountsNearOneCellsMatchExactDistancesOnManySegments)
   CHECK(expectedNear > 50);
   CHECK_EQ(near, expectedNear);
   CHECK_EQ(far, static_cast<Index>(points.size()) - expectedNear);
+  // The pieces sampled on several threads, and the points' buckets kept in a hash set instead of
+  // flags over their box (two points 1e7 away make the box far larger than their number).
+  near = far = -1;
+  CountByDistanceToOneCells(points, smoothed, 2.0, near, far, ThreadedFor);
+  CHECK_EQ(near, expectedNear);
+  CHECK_EQ(far, static_cast<Index>(points.size()) - expectedNear);
+  for (const double at : { 1e7, -1e7 })
+  {
+    CriticalPointLocation distant;
+    distant.Position[0] = distant.Position[1] = at;
+    points.push_back(distant);
+  }
+  for (const ParallelFor& parallel : { ParallelFor(SequentialFor), ParallelFor(ThreadedFor) })
+  {
+    near = far = -1;
+    CountByDistanceToOneCells(points, smoothed, 2.0, near, far, parallel);
+    CHECK_EQ(near, expectedNear);
+    CHECK_EQ(far, static_cast<Index>(points.size()) - expectedNear);
+  }
 }
 
 namespace

@@ -7,6 +7,7 @@
 #include "DeterministicRandom.h"
 #include "SibsonPatchSampling.h"
 #include "TestHarness.h"
+#include "TestSupport.h" // ThreadedFor
 
 #include <algorithm>
 #include <chrono>
@@ -428,7 +429,7 @@ TEST_CASE(SurfaceOfLinearDataIsLinear)
 {
   // Boundary of F = x + y: the Laplace values and difference derivatives are exact, nothing
   // needs correcting, and the surface is x + y.
-  for (int n = 1; n <= 6; ++n)
+  for (const int n : { 1, 2, 3, 4, 5, 6, 66 }) // 66: a Laplace system factored for itself alone
   {
     MonotoneSurfaceBoundary b;
     const double h = 1.0 / n;
@@ -555,6 +556,55 @@ TEST_CASE(StressManySurfacesAndLargerGrids)
     total, failures, sampledNegative, worstShift);
   CHECK(failures == 0);
   CHECK(sampledNegative == 0);
+}
+
+TEST_CASE(SurfacesBuiltOnManyThreadsEqualOneThread)
+{
+  // The Laplace systems of grids up to 64 interior nodes a side are factored once per process
+  // and shared by every thread that builds a surface; larger ones are factored per surface.
+  // Surfaces of both kinds built on four threads at once (first uses of the shared
+  // factorizations included) must equal the same surfaces built one after the other, bit for bit.
+  Random random(42);
+  std::vector<MonotoneSurfaceBoundary> boundaries;
+  for (int trial = 0; trial < 48; ++trial)
+  {
+    const int n = trial % 8 == 7 ? 64 + trial % 3 : 1 + random.Integer(40);
+    const auto flavour = static_cast<BoundaryFlavour>(random.Integer(static_cast<int>(BoundaryFlavour::Count)));
+    boundaries.push_back(MakeBoundary(random, n, flavour));
+  }
+  const auto evaluations = [](const MonotoneSurfaceBoundary& b) {
+    MonotoneSibsonSurface surface;
+    std::string error;
+    std::vector<double> values;
+    if (!surface.Build(b, error))
+    {
+      return values;
+    }
+    for (int a = 0; a <= 20; ++a)
+    {
+      for (int c = 0; c <= 20; ++c)
+      {
+        values.push_back(surface.Evaluate(a / 20.0, c / 20.0));
+      }
+    }
+    return values;
+  };
+  std::vector<std::vector<double>> threaded(boundaries.size());
+  ThreadedFor(0, static_cast<Index>(boundaries.size()), [&](Index begin, Index end) {
+    for (Index t = begin; t < end; ++t)
+    {
+      threaded[t] = evaluations(boundaries[t]);
+    }
+  });
+  int built = 0;
+  for (std::size_t t = 0; t < boundaries.size(); ++t)
+  {
+    const std::vector<double> sequential = evaluations(boundaries[t]);
+    built += sequential.empty() ? 0 : 1;
+    CHECK(sequential == threaded[t]);
+  }
+  std::printf("  %d of %zu surfaces built, the same on four threads and on one\n", built, boundaries.size());
+  CHECK(built == static_cast<int>(boundaries.size()));
 }
 
 TEST_CASE(EachSafeguardAloneSuffices)
