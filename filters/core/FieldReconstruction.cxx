@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -173,106 +174,141 @@ topospline::TopologicalSampling FieldReconstruction::SamplingOf(const MorseSmale
 
 namespace
 {
-// The buckets OneCellSamples keeps, by their (i, j): a flag per bucket of the box they span
-// when that box is not much larger than their number (a grid's points), a hash set otherwise
-// (a few points far apart). Looked up once per Bezier segment of every smoothed 1-cell: on
-// 1000 x 1000 noise the hash set alone was a third of counting the spurious points of F o Phi.
-class BucketSet
+// The square buckets of side `side` that hold points (x, y) at (floor(x / side), floor(y / side)),
+// and which items are registered in each. Items register in the buckets as OneCellSamples::
+// Nearest looks into them: the bucket of each point (x + dx side, y + dy side), dx and dy in
+// {-1, 0, 1} (not floor(x / side) + dx, which may round differently). A sample of a smoothed
+// curve in bucket B is then seen by exactly the items registered in B. Per bucket of the box
+// they span when that box is not much larger than their number (a grid's points), by a sorted
+// list otherwise (a few points far apart). Looked up once per Bezier segment of every smoothed
+// 1-cell: on 1000 x 1000 noise a hash set of the buckets was a third of counting the spurious
+// points of F o Phi.
+class BucketIndex
 {
 public:
-  explicit BucketSet(const std::vector<std::pair<long long, long long>>& buckets)
+  BucketIndex(double side, const std::vector<double>& around)
+    : Side(side)
   {
-    if (buckets.empty())
+    std::vector<std::array<long long, 3>> entries; // i, j, item
+    entries.reserve(9 * (around.size() / 2));
+    for (std::size_t p = 0; p + 1 < around.size(); p += 2)
+    {
+      for (int dx = -1; dx <= 1; ++dx)
+      {
+        for (int dy = -1; dy <= 1; ++dy)
+        {
+          const auto [i, j] = this->BucketOf(around[p] + dx * side, around[p + 1] + dy * side);
+          entries.push_back({ i, j, static_cast<long long>(p / 2) });
+        }
+      }
+    }
+    if (entries.empty())
     {
       return;
     }
-    this->I0 = this->I1 = buckets[0].first;
-    this->J0 = this->J1 = buckets[0].second;
-    for (const auto& [i, j] : buckets)
+    this->I0 = this->I1 = entries[0][0];
+    this->J0 = this->J1 = entries[0][1];
+    for (const auto& e : entries)
     {
-      this->I0 = std::min(this->I0, i);
-      this->I1 = std::max(this->I1, i);
-      this->J0 = std::min(this->J0, j);
-      this->J1 = std::max(this->J1, j);
+      this->I0 = std::min(this->I0, e[0]);
+      this->I1 = std::max(this->I1, e[0]);
+      this->J0 = std::min(this->J0, e[1]);
+      this->J1 = std::max(this->J1, e[1]);
     }
     const double box = (static_cast<double>(this->I1 - this->I0) + 1) * (static_cast<double>(this->J1 - this->J0) + 1);
-    this->Dense = box <= std::max(1 << 20, 16 * static_cast<int>(std::min<std::size_t>(buckets.size(), 1 << 26)));
+    this->Dense = box <= std::max(1.0 * (1 << 20), 16.0 * static_cast<double>(entries.size()));
+    this->Items.resize(entries.size());
     if (this->Dense)
     {
-      this->Flags.assign(static_cast<std::size_t>(box), 0);
+      // Items in each bucket in the order they registered (increasing).
+      this->Offsets.assign(static_cast<std::size_t>(box) + 1, 0);
+      for (const auto& e : entries)
+      {
+        ++this->Offsets[this->Slot(e[0], e[1]) + 1];
+      }
+      std::partial_sum(this->Offsets.begin(), this->Offsets.end(), this->Offsets.begin());
+      std::vector<Index> next(this->Offsets.begin(), this->Offsets.end() - 1);
+      for (const auto& e : entries)
+      {
+        this->Items[next[this->Slot(e[0], e[1])]++] = static_cast<Index>(e[2]);
+      }
     }
-    for (const auto& [i, j] : buckets)
+    else
     {
-      if (this->Dense)
+      std::sort(entries.begin(), entries.end());
+      this->Keys.resize(entries.size());
+      for (std::size_t k = 0; k < entries.size(); ++k)
       {
-        this->Flags[this->Slot(i, j)] = 1;
-      }
-      else
-      {
-        this->Sparse.insert(std::make_pair(i, j));
+        this->Keys[k] = { entries[k][0], entries[k][1] };
+        this->Items[k] = static_cast<Index>(entries[k][2]);
       }
     }
+  }
+
+  std::pair<long long, long long> BucketOf(double x, double y) const
+  {
+    return { static_cast<long long>(std::floor(x / this->Side)), static_cast<long long>(std::floor(y / this->Side)) };
+  }
+
+  // The items registered in bucket (i, j): [first, last).
+  std::pair<const Index*, const Index*> ItemsIn(long long i, long long j) const
+  {
+    if (this->Items.empty() || i < this->I0 || i > this->I1 || j < this->J0 || j > this->J1)
+    {
+      return { nullptr, nullptr };
+    }
+    if (this->Dense)
+    {
+      const std::size_t slot = this->Slot(i, j);
+      return { this->Items.data() + this->Offsets[slot], this->Items.data() + this->Offsets[slot + 1] };
+    }
+    const std::pair<long long, long long> key(i, j);
+    const auto range = std::equal_range(this->Keys.begin(), this->Keys.end(), key);
+    return { this->Items.data() + (range.first - this->Keys.begin()),
+      this->Items.data() + (range.second - this->Keys.begin()) };
   }
   bool Contains(long long i, long long j) const
   {
-    if (i < this->I0 || i > this->I1 || j < this->J0 || j > this->J1)
-    {
-      return false;
-    }
-    return this->Dense ? this->Flags[this->Slot(i, j)] != 0 : this->Sparse.count(std::make_pair(i, j)) > 0;
+    const auto [first, last] = this->ItemsIn(i, j);
+    return first != last;
   }
-  bool Empty() const { return !this->Dense && this->Sparse.empty(); }
+  bool Empty() const { return this->Items.empty(); }
 
-private:
-  struct PairHash
+  // Calls visit(x, y, piece, segment, s) for the samples of the smoothed pieces [begin, end),
+  // 16 per Bezier segment, that lie in a bucket with items. A segment lies in its control
+  // points' bounding box (widened against rounding): it is sampled only if a bucket of that
+  // box has items (or the box spans over 64 buckets).
+  template <typename Visit>
+  void ForEachSampleInBuckets(const OneCellSmoothingResult& smoothed, Index begin, Index end, const Visit& visit) const
   {
-    std::size_t operator()(const std::pair<long long, long long>& p) const
+    constexpr int perSegment = 16;
+    for (Index p = begin; p < end; ++p)
     {
-      return std::hash<long long>()((p.first << 32) ^ (p.second & 0xffffffffLL));
-    }
-  };
-  std::size_t Slot(long long i, long long j) const
-  {
-    return static_cast<std::size_t>(j - this->J0) * static_cast<std::size_t>(this->I1 - this->I0 + 1) +
-      static_cast<std::size_t>(i - this->I0);
-  }
-  long long I0 = 0, I1 = -1, J0 = 0, J1 = -1;
-  bool Dense = false;
-  std::vector<unsigned char> Flags;
-  std::unordered_set<std::pair<long long, long long>, PairHash> Sparse;
-};
-} // namespace
-
-// The smoothed curves, sampled finely enough that the nearest sample is within a few percent of
-// `side` of the nearest curve point, with their heights, in square buckets of side `side`: the
-// samples within `side` of a point lie in its bucket or the 8 around it.
-OneCellSamples::OneCellSamples(const OneCellSmoothingResult& smoothed, double side, const std::vector<double>& around,
-  const ParallelFor& parallel, bool withHeights)
-  : Side(side > 0 ? side : 1.0)
-{
-  // The buckets Nearest looks into for the points around: each one's and the 8 beside it.
-  std::vector<std::pair<long long, long long>> aroundBuckets;
-  aroundBuckets.reserve(9 * (around.size() / 2));
-  for (std::size_t p = 0; p + 1 < around.size(); p += 2)
-  {
-    for (int dx = -1; dx <= 1; ++dx)
-    {
-      for (int dy = -1; dy <= 1; ++dy)
+      const SmoothedPiece& piece = smoothed.Pieces[p];
+      for (int j = 0; j < piece.Curve.Segments; ++j)
       {
-        // As Nearest computes them (not floor(x / side) + dx, which may round differently).
-        aroundBuckets.push_back(this->BucketOf(around[p] + dx * this->Side, around[p + 1] + dy * this->Side));
+        if (!this->MayHoldItems(piece.Curve.Segment(j)))
+        {
+          continue;
+        }
+        for (int m = 0; m <= perSegment; ++m)
+        {
+          const double s = static_cast<double>(m) / perSegment;
+          double xy[2];
+          CubicBezierSpline::EvaluateSegment(piece.Curve.Segment(j), 2, s, xy);
+          const auto [bi, bj] = this->BucketOf(xy[0], xy[1]);
+          if (this->Contains(bi, bj))
+          {
+            visit(xy, bi, bj, p, j, s);
+          }
+        }
       }
     }
   }
-  const BucketSet wanted(aroundBuckets);
-  std::vector<std::pair<long long, long long>>().swap(aroundBuckets);
-  if (wanted.Empty())
+
+private:
+  bool MayHoldItems(const double* control) const
   {
-    return;
-  }
-  // A Bezier segment lies in its control points' bounding box (widened against rounding): it
-  // can have samples in a wanted bucket only if a bucket of that box is wanted.
-  const auto mayHoldWanted = [this, &wanted](const double* control) {
     double low[2] = { control[0], control[1] }, high[2] = { control[0], control[1] };
     for (int c = 1; c < 4; ++c)
     {
@@ -295,57 +331,54 @@ OneCellSamples::OneCellSamples(const OneCellSmoothingResult& smoothed, double si
     {
       for (long long j = j0; j <= j1; ++j)
       {
-        if (wanted.Contains(i, j))
+        if (this->Contains(i, j))
         {
           return true;
         }
       }
     }
     return false;
-  };
-  // The pieces in parallel, each one's samples listed in order; joined in piece order, the
-  // buckets hold them in the order one thread would have put them there.
-  constexpr int perSegment = 16;
-  using Keyed = std::pair<long long, Sample>;
-  const std::vector<Keyed> kept = CollectInStretches<Keyed>(static_cast<Index>(smoothed.Pieces.size()), 16, parallel,
-    [&](Index p, std::vector<Keyed>& list) {
-      const SmoothedPiece& piece = smoothed.Pieces[p];
-      const int segments = piece.Curve.Segments;
-      for (int j = 0; j < segments; ++j)
-      {
-        if (!mayHoldWanted(piece.Curve.Segment(j)))
-        {
-          continue;
-        }
-        for (int m = 0; m <= perSegment; ++m)
-        {
-          Sample sample;
-          const double s = static_cast<double>(m) / perSegment;
-          CubicBezierSpline::EvaluateSegment(piece.Curve.Segment(j), 2, s, sample.XY);
-          const auto [bi, bj] = this->BucketOf(sample.XY[0], sample.XY[1]);
-          if (wanted.Contains(bi, bj))
-          {
-            sample.Height = withHeights && piece.Height.Segments > 0 ? piece.Height.Value((j + s) / segments) : 0;
-            list.emplace_back(this->KeyOf(bi, bj), sample);
-          }
-        }
-      }
-    });
-  for (const Keyed& keyed : kept)
-  {
-    this->Buckets[keyed.first].push_back(keyed.second);
   }
-}
+  std::size_t Slot(long long i, long long j) const
+  {
+    return static_cast<std::size_t>(j - this->J0) * static_cast<std::size_t>(this->I1 - this->I0 + 1) +
+      static_cast<std::size_t>(i - this->I0);
+  }
+  double Side;
+  long long I0 = 0, I1 = -1, J0 = 0, J1 = -1;
+  bool Dense = false;
+  std::vector<Index> Offsets;                          // dense: per bucket of the box
+  std::vector<std::pair<long long, long long>> Keys;   // sparse: each item's bucket, sorted
+  std::vector<Index> Items;
+};
+} // namespace
 
-std::pair<long long, long long> OneCellSamples::BucketOf(double x, double y) const
+// The smoothed curves, sampled finely enough that the nearest sample is within a few percent of
+// `side` of the nearest curve point, with their heights, in square buckets of side `side`: the
+// samples within `side` of a point lie in its bucket or the 8 around it.
+OneCellSamples::OneCellSamples(const OneCellSmoothingResult& smoothed, double side, const std::vector<double>& around)
+  : Side(side > 0 ? side : 1.0)
 {
-  return { static_cast<long long>(std::floor(x / this->Side)), static_cast<long long>(std::floor(y / this->Side)) };
+  // Only the buckets Nearest looks into for the points around.
+  const BucketIndex wanted(this->Side, around);
+  if (wanted.Empty())
+  {
+    return;
+  }
+  wanted.ForEachSampleInBuckets(smoothed, 0, static_cast<Index>(smoothed.Pieces.size()),
+    [&](const double* xy, long long bi, long long bj, Index p, int j, double s) {
+      const SmoothedPiece& piece = smoothed.Pieces[p];
+      Sample sample;
+      sample.XY[0] = xy[0];
+      sample.XY[1] = xy[1];
+      sample.Height = piece.Height.Segments > 0 ? piece.Height.Value((j + s) / piece.Curve.Segments) : 0;
+      this->Buckets[this->KeyOf(bi, bj)].push_back(sample);
+    });
 }
 
 long long OneCellSamples::Key(double x, double y) const
 {
-  const auto [i, j] = this->BucketOf(x, y);
-  return this->KeyOf(i, j);
+  return this->KeyOf(static_cast<long long>(std::floor(x / this->Side)), static_cast<long long>(std::floor(y / this->Side)));
 }
 
 long long OneCellSamples::KeyOf(long long i, long long j) const
@@ -626,7 +659,7 @@ void FieldReconstruction::EvaluateAtVertices(const PlanarScalarField& field, con
           &field.Points[2 * static_cast<std::size_t>(v)] + 2);
       }
     }
-    const OneCellSamples samples(smoothed, this->Spacing, missedPoints, this->Parallel);
+    const OneCellSamples samples(smoothed, this->Spacing, missedPoints);
     for (std::size_t m = 0; m < missed.size(); ++m)
     {
       const Index v = missed[m];
@@ -757,16 +790,40 @@ void CountByDistanceToOneCells(const std::vector<CriticalPointLocation>& points,
   {
     return;
   }
+  // What OneCellSamples::Nearest would find within `distance` for each point, turned around:
+  // each curve sample marks the points that see its bucket (those would look into it) and lie
+  // within reach. Nothing is kept but a flag per point, and the pieces go in parallel (the
+  // samples of 1000 x 1000 noise kept in buckets were several hundred MB).
+  const double side = distance > 0 ? distance : 1.0;
+  const double reach = std::min(distance, side);
   std::vector<double> around;
+  around.reserve(2 * points.size());
   for (const CriticalPointLocation& point : points)
   {
     around.insert(around.end(), point.Position, point.Position + 2);
   }
-  const OneCellSamples samples(smoothed, distance > 0 ? distance : 1.0, around, parallel, false);
-  double height;
-  for (const CriticalPointLocation& point : points)
+  const BucketIndex index(side, around);
+  std::vector<std::atomic<unsigned char>> isNear(points.size());
+  for (auto& flag : isNear)
   {
-    ++(samples.Nearest(point.Position[0], point.Position[1], distance, height) ? near : far);
+    flag.store(0, std::memory_order_relaxed);
+  }
+  parallel(0, static_cast<Index>(smoothed.Pieces.size()), [&](Index begin, Index end) {
+    index.ForEachSampleInBuckets(smoothed, begin, end, [&](const double* xy, long long bi, long long bj, Index, int, double) {
+      const auto [first, last] = index.ItemsIn(bi, bj);
+      for (const Index* item = first; item != last; ++item)
+      {
+        const double* at = points[*item].Position;
+        if (isNear[*item].load(std::memory_order_relaxed) == 0 && std::hypot(xy[0] - at[0], xy[1] - at[1]) <= reach)
+        {
+          isNear[*item].store(1, std::memory_order_relaxed);
+        }
+      }
+    });
+  });
+  for (const auto& flag : isNear)
+  {
+    ++(flag.load(std::memory_order_relaxed) != 0 ? near : far);
   }
 }
 

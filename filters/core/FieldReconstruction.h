@@ -188,10 +188,7 @@ public:
   // and only the Bezier segments that can hold one are sampled: every curve of 1000 x 1000
   // noise at 16 samples per segment is 76 million samples (9 s), for the few vertices of
   // negligible 2-cells.
-  // The pieces are sampled through `parallel`; without `withHeights` every height is 0 (for
-  // distances alone).
-  OneCellSamples(const OneCellSmoothingResult& smoothed, double side, const std::vector<double>& around,
-    const ParallelFor& parallel = SequentialFor, bool withHeights = true);
+  OneCellSamples(const OneCellSmoothingResult& smoothed, double side, const std::vector<double>& around);
   // The height of the sample nearest to (x, y) within `distance` (at most `side`); false if none.
   bool Nearest(double x, double y, double distance, double& height) const;
 
@@ -201,7 +198,6 @@ private:
     double XY[2] = { 0, 0 };
     double Height = 0;
   };
-  std::pair<long long, long long> BucketOf(double x, double y) const;
   long long Key(double x, double y) const;
   long long KeyOf(long long i, long long j) const;
   double Side;

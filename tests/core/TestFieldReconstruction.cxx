@@ -769,8 +769,8 @@ TEST_CASE(CountsNearOneCellsMatchExactDistancesOnManySegments)
   CHECK(expectedNear > 50);
   CHECK_EQ(near, expectedNear);
   CHECK_EQ(far, static_cast<Index>(points.size()) - expectedNear);
-  // The pieces sampled on several threads, and the points' buckets kept in a hash set instead of
-  // flags over their box (two points 1e7 away make the box far larger than their number).
+  // The pieces sampled on several threads, and the points' buckets kept in a sorted list instead
+  // of per bucket of their box (two points 1e7 away make the box far larger than their number).
   near = far = -1;
   CountByDistanceToOneCells(points, smoothed, 2.0, near, far, ThreadedFor);
   CHECK_EQ(near, expectedNear);
