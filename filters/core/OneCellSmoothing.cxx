@@ -14,7 +14,6 @@
 #include <memory>
 #include <mutex>
 #include <numeric>
-#include <optional>
 #include <queue>
 #include <set>
 #include <unordered_map>
@@ -401,32 +400,20 @@ int EraseRetracedLoops(OneCell& oneCell)
 
 // The cuts of every 1-cell at the junction points it passes (not at its ends).
 std::vector<std::vector<Cut>> CutsAtJunctions(const std::vector<const OneCell*>& oneCells,
-  const std::vector<JunctionPoint>& junctions, const std::vector<Index>& junctionNode, const ParallelFor& parallel)
+  const std::vector<JunctionPoint>& junctions, const std::vector<Index>& junctionNode)
 {
-  // The junctions on each 1-cell in their order; then each 1-cell's cuts, in parallel (a long
-  // merged 1-cell of noise passes hundreds of junctions, each found by a search along it).
-  std::vector<std::vector<Index>> junctionsOn(oneCells.size());
+  std::vector<std::vector<Cut>> cuts(oneCells.size());
   for (size_t j = 0; j < junctions.size(); ++j)
   {
     for (Index a : junctions[j].OneCells)
     {
-      junctionsOn[a].push_back(static_cast<Index>(j));
-    }
-  }
-  std::vector<std::vector<Cut>> cuts(oneCells.size());
-  parallel(0, static_cast<Index>(oneCells.size()), [&](Index begin, Index end) {
-    for (Index a = begin; a < end; ++a)
-    {
-      for (const Index j : junctionsOn[a])
+      const long at = PointIndexOfCell(*oneCells[a], junctions[j].Cell);
+      if (at > 0 && at + 1 < static_cast<long>(oneCells[a]->Values.size()))
       {
-        const long at = PointIndexOfCell(*oneCells[a], junctions[j].Cell);
-        if (at > 0 && at + 1 < static_cast<long>(oneCells[a]->Values.size()))
-        {
-          cuts[a].push_back({ at, junctionNode[j] });
-        }
+        cuts[a].push_back({ at, junctionNode[j] });
       }
     }
-  });
+  }
   return cuts;
 }
 
@@ -544,9 +531,10 @@ struct Shortcut
 class PiecesByGeometry
 {
 public:
-  // The piece cut from oneCell's points from .. to, whose Hash is `hash`, or InvalidIndex.
-  Index Find(const OneCell& oneCell, long from, long to, std::uint64_t hash) const
+  // The piece cut from oneCell's points from .. to, or InvalidIndex.
+  Index Find(const OneCell& oneCell, long from, long to, std::uint64_t& hash) const
   {
+    hash = Hash(oneCell, from, to);
     const auto range = this->Pieces.equal_range(hash);
     for (auto it = range.first; it != range.second; ++it)
     {
@@ -557,7 +545,6 @@ public:
     }
     return InvalidIndex;
   }
-  void Reserve(std::size_t count) { this->Pieces.reserve(count); }
   void Add(std::uint64_t hash, const OneCell& oneCell, long from, long to, Index piece)
   {
     this->Pieces.insert({ hash, { &oneCell, from, to, piece } });
@@ -576,9 +563,6 @@ private:
     h ^= h >> 31;
     return h * 0xbf58476d1ce4e5b9ULL;
   }
-
-public:
-  // Of the points from .. to of oneCell: equal for equal stretches of points.
   static std::uint64_t Hash(const OneCell& oneCell, long from, long to)
   {
     std::uint64_t h = static_cast<std::uint64_t>(oneCell.Type) + 1;
@@ -591,8 +575,6 @@ public:
     }
     return h;
   }
-
-private:
   static bool Same(const OneCell& a, long aFrom, long aTo, const OneCell& b, long bFrom, long bTo)
   {
     return a.Type == b.Type && aTo - aFrom == bTo - bFrom &&
@@ -601,107 +583,45 @@ private:
   std::unordered_multimap<std::uint64_t, Stretch> Pieces;
 };
 
-// The piece cut from oneCell's points from .. to; an ascending 1-cell's last piece into its
-// maximum is given a shortcut (below).
-SmoothedPiece MakePiece(const OneCell& oneCell, const Cut& from, const Cut& to, std::optional<Shortcut>& shortcut)
+void AddPiecesOfOneCell(Index a, const OneCell& oneCell, const std::vector<Cut>& at,
+  PiecesByGeometry& pieceOfGeometry, OneCellSmoothingResult& result, std::vector<Shortcut>& shortcuts)
 {
   const long n = static_cast<long>(oneCell.Values.size());
-  SmoothedPiece piece;
-  piece.Type = oneCell.Type;
-  piece.StartNode = from.second;
-  piece.EndNode = to.second;
-  piece.Points.assign(oneCell.Points.begin() + 2 * from.first, oneCell.Points.begin() + 2 * (to.first + 1));
-  piece.Values.assign(oneCell.Values.begin() + from.first, oneCell.Values.begin() + to.first + 1);
-  // Every ascending 1-cell into a maximum ends "centroid of the maximum's triangle,
-  // maximum's vertex": a segment they would all share. Go straight to the vertex, except
-  // from the saddle's own vertex when it is another vertex of that triangle: that straight
-  // line would run along an edge of the triangle, which another 1-cell may cross into it
-  // (at its midpoint, on a triangle mesh). (A saddle on the maximum's own vertex makes a
-  // piece of no length, which touches nothing.)
-  const std::vector<double>& q = piece.Points;
-  const bool fromSaddleVertex = from.first == 0 && piece.Values.size() == 3 &&
-    !(q[0] == q[q.size() - 2] && q[1] == q[q.size() - 1]);
-  shortcut.reset();
-  if (oneCell.Type == OneCell::Ascending && to.first == n - 1 && piece.Values.size() > 2 && !fromSaddleVertex)
+  for (size_t k = 0; k + 1 < at.size(); ++k)
   {
-    const std::size_t c = piece.Values.size() - 2;
-    shortcut = Shortcut{ InvalidIndex, { q[2 * c], q[2 * c + 1] }, piece.Values[c] };
-    piece.Points.erase(piece.Points.end() - 4, piece.Points.end() - 2);
-    piece.Values.erase(piece.Values.end() - 2);
-  }
-  return piece;
-}
-
-// The pieces of every 1-cell between its consecutive cuts, a piece already made by another
-// 1-cell on the same points (merged 1-cells) shared, numbered in the order of the 1-cells and
-// their cuts. Which stretch makes each piece is decided in that order; the pieces themselves
-// (copies of the points, a million and more on 1000 x 1000 noise) are made in parallel.
-void AddPieces(const std::vector<const OneCell*>& oneCells, const std::vector<std::vector<Cut>>& cuts,
-  const ParallelFor& parallel, OneCellSmoothingResult& result, std::vector<Shortcut>& shortcuts)
-{
-  const Index count = static_cast<Index>(oneCells.size());
-  // The stretches' hashes go over every point of every 1-cell: in parallel too.
-  std::vector<std::vector<std::uint64_t>> hashes(oneCells.size());
-  parallel(0, count, [&](Index begin, Index end) {
-    for (Index a = begin; a < end; ++a)
+    const long from = at[k].first, to = at[k + 1].first;
+    std::uint64_t hash = 0;
+    Index found = pieceOfGeometry.Find(oneCell, from, to, hash);
+    if (found == InvalidIndex)
     {
-      const std::vector<Cut>& at = cuts[a];
-      hashes[a].resize(at.empty() ? 0 : at.size() - 1);
-      for (std::size_t k = 0; k + 1 < at.size(); ++k)
+      SmoothedPiece piece;
+      piece.Type = oneCell.Type;
+      piece.StartNode = at[k].second;
+      piece.EndNode = at[k + 1].second;
+      piece.Points.assign(oneCell.Points.begin() + 2 * from, oneCell.Points.begin() + 2 * (to + 1));
+      piece.Values.assign(oneCell.Values.begin() + from, oneCell.Values.begin() + to + 1);
+      // Every ascending 1-cell into a maximum ends "centroid of the maximum's triangle,
+      // maximum's vertex": a segment they would all share. Go straight to the vertex, except
+      // from the saddle's own vertex when it is another vertex of that triangle: that straight
+      // line would run along an edge of the triangle, which another 1-cell may cross into it
+      // (at its midpoint, on a triangle mesh). (A saddle on the maximum's own vertex makes a
+      // piece of no length, which touches nothing.)
+      const std::vector<double>& q = piece.Points;
+      const bool fromSaddleVertex = from == 0 && piece.Values.size() == 3 &&
+        !(q[0] == q[q.size() - 2] && q[1] == q[q.size() - 1]);
+      if (oneCell.Type == OneCell::Ascending && to == n - 1 && piece.Values.size() > 2 && !fromSaddleVertex)
       {
-        hashes[a][k] = PiecesByGeometry::Hash(*oneCells[a], at[k].first, at[k + 1].first);
+        const std::size_t c = piece.Values.size() - 2;
+        shortcuts.push_back({ static_cast<Index>(result.Pieces.size()), { q[2 * c], q[2 * c + 1] }, piece.Values[c] });
+        piece.Points.erase(piece.Points.end() - 4, piece.Points.end() - 2);
+        piece.Values.erase(piece.Values.end() - 2);
       }
+      found = static_cast<Index>(result.Pieces.size());
+      pieceOfGeometry.Add(hash, oneCell, from, to, found);
+      result.Pieces.push_back(std::move(piece));
     }
-  });
-  std::size_t stretches = 0;
-  for (const std::vector<std::uint64_t>& h : hashes)
-  {
-    stretches += h.size();
-  }
-  PiecesByGeometry pieceOfGeometry;
-  pieceOfGeometry.Reserve(stretches);
-  std::vector<std::pair<Index, std::size_t>> madeBy; // piece -> (1-cell, cut) of its stretch
-  madeBy.reserve(stretches);
-  for (Index a = 0; a < count; ++a)
-  {
-    const std::vector<Cut>& at = cuts[a];
-    for (std::size_t k = 0; k + 1 < at.size(); ++k)
-    {
-      Index found = pieceOfGeometry.Find(*oneCells[a], at[k].first, at[k + 1].first, hashes[a][k]);
-      if (found == InvalidIndex)
-      {
-        found = static_cast<Index>(madeBy.size());
-        pieceOfGeometry.Add(hashes[a][k], *oneCells[a], at[k].first, at[k + 1].first, found);
-        madeBy.emplace_back(a, k);
-      }
-      result.PiecesOfOneCell[a].push_back(found);
-    }
-    std::vector<std::uint64_t>().swap(hashes[a]);
-  }
-  const Index pieces = static_cast<Index>(madeBy.size());
-  result.Pieces.resize(madeBy.size());
-  std::vector<std::optional<Shortcut>> shortcutOf(madeBy.size());
-  parallel(0, pieces, [&](Index begin, Index end) {
-    for (Index p = begin; p < end; ++p)
-    {
-      const auto [a, k] = madeBy[p];
-      result.Pieces[p] = MakePiece(*oneCells[a], cuts[a][k], cuts[a][k + 1], shortcutOf[p]);
-    }
-  });
-  for (Index p = 0; p < pieces; ++p)
-  {
-    if (shortcutOf[p])
-    {
-      shortcutOf[p]->Piece = p;
-      shortcuts.push_back(*shortcutOf[p]);
-    }
-  }
-  for (Index a = 0; a < count; ++a)
-  {
-    for (const Index p : result.PiecesOfOneCell[a])
-    {
-      result.Pieces[p].OneCells.push_back(a);
-    }
+    result.Pieces[found].OneCells.push_back(a);
+    result.PiecesOfOneCell[a].push_back(found);
   }
 }
 
@@ -846,35 +766,35 @@ void KeepShortcutsClear(const std::vector<Shortcut>& shortcuts, OneCellSmoothing
 // drops cuts on cycles only. Node positions become the ends of the pieces that meet there.
 void CutIntoPieces(const std::vector<const OneCell*>& oneCells, const std::vector<JunctionPoint>& junctions,
   const std::vector<Index>& junctionNode, const double domainBounds[4], const std::vector<double>& boundaryPoints,
-  std::vector<SmoothingNode>& nodes, OneCellSmoothingResult& result, const ParallelFor& parallel)
+  std::vector<SmoothingNode>& nodes, OneCellSmoothingResult& result)
 {
-  std::vector<std::vector<Cut>> cuts = CutsAtJunctions(oneCells, junctions, junctionNode, parallel);
+  std::vector<std::vector<Cut>> cuts = CutsAtJunctions(oneCells, junctions, junctionNode);
   DomainCornerNodes corners(domainBounds, boundaryPoints);
   for (Index a = 0; a < static_cast<Index>(oneCells.size()); ++a)
   {
     corners.AddCuts(*oneCells[a], nodes, cuts[a]);
+    AddEndsAndOrderCuts(*oneCells[a], cuts[a]);
   }
-  parallel(0, static_cast<Index>(oneCells.size()), [&](Index begin, Index end) {
-    for (Index a = begin; a < end; ++a)
-    {
-      AddEndsAndOrderCuts(*oneCells[a], cuts[a]);
-    }
-  });
   const std::vector<Index> rank = RankNodes(nodes, cuts);
+  PiecesByGeometry pieceOfGeometry;
   std::vector<Shortcut> shortcuts;
   result.PiecesOfOneCell.resize(oneCells.size());
-  std::vector<int> dropped(oneCells.size(), 0);
-  parallel(0, static_cast<Index>(oneCells.size()), [&](Index begin, Index end) {
-    for (Index a = begin; a < end; ++a)
-    {
-      const size_t before = cuts[a].size();
-      KeepRisingCuts(cuts[a], rank);
-      dropped[a] = static_cast<int>(before - cuts[a].size());
-      result.PiecesOfOneCell[a].reserve(cuts[a].empty() ? 0 : cuts[a].size() - 1);
-    }
-  });
-  result.DroppedCuts += std::accumulate(dropped.begin(), dropped.end(), 0);
-  AddPieces(oneCells, cuts, parallel, result, shortcuts);
+  // At most one piece per pair of consecutive cuts: reserved, since growing the pieces
+  // (216 bytes each, 1.35 million on 1000^2 noise) moved them all at every doubling.
+  std::size_t mostPieces = 0;
+  for (Index a = 0; a < static_cast<Index>(oneCells.size()); ++a)
+  {
+    const size_t before = cuts[a].size();
+    KeepRisingCuts(cuts[a], rank);
+    result.DroppedCuts += static_cast<int>(before - cuts[a].size());
+    mostPieces += cuts[a].empty() ? 0 : cuts[a].size() - 1;
+    result.PiecesOfOneCell[a].reserve(cuts[a].empty() ? 0 : cuts[a].size() - 1);
+  }
+  result.Pieces.reserve(mostPieces);
+  for (Index a = 0; a < static_cast<Index>(oneCells.size()); ++a)
+  {
+    AddPiecesOfOneCell(a, *oneCells[a], cuts[a], pieceOfGeometry, result, shortcuts);
+  }
   KeepShortcutsClear(shortcuts, result);
   // Node positions: the ends of the pieces that meet there.
   for (const SmoothedPiece& piece : result.Pieces)
@@ -2157,30 +2077,26 @@ bool OneCellSmoothing::CutAndSolveJunctionValues(const MorseSmaleComplex& comple
   result.Pieces.clear();
   result.PiecesOfOneCell.clear();
   // The 1-cells as cut: the complex's own, or a copy with its retraced loops erased.
-  // Each 1-cell on its own, in parallel (sorting every 1-cell's points to find a repeated one
-  // took a second of 1000 x 1000 noise on one thread).
   std::vector<const OneCell*> oneCells(complex.OneCells.size());
   std::vector<std::unique_ptr<OneCell>> trimmed(complex.OneCells.size());
-  std::vector<int> erasedLoops(complex.OneCells.size(), 0);
-  this->Parallel(0, static_cast<Index>(oneCells.size()), [&](Index begin, Index end) {
-    for (Index a = begin; a < end; ++a)
+  result.ErasedLoops = 0;
+  for (std::size_t a = 0; a < oneCells.size(); ++a)
+  {
+    oneCells[a] = &complex.OneCells[a];
+    if (!RepeatsAPoint(complex.OneCells[a]))
     {
-      oneCells[a] = &complex.OneCells[a];
-      if (!RepeatsAPoint(complex.OneCells[a]))
-      {
-        continue;
-      }
-      auto copy = std::make_unique<OneCell>(complex.OneCells[a]);
-      erasedLoops[a] = EraseRetracedLoops(*copy);
-      if (erasedLoops[a] > 0)
-      {
-        trimmed[a] = std::move(copy);
-        oneCells[a] = trimmed[a].get();
-      }
+      continue;
     }
-  });
-  result.ErasedLoops = std::accumulate(erasedLoops.begin(), erasedLoops.end(), 0);
-  CutIntoPieces(oneCells, junctions, junctionNode, domainBounds, boundaryPoints, result.Nodes, result, this->Parallel);
+    auto copy = std::make_unique<OneCell>(complex.OneCells[a]);
+    const int erased = EraseRetracedLoops(*copy);
+    if (erased > 0)
+    {
+      result.ErasedLoops += erased;
+      trimmed[a] = std::move(copy);
+      oneCells[a] = trimmed[a].get();
+    }
+  }
+  CutIntoPieces(oneCells, junctions, junctionNode, domainBounds, boundaryPoints, result.Nodes, result);
   this->Hooks.Report(0.1);
   JunctionValueProgram program;
   program.Parallel = this->Parallel;
