@@ -1,5 +1,6 @@
 #include "FieldReconstruction.h"
 
+#include "CompressedGraph.h"
 #include "MorseSmaleComplexExtraction.h"
 
 #include <algorithm>
@@ -8,7 +9,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -216,26 +216,25 @@ public:
       this->J1 = std::max(this->J1, e[1]);
     }
     const double box = (static_cast<double>(this->I1 - this->I0) + 1) * (static_cast<double>(this->J1 - this->J0) + 1);
-    this->Dense = box <= std::max(1.0 * (1 << 20), 16.0 * static_cast<double>(entries.size()));
-    this->Items.resize(entries.size());
+    this->Dense = box <= std::max(1.0 * (1 << 20), 16.0 * static_cast<double>(entries.size())) &&
+      box < static_cast<double>(std::numeric_limits<Index>::max());
     if (this->Dense)
     {
-      // Items in each bucket in the order they registered (increasing).
-      this->Offsets.assign(static_cast<std::size_t>(box) + 1, 0);
-      for (const auto& e : entries)
+      // Rows per bucket of the box, items in each in the order they registered (increasing).
+      std::vector<std::array<Index, 2>> itemInBucket(entries.size());
+      for (std::size_t k = 0; k < entries.size(); ++k)
       {
-        ++this->Offsets[this->Slot(e[0], e[1]) + 1];
+        itemInBucket[k] = { static_cast<Index>(this->Slot(entries[k][0], entries[k][1])),
+          static_cast<Index>(entries[k][2]) };
       }
-      std::partial_sum(this->Offsets.begin(), this->Offsets.end(), this->Offsets.begin());
-      std::vector<Index> next(this->Offsets.begin(), this->Offsets.end() - 1);
-      for (const auto& e : entries)
-      {
-        this->Items[next[this->Slot(e[0], e[1])]++] = static_cast<Index>(e[2]);
-      }
+      CompressedGraph rows(static_cast<Index>(box), itemInBucket);
+      this->Offsets = std::move(rows.Offsets);
+      this->Items = std::move(rows.Targets);
     }
     else
     {
       std::sort(entries.begin(), entries.end());
+      this->Items.resize(entries.size());
       this->Keys.resize(entries.size());
       for (std::size_t k = 0; k < entries.size(); ++k)
       {
@@ -274,10 +273,11 @@ public:
   }
   bool Empty() const { return this->Items.empty(); }
 
-  // Calls visit(x, y, piece, segment, s) for the samples of the smoothed pieces [begin, end),
-  // 16 per Bezier segment, that lie in a bucket with items. A segment lies in its control
-  // points' bounding box (widened against rounding): it is sampled only if a bucket of that
-  // box has items (or the box spans over 64 buckets).
+  // Calls visit(xy, i, j, piece, segment, s) for the samples xy of the smoothed pieces [begin,
+  // end), 16 per Bezier segment, that lie in a bucket (i, j) with items (s: the parameter on the
+  // piece's segment). A segment lies in its control points' bounding box (widened against
+  // rounding): it is sampled only if a bucket of that box has items (or the box spans over 64
+  // buckets).
   template <typename Visit>
   void ForEachSampleInBuckets(const OneCellSmoothingResult& smoothed, Index begin, Index end, const Visit& visit) const
   {
@@ -794,8 +794,8 @@ void CountByDistanceToOneCells(const std::vector<CriticalPointLocation>& points,
   // each curve sample marks the points that see its bucket (those would look into it) and lie
   // within reach. Nothing is kept but a flag per point, and the pieces go in parallel (the
   // samples of 1000 x 1000 noise kept in buckets were several hundred MB).
+  // (Nearest's reach, min(distance, side), is `distance` itself.)
   const double side = distance > 0 ? distance : 1.0;
-  const double reach = std::min(distance, side);
   std::vector<double> around;
   around.reserve(2 * points.size());
   for (const CriticalPointLocation& point : points)
@@ -814,7 +814,7 @@ void CountByDistanceToOneCells(const std::vector<CriticalPointLocation>& points,
       for (const Index* item = first; item != last; ++item)
       {
         const double* at = points[*item].Position;
-        if (isNear[*item].load(std::memory_order_relaxed) == 0 && std::hypot(xy[0] - at[0], xy[1] - at[1]) <= reach)
+        if (isNear[*item].load(std::memory_order_relaxed) == 0 && std::hypot(xy[0] - at[0], xy[1] - at[1]) <= distance)
         {
           isNear[*item].store(1, std::memory_order_relaxed);
         }

@@ -274,8 +274,7 @@ CriticalPointMatcher::CriticalPointMatcher(const std::vector<CriticalPointLocati
 {
   for (const CriticalPointLocation& cp : expected)
   {
-    this->OnVertices = this->OnVertices && cp.Vertex != InvalidIndex && cp.Vertex >= 0 &&
-      cp.Vertex < mesh.NumberOfVertices() && 2 * static_cast<std::size_t>(cp.Vertex) + 1 < points.size();
+    this->OnVertices = this->OnVertices && this->IsVertex(cp.Vertex);
   }
   if (!this->OnVertices)
   {
@@ -300,14 +299,18 @@ CriticalPointMatcher::CriticalPointMatcher(const std::vector<CriticalPointLocati
   });
 }
 
+bool CriticalPointMatcher::IsVertex(Index v) const
+{
+  return v >= 0 && v < this->Mesh.NumberOfVertices() && 2 * static_cast<std::size_t>(v) + 1 < this->Points.size();
+}
+
 std::vector<std::size_t> CriticalPointMatcher::Match(const std::vector<CriticalPointLocation>& found)
 {
   bool atVertices = this->OnVertices;
   for (std::size_t f = 0; f < found.size() && atVertices; ++f)
   {
     const Index v = found[f].Vertex;
-    atVertices = v != InvalidIndex && v >= 0 && v < this->Mesh.NumberOfVertices() &&
-      2 * static_cast<std::size_t>(v) + 1 < this->Points.size() && found[f].Position[0] == this->Points[2 * v] &&
+    atVertices = this->IsVertex(v) && found[f].Position[0] == this->Points[2 * v] &&
       found[f].Position[1] == this->Points[2 * v + 1];
   }
   if (!atVertices)

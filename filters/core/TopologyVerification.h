@@ -83,6 +83,9 @@ public:
   std::vector<std::size_t> Match(const std::vector<CriticalPointLocation>& found);
 
 private:
+  // Whether v is a vertex of the mesh with a position in Points.
+  bool IsVertex(Index v) const;
+
   struct Candidate
   {
     double Distance;
