@@ -143,6 +143,7 @@ constexpr const char* MaximumGridSize = "MaximumGridSize";
 constexpr const char* FittedCells = "FittedCells";
 constexpr const char* RefinedCells = "RefinedCells";
 constexpr const char* StiffenedCells = "StiffenedCells";
+constexpr const char* OrderedCells = "OrderedCells";
 constexpr const char* RemappedCells = "RemappedCells";
 constexpr const char* SnappedPoints = "SnappedPoints";
 constexpr const char* PointsOnOneCells = "PointsOnOneCells";

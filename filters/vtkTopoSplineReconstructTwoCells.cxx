@@ -282,6 +282,7 @@ void WriteReport(const topospline::FieldReconstructionReport& report, vtkFieldDa
   AddFieldNumbers(fd, names::FittedCells, { static_cast<double>(cells.FittedCells) });
   AddFieldNumbers(fd, names::RefinedCells, { static_cast<double>(cells.RefinedCells) });
   AddFieldNumbers(fd, names::StiffenedCells, { static_cast<double>(cells.StiffenedCells) });
+  AddFieldNumbers(fd, names::OrderedCells, { static_cast<double>(cells.OrderedCells) });
   AddFieldNumbers(fd, names::RemappedCells, { static_cast<double>(cells.RemappedCells) });
   AddFieldNumbers(fd, names::SnappedPoints, { static_cast<double>(report.SnappedPoints) });
   AddFieldNumbers(fd, names::PointsOnOneCells, { static_cast<double>(report.PointsOnOneCells) });

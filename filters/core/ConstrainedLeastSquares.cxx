@@ -210,7 +210,7 @@ bool SolveConstrainedLeastSquares(const Eigen::SparseMatrix<double>& hessian, co
   }
   report.PulledBack = 1 - t;
   report.Objective = Objective(hessian, gradient, solution);
-  if (report.Objective > report.FeasibleObjective)
+  if (options.KeepStartIfLower && report.Objective > report.FeasibleObjective)
   {
     solution = feasible;
     report.Objective = report.FeasibleObjective;

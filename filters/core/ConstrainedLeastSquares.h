@@ -35,6 +35,10 @@ struct ConstrainedLeastSquaresOptions
   // 5x): the first, then every interval after it. Multiples of 10, when the residuals are read.
   int FirstRhoUpdate = 10;
   int RhoUpdateInterval = 30;
+
+  // Return the starting point when the answer's objective is higher. Off when rows that are
+  // only aimed at matter more than the objective (they are not in it).
+  bool KeepStartIfLower = true;
 };
 
 struct ConstrainedLeastSquaresReport

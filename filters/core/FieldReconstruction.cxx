@@ -508,6 +508,7 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
   }
   this->Cells.Mesh = &mesh; // for the stiffening rounds: which vertices are neighbours
   this->Cells.StiffeningRounds = this->StiffeningRounds;
+  this->Cells.OrderingRounds = this->OrderingRounds;
   const bool reconstructed = this->Cells.Reconstruct(complex, smoothed, error, &field);
   this->Cells.Mesh = nullptr; // a local
   if (!reconstructed)

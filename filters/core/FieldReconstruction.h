@@ -102,6 +102,8 @@ public:
   // Fitted interiors: rounds of stiffening where a fit, sampled at the input's vertices, has
   // critical points deep inside its cell (TwoCellReconstruction::StiffeningRounds; 0: none).
   int StiffeningRounds = 5;
+  // Then the ordering rounds of the points left (TwoCellReconstruction::OrderingRounds; 0: none).
+  int OrderingRounds = 4;
   bool TopologicalSampling = true;
   bool VerifyTopology = true;
   double MemoryBudget = 0; // bytes for the 2-cells' surfaces (TwoCellReconstruction::MemoryBudget)

@@ -130,6 +130,18 @@ struct MonotoneSurfaceFitOptions
   };
   std::vector<StiffSpot> StiffSpots;
   double StiffRadius = 1.5;
+  // Orders between two of the samples, aimed at (not enforced exactly): F(Upper) - F(Lower) >=
+  // Margin, Lower and Upper indices into the samples fitted. TwoCellReconstruction gives them
+  // around input vertices where an earlier fit, sampled at the vertices, had a critical point
+  // that no node of the complex explains: one arc of the vertex's link above it, the rest below,
+  // which is what a regular vertex's link is.
+  struct SampleOrder
+  {
+    int Lower = 0;
+    int Upper = 0;
+    double Margin = 0;
+  };
+  std::vector<SampleOrder> SampleOrders;
   // The fit replaces the surface it starts from (the paper's, or an earlier fit) only if its
   // RMS residual is at most this times the starting surface's.
   double AcceptedResidualGrowth = 1;
@@ -249,6 +261,9 @@ private:
   void AssembleFit(const FreeOrdinates& free, const std::vector<SurfaceSample>& samples,
     const MonotoneSurfaceFitOptions& options, FitProblem& problem) const;
   void AddNodeRows(const FreeOrdinates& free, double margin, bool increasingAlongAxes, FitProblem& problem) const;
+  // Grid cell (i, j)'s 12 data (z, p, q of V00 V10 V11 V01) as unknown indices (-1: fixed) and
+  // the surface's present values.
+  void CellUnknowns(const FreeOrdinates& free, int i, int j, int unknown[12], double fixed[12]) const;
   bool SolveFit(const FitProblem& problem, const MonotoneSurfaceFitOptions& options, Eigen::VectorXd& solution,
     std::string& error);
 

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <vector>
 
@@ -176,28 +177,38 @@ struct MonotoneSibsonSurface::FitProblem
   std::vector<double> RowConstant, RowTarget;
   std::vector<char> RowEssential; // held exactly (the sufficient conditions), or only aimed at
 
-  // Adds the row form . (cell data) >= target for the cell data given as unknown indices (-1:
-  // fixed, with the value in `fixed`). A row without unknowns is a constant: left out.
-  void AddRow(const int unknown[LocalData], const double fixed[LocalData], const LocalVector& form, double target,
-    bool essential)
+  // One grid cell's part of a row: form . (cell data), the data given as unknown indices (-1:
+  // fixed, with the value in `Fixed`).
+  struct CellTerm
+  {
+    const int* Unknown;
+    const double* Fixed;
+    const LocalVector& Form;
+  };
+
+  // Adds the row: the sum of the terms >= target. A row without unknowns is a constant: left out.
+  void AddRow(std::initializer_list<CellTerm> terms, double target, bool essential)
   {
     double constant = 0;
     bool anyUnknown = false;
     const int row = static_cast<int>(this->RowConstant.size());
-    for (int m = 0; m < LocalData; ++m)
+    for (const CellTerm& term : terms)
     {
-      if (form[m] == 0)
+      for (int m = 0; m < LocalData; ++m)
       {
-        continue;
-      }
-      if (unknown[m] >= 0)
-      {
-        this->RowEntries.emplace_back(row, unknown[m], form[m]);
-        anyUnknown = true;
-      }
-      else
-      {
-        constant += form[m] * fixed[m];
+        if (term.Form[m] == 0)
+        {
+          continue;
+        }
+        if (term.Unknown[m] >= 0)
+        {
+          this->RowEntries.emplace_back(row, term.Unknown[m], term.Form[m]); // repeated entries add up
+          anyUnknown = true;
+        }
+        else
+        {
+          constant += term.Form[m] * term.Fixed[m];
+        }
       }
     }
     if (anyUnknown)
@@ -255,26 +266,16 @@ void MonotoneSibsonSurface::AssembleFit(const FreeOrdinates& free, const std::ve
     for (int i = 0; i < n; ++i)
     {
       // The cell's data as d = E x + d0: E picks unknowns, d0 holds the fixed data.
-      int nodes[4];
-      this->CellNodes(i, j, nodes);
       int unknown[LocalData];
       double fixed[LocalData];
+      this->CellUnknowns(free, i, j, unknown, fixed);
       LocalVector d0;
-      for (int v = 0; v < 4; ++v)
+      for (int m = 0; m < LocalData; ++m)
       {
-        const int k = nodes[v];
-        const int unknowns[3] = { free.Z[k], free.P[k], free.Q[k] };
-        const double values[3] = { this->Z[k], this->P[k], this->Q[k] };
-        for (int c = 0; c < 3; ++c)
+        d0[m] = unknown[m] >= 0 ? 0.0 : fixed[m];
+        if (unknown[m] >= 0)
         {
-          const int m = 4 * c + v;
-          unknown[m] = unknowns[c];
-          fixed[m] = values[c];
-          d0[m] = unknown[m] >= 0 ? 0.0 : fixed[m];
-          if (unknown[m] >= 0)
-          {
-            problem.Feasible[unknown[m]] = fixed[m];
-          }
+          problem.Feasible[unknown[m]] = fixed[m];
         }
       }
       // (E x + d0)^T (M + mu K) (E x + d0) - 2 b^T (E x + d0), M and b the normal equations.
@@ -298,11 +299,51 @@ void MonotoneSibsonSurface::AssembleFit(const FreeOrdinates& free, const std::ve
       }
       for (const LocalVector& form : conditions)
       {
-        problem.AddRow(unknown, fixed, form, margin, true);
+        problem.AddRow({ { unknown, fixed, form } }, margin, true);
       }
     }
   }
   this->AddNodeRows(free, margin, options.IncreasingAlongAxes, problem);
+  // The orders between samples: F(upper) - F(lower), a row over the two samples' grid cells.
+  for (const MonotoneSurfaceFitOptions::SampleOrder& order : options.SampleOrders)
+  {
+    if (order.Lower < 0 || order.Upper < 0 || order.Lower >= static_cast<int>(samples.size()) ||
+      order.Upper >= static_cast<int>(samples.size()))
+    {
+      continue;
+    }
+    int unknown[2][LocalData];
+    double fixed[2][LocalData];
+    LocalVector form[2];
+    const int ends[2] = { order.Upper, order.Lower };
+    for (int e = 0; e < 2; ++e)
+    {
+      int i, j;
+      double X, Y;
+      this->Locate(samples[ends[e]].U, samples[ends[e]].V, i, j, X, Y);
+      this->CellUnknowns(free, i, j, unknown[e], fixed[e]);
+      form[e] = (e == 0 ? 1.0 : -1.0) * EvaluationWeights(X, Y);
+    }
+    problem.AddRow({ { unknown[0], fixed[0], form[0] }, { unknown[1], fixed[1], form[1] } }, order.Margin, false);
+  }
+}
+
+void MonotoneSibsonSurface::CellUnknowns(
+  const FreeOrdinates& free, int i, int j, int unknown[LocalData], double fixed[LocalData]) const
+{
+  int nodes[4];
+  this->CellNodes(i, j, nodes);
+  for (int v = 0; v < 4; ++v)
+  {
+    const int k = nodes[v];
+    const int unknowns[3] = { free.Z[k], free.P[k], free.Q[k] };
+    const double values[3] = { this->Z[k], this->P[k], this->Q[k] };
+    for (int c = 0; c < 3; ++c)
+    {
+      unknown[4 * c + v] = unknowns[c];
+      fixed[4 * c + v] = values[c];
+    }
+  }
 }
 
 void MonotoneSibsonSurface::AddNodeRows(
@@ -320,7 +361,7 @@ void MonotoneSibsonSurface::AddNodeRows(
     const double fixed[LocalData] = { 0, 0, 0, 0, this->P[k], 0, 0, 0, this->Q[k], 0, 0, 0 };
     LocalVector form = LocalVector::Zero();
     form[4] = form[8] = 1;
-    problem.AddRow(unknown, fixed, form, margin, true);
+    problem.AddRow({ { unknown, fixed, form } }, margin, true);
   }
   // p >= 0 and q >= 0 at every free derivative: F increasing along u and along v, as its four
   // sides are (minimum at (0,0), saddles at (1,0) and (0,1), maximum at (1,1)). Not needed for
@@ -337,7 +378,7 @@ void MonotoneSibsonSurface::AddNodeRows(
         const double fixed[LocalData] = {};
         LocalVector form = LocalVector::Zero();
         form[4] = 1;
-        problem.AddRow(unknown, fixed, form, 0.0, false);
+        problem.AddRow({ { unknown, fixed, form } }, 0.0, false);
       }
     }
   }

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -701,6 +702,29 @@ void ForEachCellInSlices(Index n, const ParallelFor& parallel, const ProgressHoo
   }
 }
 
+// The cells of `order` as ForEachCellInSlices does, each taken by the next thread that is free
+// (largest first, when `order` is sorted so): split into fixed shares, a few cells far larger
+// than the others (a terrain's) could all fall in one thread's share, the other thread idle.
+// Each cell's work depends on that cell alone, so the result does not depend on the order.
+void ForEachCellLargestFirst(const std::vector<Index>& order, const ParallelFor& parallel, const ProgressHooks& hooks,
+  double from, double to, const std::function<void(Index)>& body)
+{
+  const Index n = static_cast<Index>(order.size());
+  const Index slice = std::max<Index>(256, (n + 49) / 50);
+  for (Index begin = 0; begin < n && !hooks.Aborted(); begin += slice)
+  {
+    const Index end = std::min(n, begin + slice);
+    std::atomic<Index> next(begin);
+    parallel(begin, end, [&](Index, Index) {
+      for (Index i = next++; i < end && !hooks.Aborted(); i = next++)
+      {
+        body(order[i]);
+      }
+    });
+    hooks.Report(from + (to - from) * static_cast<double>(end) / static_cast<double>(n));
+  }
+}
+
 // Per vertex: whether it is inside the mesh and its whole ring of neighbours lies in its own
 // cell (cellOf; InvalidIndex: in none).
 std::vector<char> RingsInTheirCells(
@@ -807,14 +831,14 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
     this->BuildCellLocator();
     this->LocateSamples(*data, complex.TwoCellId, firstVertex, vertices, parameters, cellOf);
   }
-  const bool stiffen = fit && this->Mesh != nullptr && this->StiffeningRounds > 0 &&
+  const bool stiffen = fit && this->Mesh != nullptr && (this->StiffeningRounds > 0 || this->OrderingRounds > 0) &&
     this->Mesh->NumberOfVertices() == static_cast<Index>(data->Values.size());
   const std::vector<char> ringInCell = stiffen ? RingsInTheirCells(*this->Mesh, cellOf, this->Parallel) : std::vector<char>();
   if (!this->SurfacesFitInMemory(boundaries, firstVertex, error))
   {
     return false;
   }
-  std::vector<char> refined(n, 0), stiffened(n, 0), remapped(n, 0);
+  std::vector<char> refined(n, 0), stiffened(n, 0), ordered(n, 0), remapped(n, 0);
   auto samplesOf = [&](Index c) {
     std::vector<SurfaceSample> samples;
     samples.reserve(firstVertex[c + 1] - firstVertex[c]);
@@ -824,21 +848,26 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
     }
     return samples;
   };
-  ForEachCellInSlices(n, this->Parallel, this->Hooks, 0.7, 0.9, [&](Index begin, Index end) {
-    for (Index c = begin; c < end && !this->Hooks.Aborted(); ++c)
+  // The cells with the most samples first: their fits take the longest.
+  std::vector<Index> largestFirst(n);
+  std::iota(largestFirst.begin(), largestFirst.end(), 0);
+  if (fit)
+  {
+    std::stable_sort(largestFirst.begin(), largestFirst.end(),
+      [&](Index a, Index b) { return firstVertex[a + 1] - firstVertex[a] > firstVertex[b + 1] - firstVertex[b]; });
+  }
+  ForEachCellLargestFirst(largestFirst, this->Parallel, this->Hooks, 0.7, 0.9, [&](Index c) {
+    ReconstructedTwoCell& cell = *this->Cells[c];
+    BuildSurface(cell, boundaries[c]);
+    if (fit && cell.Valid)
     {
-      ReconstructedTwoCell& cell = *this->Cells[c];
-      BuildSurface(cell, boundaries[c]);
-      if (fit && cell.Valid)
-      {
-        refined[c] = this->FitSurface(cell, boundaries[c], samplesOf(c));
-      }
-      // Only fitted cells read their sides again (alternative maps, stiffening): on uniform
-      // noise the others are nearly all, and their sides were a tenth of stage 4's peak.
-      if (!(fit && cell.Valid && cell.Surface.FitReport().Fitted))
-      {
-        boundaries[c] = MonotoneSurfaceBoundary();
-      }
+      refined[c] = this->FitSurface(cell, boundaries[c], samplesOf(c));
+    }
+    // Only fitted cells read their sides again (alternative maps, stiffening): on uniform
+    // noise the others are nearly all, and their sides were a tenth of stage 4's peak.
+    if (!(fit && cell.Valid && cell.Surface.FitReport().Fitted))
+    {
+      boundaries[c] = MonotoneSurfaceBoundary();
     }
   });
   // The largest misses get their second chance on the alternative maps (AlternativeMapStrength):
@@ -878,15 +907,14 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
       remappedSamples[c] = std::move(samples);
     }
   }
-  ForEachCellInSlices(n, this->Parallel, this->Hooks, 0.9, 0.99, [&](Index begin, Index end) {
-    for (Index c = begin; c < end && !this->Hooks.Aborted(); ++c)
+  ForEachCellLargestFirst(largestFirst, this->Parallel, this->Hooks, 0.9, 0.99, [&](Index c) {
+    ReconstructedTwoCell& cell = *this->Cells[c];
+    if (stiffen && cell.Valid && cell.Surface.FitReport().Fitted)
     {
-      ReconstructedTwoCell& cell = *this->Cells[c];
-      if (stiffen && cell.Valid && cell.Surface.FitReport().Fitted)
-      {
-        const std::vector<SurfaceSample> samples = remapped[c] ? std::move(remappedSamples[c]) : samplesOf(c);
-        stiffened[c] = this->StiffenWhereSamplingBreaks(cell, samples, vertices.data() + firstVertex[c], ringInCell);
-      }
+      const std::vector<SurfaceSample> samples = remapped[c] ? std::move(remappedSamples[c]) : samplesOf(c);
+      const int outcome = this->StiffenWhereSamplingBreaks(cell, samples, vertices.data() + firstVertex[c], ringInCell);
+      stiffened[c] = (outcome & StiffenedFit) != 0 ? 1 : 0;
+      ordered[c] = (outcome & OrderedFit) != 0 ? 1 : 0;
     }
   });
   if (this->Hooks.Aborted())
@@ -896,6 +924,7 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
   }
   this->Summary.RefinedCells = std::count(refined.begin(), refined.end(), 1);
   this->Summary.StiffenedCells = std::count(stiffened.begin(), stiffened.end(), 1);
+  this->Summary.OrderedCells = std::count(ordered.begin(), ordered.end(), 1);
   this->Summary.RemappedCells = std::count(remapped.begin(), remapped.end(), 1);
   this->Summary.SurfaceSeconds = Seconds(start);
   this->Summarize();
@@ -1247,49 +1276,153 @@ bool TwoCellReconstruction::FitOnAlternativeMaps(ReconstructedTwoCell& cell, con
   return kept;
 }
 
-// A monotone F has no critical point, but sampled at the vertices, a ridge or a trough that
-// rises slowly along its crest compared with its flanks breaks into pairs of critical points:
-// the fit makes such crests where the monotonicity rows bind against data that falls (a
-// cancelled pit filled, its rim kept). Stiffening the thin plate there widens them until the
-// vertices see the rise.
-bool TwoCellReconstruction::StiffenWhereSamplingBreaks(ReconstructedTwoCell& cell,
-  const std::vector<SurfaceSample>& samples, const Index* vertices, const std::vector<char>& ringInCell) const
+// The vertices of one cell two rings or more inside it (DeepVertices: no smoothed 1-cell passes
+// next to them, so no node of the complex can explain a critical point there) and, for a
+// surface, those of them critical for F sampled at the cell's vertices.
+class TwoCellReconstruction::DeepCriticalVertices
 {
-  const TriangleMeshTopology& mesh = *this->Mesh;
-  const Index count = static_cast<Index>(samples.size());
-  const std::vector<Index> deep = DeepVertices(mesh, vertices, count, ringInCell);
-  if (deep.empty())
+public:
+  DeepCriticalVertices(const TriangleMeshTopology& mesh, const std::vector<SurfaceSample>& samples,
+    const Index* vertices, const std::vector<char>& ringInCell)
+    : Mesh(mesh)
+    , Samples(samples)
+    , Vertices(vertices)
+    , Deep(DeepVertices(mesh, vertices, static_cast<Index>(samples.size()), ringInCell))
   {
-    return false;
-  }
-  // The deep vertices critical for F sampled at the cell's vertices (the rings of deep
-  // vertices lie in the cell); each vertex's slot among them is found once, for every round.
-  std::unordered_map<Index, Index> slotOf;
-  slotOf.reserve(2 * count);
-  for (Index k = 0; k < count; ++k)
-  {
-    slotOf[vertices[k]] = k;
-  }
-  std::vector<double> sampled(count);
-  const auto criticalSpots = [&](const MonotoneSibsonSurface& surface) {
-    surface.EvaluateSamples(samples, sampled);
-    const auto value = [&](Index w) { return sampled[slotOf.at(w)]; };
-    std::vector<Index> critical;
-    for (Index k : deep)
+    // Each vertex's slot among the samples, found once for every round.
+    this->SlotOf.reserve(2 * samples.size());
+    for (Index k = 0; k < static_cast<Index>(samples.size()); ++k)
     {
-      if (IsCriticalVertex(mesh, vertices[k], value))
+      this->SlotOf[vertices[k]] = k;
+    }
+  }
+
+  bool Empty() const { return this->Deep.empty(); }
+
+  // The samples (slots) of the deep vertices critical for `surface`; its values at every sample
+  // are kept (Values) for RiseDirection.
+  std::vector<Index> Find(const MonotoneSibsonSurface& surface)
+  {
+    surface.EvaluateSamples(this->Samples, this->Values);
+    const auto value = [&](Index w) { return this->Values[this->SlotOf.at(w)]; };
+    std::vector<Index> critical;
+    for (Index k : this->Deep)
+    {
+      if (IsCriticalVertex(this->Mesh, this->Vertices[k], value))
       {
         critical.push_back(k);
       }
     }
     return critical;
-  };
-  std::vector<Index> critical = criticalSpots(cell.Surface);
+  }
+
+  // The samples of the vertices within `rings` rings of deep sample k's vertex (all in the
+  // cell: the two rings of a deep vertex are), k excepted.
+  std::vector<Index> Around(Index k, int rings) const
+  {
+    std::vector<Index> around = { this->Vertices[k] };
+    for (int ring = 0, from = 0; ring < rings; ++ring)
+    {
+      const int to = static_cast<int>(around.size());
+      for (int a = from; a < to; ++a)
+      {
+        const Index v = around[a];
+        for (Index i = this->Mesh.VertexTriangleBegin(v); i < this->Mesh.VertexTriangleEnd(v); ++i)
+        {
+          for (Index w : this->Mesh.TriangleVertices[this->Mesh.VertexTriangle(i)])
+          {
+            if (std::find(around.begin(), around.end(), w) == around.end())
+            {
+              around.push_back(w);
+            }
+          }
+        }
+      }
+      from = to;
+    }
+    std::vector<Index> slots;
+    for (std::size_t a = 1; a < around.size(); ++a)
+    {
+      slots.push_back(this->SlotOf.at(around[a]));
+    }
+    return slots;
+  }
+
+  // Whether the images in the square of sample k's neighbours wind around its own (each
+  // incident triangle turns by the signed angle its far edge subtends; a fold of the sampled
+  // map turns by 0): only then can an order of its neighbours make it regular.
+  bool Surrounded(Index k) const
+  {
+    const Index v = this->Vertices[k];
+    double turn = 0;
+    for (Index i = this->Mesh.VertexTriangleBegin(v); i < this->Mesh.VertexTriangleEnd(v); ++i)
+    {
+      const auto& t = this->Mesh.TriangleVertices[this->Mesh.VertexTriangle(i)];
+      const int at = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+      const SurfaceSample& a = this->Samples[this->SlotOf.at(t[(at + 1) % 3])];
+      const SurfaceSample& b = this->Samples[this->SlotOf.at(t[(at + 2) % 3])];
+      const double au = a.U - this->Samples[k].U, av = a.V - this->Samples[k].V;
+      const double bu = b.U - this->Samples[k].U, bv = b.V - this->Samples[k].V;
+      turn += std::atan2(au * bv - av * bu, au * bu + av * bv);
+    }
+    return std::abs(turn) > M_PI;
+  }
+
+  // The unit gradient in the square of the plane fitted by least squares to the last surface's
+  // values (Find) at sample k and the two rings around it; (1, 1) / sqrt 2, F's rise across
+  // the square, where the plane is level.
+  void RiseDirection(Index k, double direction[2]) const
+  {
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+    std::vector<Index> slots = this->Around(k, 2);
+    slots.push_back(k);
+    for (Index w : slots)
+    {
+      const Eigen::Vector3d row(1, this->Samples[w].U - this->Samples[k].U, this->Samples[w].V - this->Samples[k].V);
+      normal += row * row.transpose();
+      moment += this->Values[w] * row;
+    }
+    const Eigen::Vector3d plane = normal.ldlt().solve(moment);
+    const double length = std::hypot(plane[1], plane[2]);
+    direction[0] = direction[1] = std::sqrt(0.5);
+    if (std::isfinite(length) && length > 0)
+    {
+      direction[0] = plane[1] / length;
+      direction[1] = plane[2] / length;
+    }
+  }
+
+private:
+  const TriangleMeshTopology& Mesh;
+  const std::vector<SurfaceSample>& Samples;
+  const Index* Vertices;
+  const std::vector<Index> Deep;
+  std::unordered_map<Index, Index> SlotOf;
+  std::vector<double> Values;
+};
+
+// A monotone F has no critical point, but sampled at the vertices, a ridge or a trough that
+// rises slowly along its crest compared with its flanks breaks into pairs of critical points:
+// the fit makes such crests where the monotonicity rows bind against data that falls (a
+// cancelled pit filled, its rim kept). Stiffening the thin plate there widens them until the
+// vertices see the rise; where that is not enough, the samples around the points left are
+// ordered (OrderWhereSamplingBreaks).
+int TwoCellReconstruction::StiffenWhereSamplingBreaks(ReconstructedTwoCell& cell,
+  const std::vector<SurfaceSample>& samples, const Index* vertices, const std::vector<char>& ringInCell) const
+{
+  DeepCriticalVertices deep(*this->Mesh, samples, vertices, ringInCell);
+  if (deep.Empty())
+  {
+    return 0;
+  }
+  std::vector<Index> critical = deep.Find(cell.Surface);
   std::size_t fewest = critical.size();
   MonotoneSurfaceFitOptions options = this->Fit;
   options.AcceptedResidualGrowth = this->StiffeningResidualGrowth;
+  MonotoneSurfaceFitOptions kept = options;
   const MonotoneSibsonSurface first = cell.Surface;
-  bool stiffened = false;
+  int outcome = 0;
   double step = this->StiffeningFactor;
   for (int round = 0, stale = 0; round < this->StiffeningRounds && !critical.empty(); ++round)
   {
@@ -1319,12 +1452,13 @@ bool TwoCellReconstruction::StiffenWhereSamplingBreaks(ReconstructedTwoCell& cel
       }
       continue;
     }
-    critical = criticalSpots(trial);
+    critical = deep.Find(trial);
     if (critical.size() < fewest)
     {
       fewest = critical.size();
       cell.Surface = std::move(trial);
-      stiffened = true;
+      kept = options;
+      outcome = StiffenedFit;
       stale = 0;
     }
     else if (++stale == 2)
@@ -1332,7 +1466,89 @@ bool TwoCellReconstruction::StiffenWhereSamplingBreaks(ReconstructedTwoCell& cel
       break; // points that stiffening does not move (a kink of Phi, a crest the rows force)
     }
   }
-  return stiffened;
+  if (fewest > 0 && this->OrderingRounds > 0 && this->OrderWhereSamplingBreaks(cell, first, kept, deep, samples))
+  {
+    outcome |= OrderedFit;
+  }
+  return outcome;
+}
+
+// The points stiffening leaves are mostly crests too narrow or too level for the thin plate to
+// widen at an acceptable cost. Their values are ordered instead: around each, every neighbour
+// ahead along the local rise (the gradient of the plane fitted to the last fit's values over
+// two rings, which on a crest is the rise along its top: the flanks cancel) is asked to be
+// higher than the vertex, every one behind it lower, each by OrderingSlope x the cell's sample
+// range x its distance along that direction in the square. A linear order of a star-shaped
+// link has one arc above and one below: a regular vertex. Neighbouring points' directions are
+// close, so their orders agree; the rows are only aimed at (ConstrainedLeastSquares), and a fit
+// is kept only with fewer such points.
+bool TwoCellReconstruction::OrderWhereSamplingBreaks(ReconstructedTwoCell& cell, const MonotoneSibsonSurface& first,
+  MonotoneSurfaceFitOptions options, DeepCriticalVertices& deep, const std::vector<SurfaceSample>& samples) const
+{
+  const TriangleMeshTopology& mesh = *this->Mesh;
+  double lowest = std::numeric_limits<double>::max(), highest = -lowest;
+  for (const SurfaceSample& sample : samples)
+  {
+    lowest = std::min(lowest, sample.Value);
+    highest = std::max(highest, sample.Value);
+  }
+  const double slope = this->OrderingSlope * (highest - lowest);
+  // The rows need not hold at the start, so the fit may end above the first fit's objective.
+  options.Solver.KeepStartIfLower = false;
+  std::vector<Index> critical = deep.Find(cell.Surface);
+  std::size_t fewest = critical.size();
+  std::unordered_map<Index, std::vector<MonotoneSurfaceFitOptions::SampleOrder>> ordersAt;
+  bool ordered = false;
+  for (int round = 0, stale = 0; round < this->OrderingRounds && stale < 2; ++round)
+  {
+    // The values of the fit that left these points (deep.Values) set each point's direction;
+    // a point met again gets its orders anew. Points where the sampled map folds are left.
+    critical.erase(std::remove_if(critical.begin(), critical.end(), [&](Index k) { return !deep.Surrounded(k); }),
+      critical.end());
+    if (critical.empty())
+    {
+      break;
+    }
+    for (Index k : critical)
+    {
+      double direction[2];
+      deep.RiseDirection(k, direction);
+      std::vector<MonotoneSurfaceFitOptions::SampleOrder>& orders = ordersAt[k];
+      orders.clear();
+      for (Index w : deep.Around(k, 1))
+      {
+        const double along =
+          direction[0] * (samples[w].U - samples[k].U) + direction[1] * (samples[w].V - samples[k].V);
+        const int vertex = static_cast<int>(k), neighbour = static_cast<int>(w);
+        orders.push_back(along > 0 ? MonotoneSurfaceFitOptions::SampleOrder{ vertex, neighbour, slope * along }
+                                   : MonotoneSurfaceFitOptions::SampleOrder{ neighbour, vertex, -slope * along });
+      }
+    }
+    options.SampleOrders.clear();
+    for (const auto& entry : ordersAt)
+    {
+      options.SampleOrders.insert(options.SampleOrders.end(), entry.second.begin(), entry.second.end());
+    }
+    MonotoneSibsonSurface trial = first;
+    std::string message;
+    if (!trial.FitToSamples(samples, message, options) || !trial.FitReport().Fitted)
+    {
+      break;
+    }
+    critical = deep.Find(trial);
+    if (critical.size() < fewest)
+    {
+      fewest = critical.size();
+      cell.Surface = std::move(trial);
+      ordered = true;
+      stale = 0;
+    }
+    else
+    {
+      ++stale;
+    }
+  }
+  return ordered;
 }
 
 int TwoCellReconstruction::FinestRefinedGridSize(int gridSize, std::size_t samples) const

@@ -134,6 +134,7 @@ struct TwoCellReconstructionReport
   Index FittedCells = 0;       // interiors fitted to the input samples (Interior == Fitted)
   Index RefinedCells = 0;      // of them, cells whose grid was refined beyond the sides' need
   Index StiffenedCells = 0;    // of them, cells whose fit was stiffened (StiffeningRounds)
+  Index OrderedCells = 0;      // of them, cells whose fit orders samples around critical points (OrderingRounds)
   Index RemappedCells = 0;     // of them, cells fitted on an alternative map (AlternativeMapStrength)
   Index MeshTriangles = 0;     // triangles of all cell meshes
   Index CrowdedTriangles = 0;  // of them, flattened in (u, v) by rounding (TwoCellMesh::CrowdedTriangles)
@@ -240,6 +241,12 @@ public:
   int StiffeningRounds = 5;
   double StiffeningFactor = 10;
   double StiffeningResidualGrowth = 1.25;
+  // Where critical points are left after the stiffening rounds, up to OrderingRounds more fits
+  // (from the first fit, with the kept stiffening) ask each such vertex's neighbours to be above
+  // or below it by a linear order along the local rise, with a slope of OrderingSlope times
+  // the cell's sample range per unit of the square (OrderWhereSamplingBreaks; 0 rounds: none).
+  int OrderingRounds = 4;
+  double OrderingSlope = 0.005;
   // Bytes the Sibson surfaces and their Bezier patches may take (<= 0: no limit). Checked
   // after the parameterization, when every cell's grid size N is known and before any surface
   // is built: the patches grow with the square of a cell's busiest side (4 N^2 triangles),
@@ -323,11 +330,22 @@ private:
   // Fits the cell's interior, refining its grid (see SurfaceTolerance); returns whether refined.
   bool FitSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided,
     const std::vector<SurfaceSample>& samples) const;
-  // The stiffening rounds (see StiffeningRounds) of a cell whose samples are those of
-  // `vertices` (ringInCell: per input vertex, whether it and its ring of neighbours lie inside
-  // its cell). Returns whether a stiffened fit was kept.
-  bool StiffenWhereSamplingBreaks(ReconstructedTwoCell& cell, const std::vector<SurfaceSample>& samples,
+  // The stiffening rounds (see StiffeningRounds), then the ordering rounds (OrderingRounds), of
+  // a cell whose samples are those of `vertices` (ringInCell: per input vertex, whether it and
+  // its ring of neighbours lie inside its cell). Returns which kind of fit was kept (0: the
+  // first): StiffenedFit, OrderedFit or both.
+  enum
+  {
+    StiffenedFit = 1,
+    OrderedFit = 2
+  };
+  class DeepCriticalVertices;
+  int StiffenWhereSamplingBreaks(ReconstructedTwoCell& cell, const std::vector<SurfaceSample>& samples,
     const Index* vertices, const std::vector<char>& ringInCell) const;
+  // The ordering rounds from `first` with the kept stiffening's options; returns whether an
+  // ordered fit was kept.
+  bool OrderWhereSamplingBreaks(ReconstructedTwoCell& cell, const MonotoneSibsonSurface& first,
+    MonotoneSurfaceFitOptions options, DeepCriticalVertices& deep, const std::vector<SurfaceSample>& samples) const;
   void Summarize();
   void BuildCellLocator();
   // The cell containing (x, y) and the point's (u, v) in its square (Inside false: snapped to

@@ -223,4 +223,18 @@ for seed in (7, 8):
     print("alternative maps, Shepard seed %d at 5 %%: largest miss of ReconstructedExact %.2f -> %.2f %% of the range" % (
         seed, 100 * misses[0], 100 * misses[30]), flush=True)
 checks.check(lowered >= 1, "alternative maps lower the largest miss on Shepard seed 7 or 8 (%d)" % lowered)
+
+# The ordering rounds after the stiffening (docs/Reconstruction.md, "Critical points the
+# stiffening leaves, ordered away") are reported in field data: cells whose kept fit orders
+# samples; none with the paper's interior. (TestFieldReconstruction checks what they do.)
+smooth = Smooth1Cells(Input=SimplifyMorseSmaleComplex(Input=MorseSmaleComplex(Input=ShepardField(Seed=1)),
+                                                      PersistenceThreshold=25))
+fitted = sm.Fetch(Reconstruct2Cells(Input=smooth)).GetFieldData()
+paper = sm.Fetch(Reconstruct2Cells(Input=smooth, Interior=0)).GetFieldData()
+ordered = tt.field_value(fitted, "OrderedCells")
+checks.check(ordered is not None and ordered <= tt.field_value(fitted, "FittedCells"),
+             "ordering rounds: OrderedCells %s of %s fitted cells" % (ordered, tt.field_value(fitted, "FittedCells")))
+checks.equal(tt.field_value(paper, "OrderedCells"), 0, "ordering rounds: none with the paper's interior")
+checks.equal(tt.field_value(fitted, "TopologyVerified"), 1, "ordering rounds, Shepard seed 1 at 25 %: verdict")
+print("ordering rounds, Shepard seed 1 at 25 %%: %s cells ordered" % ordered, flush=True)
 checks.finish()
