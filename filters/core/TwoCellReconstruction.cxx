@@ -684,28 +684,16 @@ bool IsCriticalVertex(const TriangleMeshTopology& mesh, Index v, const Values& v
   return changes != 2;
 }
 
-// The cells [0, n) through `parallel` in successive slices, the fraction done reported (as
-// [from, to] of the caller's progress) on the calling thread after each slice: on 1000 x 1000
-// noise one pass over the half million cells takes a minute, which a single report at its end
-// left without a moving progress bar, and reports from the worker threads would reach VTK's
-// observers off the main thread. Slices of at least 256 cells keep both threads busy; the body
-// polls the abort itself, and no slice starts after one.
-void ForEachCellInSlices(Index n, const ParallelFor& parallel, const ProgressHooks& hooks, double from, double to,
-  const RangeBody& body)
-{
-  const Index slice = std::max<Index>(256, (n + 49) / 50);
-  for (Index begin = 0; begin < n && !hooks.Aborted(); begin += slice)
-  {
-    const Index end = std::min(n, begin + slice);
-    parallel(begin, end, body);
-    hooks.Report(from + (to - from) * static_cast<double>(end) / static_cast<double>(n));
-  }
-}
-
-// The cells of `order` as ForEachCellInSlices does, each taken by the next thread that is free
-// (largest first, when `order` is sorted so): split into fixed shares, a few cells far larger
-// than the others (a terrain's) could all fall in one thread's share, the other thread idle.
-// Each cell's work depends on that cell alone, so the result does not depend on the order.
+// The cells of `order` through `parallel` in successive slices, each cell taken by the next
+// thread that is free (largest first, when `order` is sorted so: split into fixed shares, a few
+// cells far larger than the others, a terrain's, could all fall in one thread's share, the
+// other thread idle; each cell's work depends on that cell alone, so the result does not depend
+// on the order). The fraction done is reported (as [from, to] of the caller's progress) on the
+// calling thread after each slice: on 1000 x 1000 noise one pass over the half million cells
+// takes a minute, which a single report at its end left without a moving progress bar, and
+// reports from the worker threads would reach VTK's observers off the main thread. Slices of
+// at least 256 cells keep both threads busy; the abort is polled before each cell, and no slice
+// starts after one.
 void ForEachCellLargestFirst(const std::vector<Index>& order, const ParallelFor& parallel, const ProgressHooks& hooks,
   double from, double to, const std::function<void(Index)>& body)
 {
@@ -801,11 +789,14 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
   auto start = Clock::now();
   const std::vector<int> samplesPerPiece =
     BoundarySamplesPerPiece(complex, smoothed, this->BoundarySamples, this->BoundarySampleSpacing, SparseSamplesBelowVertices);
-  ForEachCellInSlices(n, this->Parallel, this->Hooks, 0.0, 0.65, [&](Index begin, Index end) {
-    for (Index c = begin; c < end && !this->Hooks.Aborted(); ++c)
-    {
-      this->ParameterizeCell(complex.TwoCells[c], smoothed, samplesPerPiece, *this->Cells[c], boundaries[c]);
-    }
+  // The cells with the most vertices first, in every pass: their meshes, maps and fits take
+  // the longest (ForEachCellLargestFirst).
+  std::vector<Index> largestFirst(n);
+  std::iota(largestFirst.begin(), largestFirst.end(), 0);
+  std::stable_sort(largestFirst.begin(), largestFirst.end(),
+    [&](Index a, Index b) { return complex.TwoCells[a].NumberOfVertices > complex.TwoCells[b].NumberOfVertices; });
+  ForEachCellLargestFirst(largestFirst, this->Parallel, this->Hooks, 0.0, 0.65, [&](Index c) {
+    this->ParameterizeCell(complex.TwoCells[c], smoothed, samplesPerPiece, *this->Cells[c], boundaries[c]);
   });
   this->DensifyFailedBoundaries(complex, smoothed, samplesPerPiece, boundaries);
   if (this->Hooks.Aborted())
@@ -848,14 +839,6 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
     }
     return samples;
   };
-  // The cells with the most samples first: their fits take the longest.
-  std::vector<Index> largestFirst(n);
-  std::iota(largestFirst.begin(), largestFirst.end(), 0);
-  if (fit)
-  {
-    std::stable_sort(largestFirst.begin(), largestFirst.end(),
-      [&](Index a, Index b) { return firstVertex[a + 1] - firstVertex[a] > firstVertex[b + 1] - firstVertex[b]; });
-  }
   ForEachCellLargestFirst(largestFirst, this->Parallel, this->Hooks, 0.7, 0.9, [&](Index c) {
     ReconstructedTwoCell& cell = *this->Cells[c];
     BuildSurface(cell, boundaries[c]);
