@@ -1468,7 +1468,6 @@ int TwoCellReconstruction::StiffenWhereSamplingBreaks(ReconstructedTwoCell& cell
 bool TwoCellReconstruction::OrderWhereSamplingBreaks(ReconstructedTwoCell& cell, const MonotoneSibsonSurface& first,
   MonotoneSurfaceFitOptions options, DeepCriticalVertices& deep, const std::vector<SurfaceSample>& samples) const
 {
-  const TriangleMeshTopology& mesh = *this->Mesh;
   double lowest = std::numeric_limits<double>::max(), highest = -lowest;
   for (const SurfaceSample& sample : samples)
   {
