@@ -174,6 +174,14 @@ topospline::TopologicalSampling FieldReconstruction::SamplingOf(const MorseSmale
 
 namespace
 {
+// The square bucket of side `side` that holds (x, y): the one rule by which BucketIndex
+// registers points and OneCellSamples keeps and looks up its samples (they must agree, see
+// BucketIndex).
+std::pair<long long, long long> SquareBucket(double x, double y, double side)
+{
+  return { static_cast<long long>(std::floor(x / side)), static_cast<long long>(std::floor(y / side)) };
+}
+
 // The square buckets of side `side` that hold points (x, y) at (floor(x / side), floor(y / side)),
 // and which items are registered in each. Items register in the buckets as OneCellSamples::
 // Nearest looks into them: the bucket of each point (x + dx side, y + dy side), dx and dy in
@@ -244,10 +252,7 @@ public:
     }
   }
 
-  std::pair<long long, long long> BucketOf(double x, double y) const
-  {
-    return { static_cast<long long>(std::floor(x / this->Side)), static_cast<long long>(std::floor(y / this->Side)) };
-  }
+  std::pair<long long, long long> BucketOf(double x, double y) const { return SquareBucket(x, y, this->Side); }
 
   // The items registered in bucket (i, j): [first, last).
   std::pair<const Index*, const Index*> ItemsIn(long long i, long long j) const
@@ -378,7 +383,8 @@ OneCellSamples::OneCellSamples(const OneCellSmoothingResult& smoothed, double si
 
 long long OneCellSamples::Key(double x, double y) const
 {
-  return this->KeyOf(static_cast<long long>(std::floor(x / this->Side)), static_cast<long long>(std::floor(y / this->Side)));
+  const auto [i, j] = SquareBucket(x, y, this->Side);
+  return this->KeyOf(i, j);
 }
 
 long long OneCellSamples::KeyOf(long long i, long long j) const
