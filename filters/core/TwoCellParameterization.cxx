@@ -17,6 +17,7 @@
 #include <Eigen/SparseLU>
 
 #include <algorithm>
+#include <iterator>
 #include <array>
 #include <cmath>
 #include <exception>
@@ -702,6 +703,91 @@ int DropSlitsOutsideTheLoop(const CellBoundary& cell, std::vector<double>& point
     }
   }
   return dropped;
+}
+
+// The walk with every run of consecutive samples that lie on (next to) one point made one
+// sample. A 1-cell piece that stage 3 left of no length is sampled k times at one point, and
+// its samples differ by rounding only: a few ulps apart, in no order, they make zero-length
+// edges and pinches that no triangulation takes. A run is a chain of consecutive samples each
+// within `tolerance` of the one before (in x and in y); it becomes one sample at the least of
+// its points (by x, then y), so that a slit, which retraces a run backwards, gets the same
+// point on both of its sides. Its parameter is its first sample's, or that of the corner of the
+// square it holds (u and v each 0 or 1), which must stay; a run holding two corners (a side of
+// no length) keeps both, and is refused later. Returns the number of samples dropped (0:
+// `points` and `parameters` are left empty).
+std::size_t MergeCoincidentRuns(const std::vector<double>& boundaryPoints,
+  const std::vector<double>& boundaryParameters, std::vector<double>& points, std::vector<double>& parameters)
+{
+  points.clear();
+  parameters.clear();
+  const std::size_t n = std::min(boundaryPoints.size(), boundaryParameters.size()) / 2;
+  if (n < 2)
+  {
+    return 0;
+  }
+  double largest = 0;
+  for (std::size_t i = 0; i < 2 * n; ++i)
+  {
+    largest = std::max(largest, std::abs(boundaryPoints[i]));
+  }
+  const double tolerance = 1e-12 * largest;
+  const auto near = [&](std::size_t a, std::size_t b) {
+    return std::abs(boundaryPoints[2 * a] - boundaryPoints[2 * b]) <= tolerance &&
+      std::abs(boundaryPoints[2 * a + 1] - boundaryPoints[2 * b + 1]) <= tolerance;
+  };
+  // A run starts where a sample is not near the one before it (cyclically).
+  std::size_t start = n;
+  bool anyNear = false;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    if (near((i + n - 1) % n, i))
+    {
+      anyNear = true;
+    }
+    else if (start == n)
+    {
+      start = i;
+    }
+  }
+  if (!anyNear || start == n)
+  {
+    return 0; // nothing to merge, or the whole walk on one point (refused later)
+  }
+  const auto corner = [&](std::size_t a) {
+    const double u = boundaryParameters[2 * a], v = boundaryParameters[2 * a + 1];
+    return (u == 0 || u == 1) && (v == 0 || v == 1);
+  };
+  std::vector<std::size_t> run;
+  for (std::size_t k = 0; k < n;)
+  {
+    run.clear();
+    run.push_back((start + k) % n);
+    for (++k; k < n && near(run.back(), (start + k) % n); ++k)
+    {
+      run.push_back((start + k) % n);
+    }
+    double x = boundaryPoints[2 * run[0]], y = boundaryPoints[2 * run[0] + 1];
+    for (const std::size_t i : run)
+    {
+      if (std::make_pair(boundaryPoints[2 * i], boundaryPoints[2 * i + 1]) < std::make_pair(x, y))
+      {
+        x = boundaryPoints[2 * i];
+        y = boundaryPoints[2 * i + 1];
+      }
+    }
+    std::vector<std::size_t> kept;
+    std::copy_if(run.begin(), run.end(), std::back_inserter(kept), corner);
+    if (kept.empty())
+    {
+      kept.push_back(run.front());
+    }
+    for (const std::size_t i : kept)
+    {
+      points.insert(points.end(), { run.size() > 1 ? x : boundaryPoints[2 * i], run.size() > 1 ? y : boundaryPoints[2 * i + 1] });
+      parameters.insert(parameters.end(), { boundaryParameters[2 * i], boundaryParameters[2 * i + 1] });
+    }
+  }
+  return n - points.size() / 2;
 }
 
 // Pairs of equal count, finite, at least one sample per corner of the square.
@@ -1418,7 +1504,11 @@ bool TwoCellParameterization::Parameterize(
     error.clear();
     return true;
   };
-  if (!ReadBoundaryWalk(boundaryPoints, boundaryParameters, cell, error) || !analyze() ||
+  std::vector<double> mergedPoints, mergedParameters;
+  const bool merged = MergeCoincidentRuns(boundaryPoints, boundaryParameters, mergedPoints, mergedParameters) > 0;
+  if (!ReadBoundaryWalk(merged ? mergedPoints : boundaryPoints, merged ? mergedParameters : boundaryParameters, cell,
+        error) ||
+    !analyze() ||
     !CheckOuterLoop(cell, error) || !dropOutsideSlits() ||
     !TriangulateCell(cell, InteriorEdgeLength(cell, this->TargetEdgeLength, this->MaximumVertices), this->ShapeBound,
       this->MaximumFixRounds, mesh, error))

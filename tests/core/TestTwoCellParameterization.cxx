@@ -800,10 +800,15 @@ TEST_CASE(DegenerateInputs)
   bad[5] = std::nan("");
   CHECK(Fails(bad, square.Parameters, "NaN coordinate"));
   // Repeated points: consecutive, and a vertex visited twice.
+  // (A sample repeating the one before it is merged with it, CoincidentRunsAreMerged; two
+  // corners on one point, a side of no length, are refused.)
   bad = square.Points;
-  bad[2] = bad[0];
-  bad[3] = bad[1];
-  CHECK(Fails(bad, square.Parameters, "consecutive repeated point"));
+  for (int i = 1; i <= 3; ++i)
+  {
+    bad[2 * i] = bad[0];
+    bad[2 * i + 1] = bad[1];
+  }
+  CHECK(Fails(bad, square.Parameters, "two corners on one point"));
   // A vertex visited twice: here two lobes touching (a pinched cell, opened; see
   // PinchedCellIsOpenedAtItsPinch), but a bow tie crosses itself there.
   bad = square.Points;
@@ -1385,6 +1390,122 @@ TEST_CASE(InverseEvaluation)
 // A pinched cell (uniform noise makes them): two lobes touching at one point that the boundary
 // visits twice, both turning the same way. Each visit moves a little into the outside between
 // the lobes, leaving a thin neck; the map is then one-to-one, and each lobe maps into the square.
+// A 1-cell piece of no length (stage 3 can leave one next to a domain corner) is sampled k times
+// at one point, its samples apart by a few ulps in no order: a b c a b c a. Exact repeats are
+// zero-length edges and the rest pinch the walk; both were refused, and the cell was lost
+// (stress case #197 of seed 97, a crop at 50 %). Such runs are one sample now, at the least of
+// their points, so that a slit retracing a run gets the same point on both of its sides.
+TEST_CASE(CoincidentRunsAreMerged)
+{
+  // x of the run's samples: three values one ulp apart, in the order rounding gave stage 3.
+  const auto runAt = [](double x, double y, int length) {
+    const double xs[3] = { x, std::nextafter(x, 2.0), std::nextafter(x, -2.0) };
+    std::vector<std::pair<double, double>> run;
+    for (int i = 0; i < length; ++i)
+    {
+      run.push_back({ xs[i % 3], y });
+    }
+    return run;
+  };
+  Random random(5);
+  const std::vector<double> square = SquarePoints(4);
+  // A square with a run of 7 samples in the middle of its bottom side, and one with the run at
+  // its (1, 0) corner, the corner sample inside the run.
+  for (const bool atCorner : { false, true })
+  {
+    Walk walk;
+    int kept = 0;
+    for (int k = 0; k < 16; ++k)
+    {
+      const std::pair<double, double> p = { square[2 * k], square[2 * k + 1] };
+      if (k == (atCorner ? 4 : 2))
+      {
+        const auto run = runAt(p.first, p.second, 7);
+        for (std::size_t i = 0; i < run.size(); ++i)
+        {
+          walk.Add(run[i]);
+          if (atCorner && i == 3)
+          {
+            walk.Corner();
+          }
+        }
+      }
+      else
+      {
+        walk.Add(p);
+        if (k % 4 == 0)
+        {
+          walk.Corner();
+        }
+      }
+      ++kept;
+    }
+    const Cell cell = walk.Build();
+    TwoCellParameterization tcp;
+    std::string error;
+    const bool ok = tcp.Parameterize(cell.Points, cell.Parameters, error);
+    std::printf("  run of 7 samples %s: %s\n", atCorner ? "at a corner" : "along a side", ok ? "merged" : error.c_str());
+    CHECK(ok);
+    if (!ok)
+    {
+      continue;
+    }
+    const TwoCellMesh& mesh = tcp.GetMesh();
+    CHECK_EQ(mesh.BoundaryCount, kept);
+    CHECK(mesh.MinimumParameterArea > 0);
+    // The merged sample sits at the least of the run's points and keeps the corner it held.
+    bool found = false;
+    for (Index i = 0; i < mesh.BoundaryCount; ++i)
+    {
+      if (mesh.Points[2 * i] == std::nextafter(atCorner ? 1.0 : 0.5, -2.0) && mesh.Points[2 * i + 1] == 0)
+      {
+        found = !atCorner || (mesh.Parameters[2 * i] == 1 && mesh.Parameters[2 * i + 1] == 0);
+      }
+    }
+    CHECK(found);
+    // Every point of the cell is mapped inside the square and back.
+    CHECK(InverseRoundTripError(tcp, cell, random, 200) <= 1e-9);
+  }
+  // A slit with a run on it, retraced: out a b c a, back a c b a (the same samples reversed).
+  Walk pouch;
+  const std::pair<double, double> base = CirclePoint(10, 40);
+  for (int k = 0; k <= 10; ++k)
+  {
+    pouch.Add(CirclePoint(k, 40));
+    if (k == 0 || k == 10)
+    {
+      pouch.Corner();
+    }
+  }
+  const std::pair<double, double> middle = Scaled(base, 0.5);
+  const auto run = runAt(middle.first, middle.second, 4);
+  pouch.Add(Scaled(base, 0.75));
+  for (const auto& p : run)
+  {
+    pouch.Add(p);
+  }
+  pouch.Add(Scaled(base, 0.25));
+  pouch.Corner();
+  for (auto p = run.rbegin(); p != run.rend(); ++p)
+  {
+    pouch.Add(*p);
+  }
+  pouch.Add(Scaled(base, 0.75));
+  pouch.Add(base);
+  pouch.Corner();
+  for (int k = 11; k < 40; ++k)
+  {
+    pouch.Add(CirclePoint(k, 40));
+  }
+  const Cell slit = pouch.Build();
+  TwoCellParameterization tcp;
+  std::string error;
+  const bool ok = tcp.Parameterize(slit.Points, slit.Parameters, error);
+  std::printf("  slit with a run of 4 samples: %s\n", ok ? "merged on both sides" : error.c_str());
+  CHECK(ok && tcp.GetMesh().MinimumParameterArea > 0);
+  CHECK(ok && tcp.GetMesh().BoundaryCount == static_cast<Index>(slit.Points.size() / 2) - 6);
+}
+
 TEST_CASE(PinchedCellIsOpenedAtItsPinch)
 {
   for (const bool clockwise : { false, true })
