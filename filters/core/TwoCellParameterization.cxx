@@ -709,7 +709,7 @@ int DropSlitsOutsideTheLoop(const CellBoundary& cell, std::vector<double>& point
 // sample. A 1-cell piece that stage 3 left of no length is sampled k times at one point, and
 // its samples differ by rounding only: a few ulps apart, in no order, they make zero-length
 // edges and pinches that no triangulation takes. A run is a chain of consecutive samples each
-// within `tolerance` of the one before (in x and in y); it becomes one sample at the least of
+// within the tolerance below of the one before (in x and in y); it becomes one sample at the least of
 // its points (by x, then y), so that a slit, which retraces a run backwards, gets the same
 // point on both of its sides. Its parameter is its first sample's, or that of the corner of the
 // square it holds (u and v each 0 or 1), which must stay; a run holding two corners (a side of
@@ -725,12 +725,19 @@ std::size_t MergeCoincidentRuns(const std::vector<double>& boundaryPoints,
   {
     return 0;
   }
+  // Within 1e-12 of the walk's extent, or a few ulps of its coordinates where they lie far
+  // from 0 (an image's origin may be up to 1e12 spacings away): a tolerance relative to the
+  // coordinates alone would merge samples a spacing apart there.
+  double low[2] = { boundaryPoints[0], boundaryPoints[1] }, high[2] = { low[0], low[1] };
   double largest = 0;
   for (std::size_t i = 0; i < 2 * n; ++i)
   {
+    low[i % 2] = std::min(low[i % 2], boundaryPoints[i]);
+    high[i % 2] = std::max(high[i % 2], boundaryPoints[i]);
     largest = std::max(largest, std::abs(boundaryPoints[i]));
   }
-  const double tolerance = 1e-12 * largest;
+  const double tolerance = std::max(
+    1e-12 * std::max(high[0] - low[0], high[1] - low[1]), 16 * std::numeric_limits<double>::epsilon() * largest);
   const auto near = [&](std::size_t a, std::size_t b) {
     return std::abs(boundaryPoints[2 * a] - boundaryPoints[2 * b]) <= tolerance &&
       std::abs(boundaryPoints[2 * a + 1] - boundaryPoints[2 * b + 1]) <= tolerance;

@@ -103,8 +103,8 @@ public:
   // self-touching boundary that is not of this form, zero area, (u, v) off the border or not
   // monotone) or if the map could not be made one-to-one.
   // A walk of another form is repaired where it can be: consecutive samples within 1e-12 of the
-  // largest coordinate of one another (a 1-cell piece of no length, sampled k times at one
-  // point, its samples apart by rounding) are made one sample; sides that overlap along a straight
+  // walk's extent (or 16 ulps of its coordinates) of one another (a 1-cell piece of no length,
+  // sampled k times at one point, its samples apart by rounding) are made one sample; sides that overlap along a straight
   // stretch, each sampled its own way, get each other's samples (a slit then); a loop that
   // touches itself at a point (a pinched cell) is opened there by 1e-3 of an edge.
   bool Parameterize(const std::vector<double>& boundaryPoints, const std::vector<double>& boundaryParameters,

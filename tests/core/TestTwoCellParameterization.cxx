@@ -1504,6 +1504,40 @@ TEST_CASE(CoincidentRunsAreMerged)
   std::printf("  slit with a run of 4 samples: %s\n", ok ? "merged on both sides" : error.c_str());
   CHECK(ok && tcp.GetMesh().MinimumParameterArea > 0);
   CHECK(ok && tcp.GetMesh().BoundaryCount == static_cast<Index>(slit.Points.size() / 2) - 6);
+
+  // Far from the origin (x + 1e9: an ulp is 1.2e-7 there), a run is still merged, but two
+  // distinct samples 1e-4 apart are not (a tolerance of 1e-12 of the coordinates, 1e-3 there,
+  // merged them).
+  Walk far;
+  const double offset = 1e9;
+  for (int k = 0; k < 16; ++k)
+  {
+    const std::pair<double, double> p = { offset + square[2 * k], square[2 * k + 1] };
+    if (k == 2)
+    {
+      for (const auto& q : runAt(p.first, p.second, 5))
+      {
+        far.Add(q);
+      }
+      continue;
+    }
+    far.Add(p);
+    if (k == 1)
+    {
+      far.Add({ p.first + 1e-4, p.second });
+    }
+    if (k % 4 == 0)
+    {
+      far.Corner();
+    }
+  }
+  const Cell farCell = far.Build();
+  TwoCellParameterization farMap;
+  const bool farOk = farMap.Parameterize(farCell.Points, farCell.Parameters, error);
+  std::printf("  square 1e9 from the origin, a run of 5 and two samples 1e-4 apart: %s, %d of %d samples kept\n",
+    farOk ? "parameterized" : error.c_str(), farOk ? static_cast<int>(farMap.GetMesh().BoundaryCount) : 0,
+    static_cast<int>(farCell.Points.size() / 2));
+  CHECK(farOk && farMap.GetMesh().BoundaryCount == static_cast<Index>(farCell.Points.size() / 2) - 4);
 }
 
 TEST_CASE(PinchedCellIsOpenedAtItsPinch)
