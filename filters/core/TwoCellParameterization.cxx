@@ -17,10 +17,10 @@
 #include <Eigen/SparseLU>
 
 #include <algorithm>
-#include <iterator>
 #include <array>
 #include <cmath>
 #include <exception>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -709,12 +709,12 @@ int DropSlitsOutsideTheLoop(const CellBoundary& cell, std::vector<double>& point
 // sample. A 1-cell piece that stage 3 left of no length is sampled k times at one point, and
 // its samples differ by rounding only: a few ulps apart, in no order, they make zero-length
 // edges and pinches that no triangulation takes. A run is a chain of consecutive samples each
-// within the tolerance below of the one before (in x and in y); it becomes one sample at the least of
-// its points (by x, then y), so that a slit, which retraces a run backwards, gets the same
-// point on both of its sides. Its parameter is its first sample's, or that of the corner of the
-// square it holds (u and v each 0 or 1), which must stay; a run holding two corners (a side of
-// no length) keeps both, and is refused later. Returns the number of samples dropped (0:
-// `points` and `parameters` are left empty).
+// within the tolerance below of the one before (in x and in y); it becomes one sample at the
+// least of its points (by x, then y), so that a slit, which retraces a run backwards, gets the
+// same point on both of its sides. Its parameter is its first sample's, or that of the corner
+// of the square it holds (u and v each 0 or 1), which must stay; a run holding two corners (a
+// side of no length) keeps both, on one point, and is refused later. Returns the number of
+// samples dropped; when it is 0 the caller reads the walk as given.
 std::size_t MergeCoincidentRuns(const std::vector<double>& boundaryPoints,
   const std::vector<double>& boundaryParameters, std::vector<double>& points, std::vector<double>& parameters)
 {
@@ -790,7 +790,7 @@ std::size_t MergeCoincidentRuns(const std::vector<double>& boundaryPoints,
     }
     for (const std::size_t i : kept)
     {
-      points.insert(points.end(), { run.size() > 1 ? x : boundaryPoints[2 * i], run.size() > 1 ? y : boundaryPoints[2 * i + 1] });
+      points.insert(points.end(), { x, y }); // a run of one sample: its own point
       parameters.insert(parameters.end(), { boundaryParameters[2 * i], boundaryParameters[2 * i + 1] });
     }
   }

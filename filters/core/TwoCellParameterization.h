@@ -37,9 +37,9 @@ enum class GradientWeighting
 struct TwoCellMesh
 {
   // Vertex positions (x, y), interleaved. The first BoundaryCount vertices are the input
-  // samples (as repaired, see Parameterize), in input order; the rest are interior Steiner points. A slit sample visited k
-  // times is k vertices with equal (x, y) (the mesh is cut open along the slit); the triangles
-  // on each side of the slit use the copy of that side.
+  // samples (as repaired, see Parameterize), in input order; the rest are interior Steiner
+  // points. A slit sample visited k times is k vertices with equal (x, y) (the mesh is cut open
+  // along the slit); the triangles on each side of the slit use the copy of that side.
   std::vector<double> Points;
   // (u, v) per vertex, interleaved: the given values on the boundary (bit for bit), mean value
   // coordinates inside.
@@ -104,9 +104,10 @@ public:
   // monotone) or if the map could not be made one-to-one.
   // A walk of another form is repaired where it can be: consecutive samples within 1e-12 of the
   // walk's extent (or 16 ulps of its coordinates) of one another (a 1-cell piece of no length,
-  // sampled k times at one point, its samples apart by rounding) are made one sample; sides that overlap along a straight
-  // stretch, each sampled its own way, get each other's samples (a slit then); a loop that
-  // touches itself at a point (a pinched cell) is opened there by 1e-3 of an edge.
+  // sampled k times at one point, its samples apart by rounding) are made one sample; sides
+  // that overlap along a straight stretch, each sampled its own way, get each other's samples
+  // (a slit then); a loop that touches itself at a point (a pinched cell) is opened there by
+  // 1e-3 of an edge.
   bool Parameterize(const std::vector<double>& boundaryPoints, const std::vector<double>& boundaryParameters,
     std::string& error);
 
