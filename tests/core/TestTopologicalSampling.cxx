@@ -8,7 +8,8 @@
 // whose neighbour along the boundary can rise past it goes up there, and one with a free
 // neighbour along the boundary moves there; a saddle lowered off its vertex comes
 // back by the patterns of its link; a saddle walked a few vertex values off its node is walked
-// back. Each sampled result is checked by
+// back; a vertex a ridge and a valley both claim goes to the nearer one; a ridge carved beside a
+// monkey saddle leaves the saddle's lower link whole. Each sampled result is checked by
 // extracting its critical points again (stage 1) against the wanted complex. (The whole
 // sequence on real reconstructions is tested in TestFieldReconstruction.)
 //
@@ -1207,6 +1208,138 @@ TEST_CASE(AValleyBesideARidgeGoesRoundTheVerticesBothClaim)
       static_cast<int>(carving), static_cast<int>(changed), valley ? 1 : 0, ridge ? 1 : 0);
     CHECK(valley);
     CHECK(ridge);
+  }
+}
+
+TEST_CASE(AVertexBothClaimGoesToTheOneCellPassingNearer)
+{
+  // A valley runs along row 5 through its vertices; a ridge runs 0.6 spacings above it, along
+  // row 6, but dips to 0.4 above it at x = 10, where its walk steps onto (10, 5) and (11, 5).
+  // Both claim those two vertices. The valley passes them at no distance, the ridge at 0.4 and
+  // 0.6: they are the valley's, lowered along it, and the ridge, walked again round them,
+  // rises along row 6. Left to neither (as when neither passes clearly nearer), they would keep
+  // the data's values, and row 5 would not fall along the valley.
+  const int nx = 20, ny = 10;
+  auto id = [&](int i, int j) { return static_cast<Index>(j) * nx + i; };
+  PlanarScalarField field =
+    UnitGrid(nx, ny, [](int i, int j) { return 1e-4 * std::sin(1.3 * i + 0.7 * j) * std::cos(0.9 * j - 0.4 * i); });
+  TriangleMeshTopology mesh;
+  mesh.BuildGrid(nx, ny, SequentialFor);
+  SamplingConstraints constraints;
+  for (const bool up : { false, true })
+  {
+    SaddleOneCell cell;
+    cell.Ascending = up;
+    cell.Saddle = id(2, up ? 6 : 5);
+    for (double x = 2; x <= 17 + 1e-9; x += 0.125)
+    {
+      const double dip = 0.2 * std::max(0.0, 1 - std::abs(x - 10) / 0.5);
+      cell.Points.insert(cell.Points.end(), { x, up ? 5.6 - dip : 5.0, (up ? 1e-3 : -1e-3) * (x - 2) });
+    }
+    constraints.OneCells.push_back(cell);
+    constraints.Saddles.push_back(cell.Saddle);
+    const Index end = id(17, up ? 6 : 5);
+    (up ? constraints.Maxima : constraints.Minima).push_back(end);
+    field.Values[cell.Saddle] = 0;
+    field.Values[end] = up ? 1 : -1;
+  }
+  for (const OneCellCarving carving :
+    { OneCellCarving::JustPastTheWalk, OneCellCarving::WhereNeeded, OneCellCarving::Everywhere })
+  {
+    std::vector<double> values = field.Values;
+    const Index changed = CarveOneCells(field, mesh, constraints, 1.0, values, carving);
+    bool valley = true, ridge = true;
+    for (int i = 5; i <= 15; ++i)
+    {
+      valley = valley && values[id(i, 5)] < 0 && values[id(i, 5)] < values[id(i - 1, 5)];
+      ridge = ridge && values[id(i, 6)] > 0 && values[id(i, 6)] > values[id(i - 1, 6)];
+    }
+    std::printf("  carving %d: %d vertices changed; row 5 falls: %d, row 6 rises: %d\n", static_cast<int>(carving),
+      static_cast<int>(changed), valley ? 1 : 0, ridge ? 1 : 0);
+    CHECK(valley);
+    CHECK(ridge);
+  }
+}
+
+TEST_CASE(ARidgeBesideASaddleLeavesItsLowerLinkWhole)
+{
+  // A ridge (another saddle's ascending 1-cell) runs through a vertex of a wanted saddle's link
+  // that lies below the saddle. Raised to the ridge's height, that vertex would join the upper
+  // link, and a monkey saddle (wanted twice: three pieces of lower link) would be left a simple
+  // saddle, formed again a few vertices away by the floods. Carving leaves such a link as it
+  // is, and carves the rest of the ridge; a simple saddle (wanted once), which two pieces keep,
+  // lets the ridge through. The pieces of the lower link are counted here around the grid's
+  // cyclic link of six: (i+1, j), (i, j+1), (i-1, j+1), (i-1, j), (i, j-1), (i+1, j-1).
+  const int nx = 12, ny = 12;
+  auto id = [&](int i, int j) { return static_cast<Index>(j) * nx + i; };
+  const Index saddle = id(6, 6);
+  PlanarScalarField field = UnitGrid(nx, ny, [](int, int) { return 0.1; });
+  const std::array<std::array<int, 2>, 6> around{ { { 7, 6 }, { 6, 7 }, { 5, 7 }, { 5, 6 }, { 6, 5 }, { 7, 5 } } };
+  field.Values[saddle] = 0.5;
+  for (std::size_t k = 0; k < around.size(); ++k)
+  {
+    field.Values[id(around[k][0], around[k][1])] = k % 2 == 0 ? 0.2 : 0.8;
+  }
+  auto lowerPieces = [&](const std::vector<double>& values) {
+    int pieces = 0;
+    for (std::size_t k = 0; k < around.size(); ++k)
+    {
+      const Index a = id(around[k][0], around[k][1]), b = id(around[(k + 5) % 6][0], around[(k + 5) % 6][1]);
+      pieces += values[a] < values[saddle] && !(values[b] < values[saddle]) ? 1 : 0;
+    }
+    return pieces;
+  };
+  TriangleMeshTopology mesh;
+  mesh.BuildGrid(nx, ny, SequentialFor);
+  // The ridge: from a saddle at (2, 7) along row 7 to (5, 7), then up column 5 to a maximum at
+  // (5, 11), rising from 0.85 to 0.99.
+  SaddleOneCell ridge;
+  ridge.Saddle = id(2, 7);
+  ridge.Ascending = true;
+  std::vector<std::array<double, 2>> path;
+  for (double x = 2; x < 5; x += 0.125)
+  {
+    path.push_back({ x, 7 });
+  }
+  for (double y = 7; y <= 11 + 1e-9; y += 0.125)
+  {
+    path.push_back({ 5, y });
+  }
+  for (std::size_t p = 0; p < path.size(); ++p)
+  {
+    ridge.Points.insert(ridge.Points.end(), { path[p][0], path[p][1], 0.85 + 0.14 * p / (path.size() - 1) });
+  }
+  const Index ridgeMaximum = id(5, 11);
+  field.Values[ridge.Saddle] = 0.85;
+  field.Values[ridgeMaximum] = 0.99;
+  CHECK_EQ(lowerPieces(field.Values), 3);
+  for (const int wanted : { 2, 1 })
+  {
+    SamplingConstraints constraints;
+    constraints.OneCells.push_back(ridge);
+    constraints.Saddles = { ridge.Saddle };
+    constraints.Saddles.insert(constraints.Saddles.end(), wanted, saddle);
+    constraints.Maxima = { ridgeMaximum };
+    for (const OneCellCarving carving :
+      { OneCellCarving::JustPastTheWalk, OneCellCarving::WhereNeeded, OneCellCarving::Everywhere })
+    {
+      std::vector<double> values = field.Values;
+      const Index changed = CarveOneCells(field, mesh, constraints, 1.0, values, carving);
+      std::printf("  saddle wanted %d time(s), carving %d: %d vertices changed, %d pieces of its lower link\n", wanted,
+        static_cast<int>(carving), static_cast<int>(changed), lowerPieces(values));
+      // The ridge is carved past the link: (4, 7) before it, (5, 9) after it.
+      CHECK(values[id(4, 7)] > 0.85 && values[id(5, 9)] > 0.85);
+      CHECK_EQ(values[saddle], 0.5);
+      if (wanted == 2)
+      {
+        CHECK_EQ(lowerPieces(values), 3);
+      }
+      else
+      {
+        CHECK(values[id(5, 7)] > 0.85);
+        CHECK_EQ(lowerPieces(values), 2);
+      }
+    }
   }
 }
 

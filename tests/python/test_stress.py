@@ -141,6 +141,13 @@ REQUIRED = [
     # ulps apart: its cell's walk was refused (zero-length edges, pinches) and 744 vertices were
     # left out (seed 97 #197; TwoCellParameterization merges such runs since Session 44).
     dict(kind="crop", file="r_volcano_maunga_whau.vti", i0=8, j0=12, w=78, h=48, percent=50.0, k=13, seed=1325395662),
+    # A ridge and a valley leaving one boundary saddle half a spacing apart both claimed the
+    # valley's first vertex, which kept a value above the saddle; the saddle formed eleven
+    # vertices away (seed 97 #43; the vertex is the valley's since Session 45).
+    dict(kind="noise", nx=48, ny=48, percent=50.0, k=24, seed=1453393452),
+    # A ridge carved through the vertex by which a monkey saddle's third valley leaves: one of
+    # the two saddles formed three vertices away (seed 97 #77; its link is held since Session 45).
+    dict(kind="noise", nx=128, ny=128, percent=10.0, k=18, seed=163665149),
 ]
 
 
