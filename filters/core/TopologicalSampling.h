@@ -126,12 +126,15 @@ enum class OneCellCarving : int
 // curve), raised to the 1-cell's height for an ascending one (lowered for a descending one)
 // and strictly monotone from the saddle on. Vertices within `spacing` of the 1-cell's saddle
 // or extremum are left to the floods and to CarveSaddleOneCells; so are vertices that a
-// ridge and a valley both claim, and boundary vertices the 1-cell does not run through. A
-// 1-cell whose walk met a vertex claimed by both (a ridge and a valley less than a spacing
-// apart) is walked again round the vertices the other kind claimed, so that its chain does not
-// break there; the other 1-cells are walked once.
-// Critical vertices keep their values (the nodes' critical values, as Apply sets them), and
-// no vertex next to a wanted maximum (minimum) is raised (lowered) past it.
+// ridge and a valley both claim, unless one kind's 1-cells pass at less than half the other's
+// distance (the vertex is then that kind's), and boundary vertices the 1-cell does not run
+// through. A 1-cell whose walk met a vertex claimed by both (a ridge and a valley less than a
+// spacing apart) is walked again round the vertices the other kind claimed (but those that are
+// its kind's), so that its chain does not break there; the other 1-cells are walked once.
+// Critical vertices keep their values (the nodes' critical values, as Apply sets them), no
+// vertex next to a wanted maximum (minimum) is raised (lowered) past it, and the link of a
+// wanted interior monkey saddle keeps its values where the claims would leave the saddle fewer
+// pieces of lower link than it needs.
 // `carving` says how far (OneCellCarving). The walks run with `parallel` (they only read the
 // values; the result does not depend on it). Returns the number of changed vertices.
 Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
