@@ -3552,12 +3552,13 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
     }
   }
   // Whether `asked` carves v: only its kind claims v, or passes it clearly nearer, and its
-  // claim moves v up (down). What v would get (NaN: it keeps its value).
+  // claim moves v up (down).
   const auto carves = [&](const CarvingClaims& asked, Index v) {
     const CarvingClaims& other = &asked == &raise ? lower : raise;
     return asked.Has(v) && (!other.Has(v) || asked.Nearer(other, v)) &&
       (asked.Up ? values[v] < asked.To[v] : values[v] > asked.To[v]);
   };
+  // What v would get (NaN: it keeps its value).
   const auto carved = [&](Index v) {
     return carves(raise, v) ? raise.To[v] : carves(lower, v) ? lower.To[v] : std::numeric_limits<double>::quiet_NaN();
   };
@@ -3587,10 +3588,11 @@ Index CarveOneCells(const PlanarScalarField& field, const TriangleMeshTopology& 
       {
         continue;
       }
-      const auto before = [&](Index w) { return std::make_pair(values[w], w) < std::make_pair(values[s], s); };
+      const Key saddle{ values[s], s };
+      const auto before = [&](Index w) { return Key{ values[w], w } < saddle; };
       const auto after = [&](Index w) {
         const double c = carved(w);
-        return std::make_pair(std::isnan(c) ? values[w] : c, w) < std::make_pair(values[s], s);
+        return Key{ std::isnan(c) ? values[w] : c, w } < saddle;
       };
       const int now = LowerLinkKind(mesh, s, before);
       if (now >= needed && LowerLinkKind(mesh, s, after) < needed)
