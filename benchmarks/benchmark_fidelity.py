@@ -20,9 +20,15 @@ Inputs: the Trigonometric Field at 0 %; Shepard fields (250^2, 50 sites) of seed
 25 %; every DEM shipped in tests/data at 2 and 5 %. k = 4, except the Rainier crop (k = 7, the
 paper's). STDThread on 2 threads.
 
-Usage: pvpython benchmarks/benchmark_fidelity.py [--quick] [--seeds FIRST-LAST] [--fitted-only]
-                                                 [--alternative-map-strength S] [--json FILE]
+Usage: pvpython benchmarks/benchmark_fidelity.py [--quick] [--seeds FIRST-LAST] [--crops N] [--fitted-only]
+                                                 [--large] [--alternative-map-strength S] [--json FILE]
   --quick: Shepard seeds 0-3 only.
+  --crops N: N seeded random crops (64-300 vertices a side) of every DEM found, at 2 and 5 %,
+      k = 4, instead of the inputs above: the same measurements on terrain windows nothing was
+      tuned on.
+  --large: the catalog's two large DEMs too (the full Rainier DEM, 884 x 824, and the 2000 x 2000
+      terrain), from ../shared/data, skipped with a message when absent; about 10 and 30 s per
+      run, and the flood yardstick about a minute per threshold on the 2000 x 2000 terrain.
   --seeds FIRST-LAST: the Shepard fields of these seeds only (no Trigonometric Field, no DEMs):
       the same measurements on fields the tests and the tables above never saw.
   --fitted-only: the fitted interiors only (half the time).
@@ -48,14 +54,63 @@ if "--seeds" in sys.argv:
     first, _, last = sys.argv[sys.argv.index("--seeds") + 1].partition("-")
     SEEDS = range(int(first), int(last or first) + 1)
 FITTED_ONLY = "--fitted-only" in sys.argv
+LARGE = "--large" in sys.argv
+CROPS = int(sys.argv[sys.argv.index("--crops") + 1]) if "--crops" in sys.argv else 0
 STRENGTH = (float(sys.argv[sys.argv.index("--alternative-map-strength") + 1])
             if "--alternative-map-strength" in sys.argv else None)
 
 DEMS = ["r_volcano_maunga_whau.vti", "rainier_ned1_1970_crop458x306.vti", "sainthelens_usgs_dem_crop.vti",
         "msh_crater_2007_10m.vti", "ttk_happi_tas_anomaly.vti"]
+LARGE_DEMS = ["rainier_ned1_1970_full.vti", "argudo_glaciers_sthelens_10m.vti"]
+
+
+def crop_cases(count):
+    """Seeded random crops of every DEM found (the large ones too), each at 2 and 5 %."""
+    import random
+    import numpy as np
+    from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkIOXML import vtkXMLImageDataReader
+    grids = {}
+    for name in DEMS + LARGE_DEMS:
+        path = benchmark_common.data_file(name)
+        if path is None:
+            print("skip %s: not found" % name)
+            continue
+        reader = vtkXMLImageDataReader()
+        reader.SetFileName(path)
+        reader.Update()
+        image = reader.GetOutput()
+        nx, ny, _ = image.GetDimensions()
+        array = image.GetPointData().GetScalars() or image.GetPointData().GetArray(0)
+        grids[name] = (np.array(vtk_to_numpy(array), dtype=np.float64).reshape(ny, nx), image.GetSpacing())
+    random_ = random.Random(2026)
+    names = sorted(grids)
+    for _ in range(count if names else 0):
+        name = random_.choice(names)
+        values, spacing = grids[name]
+        ny, nx = values.shape
+        w, h = random_.randint(min(64, nx), min(300, nx)), random_.randint(min(64, ny), min(300, ny))
+        i0, j0 = random_.randint(0, nx - w), random_.randint(0, ny - h)
+
+        def make(window=values[j0:j0 + h, i0:i0 + w].copy(), spacing=spacing):
+            image = vtkImageData()
+            image.SetDimensions(window.shape[1], window.shape[0], 1)
+            image.SetSpacing(spacing)
+            array = numpy_to_vtk(window.ravel(), deep=1)
+            array.SetName("elevation")
+            image.GetPointData().SetScalars(array)
+            producer = TrivialProducer()
+            producer.GetClientSideObject().SetOutput(image)
+            return producer
+        for percent in (2, 5):
+            yield "%s i0 %d j0 %d %dx%d" % (name.replace(".vti", ""), i0, j0, w, h), make, percent, 4
 
 
 def cases():
+    if CROPS:
+        yield from crop_cases(CROPS)
+        return
     if SEEDS is not None:
         for seed in SEEDS:
             for percent in (5, 25):
@@ -65,7 +120,7 @@ def cases():
     for seed in range(4 if QUICK else 10):
         for percent in (5, 25):
             yield "Shepard seed %d" % seed, (lambda s=seed: ShepardField(Seed=s)), percent, 4
-    for name in DEMS:
+    for name in DEMS + (LARGE_DEMS if LARGE else []):
         path = benchmark_common.data_file(name)
         if path is None:
             print("skip %s: not found" % name)

@@ -279,23 +279,38 @@ public:
   bool Empty() const { return this->Items.empty(); }
 
   // Calls visit(xy, i, j, piece, segment, s) for the samples xy of the smoothed pieces [begin,
-  // end), 16 per Bezier segment, that lie in a bucket (i, j) with items (s: the parameter on the
-  // piece's segment). A segment lies in its control points' bounding box (widened against
-  // rounding): it is sampled only if a bucket of that box has items (or the box spans over 64
-  // buckets).
+  // end) that lie in a bucket (i, j) with items (s: the parameter on the piece's segment). A
+  // segment lies in its control points' bounding box (widened against rounding): it is sampled
+  // only if a bucket of that box has items (or the box spans over 64 buckets). Samples per
+  // segment: SamplesPerSegment, or more where the segment is long: its speed is at most 3 times
+  // its longest control leg, so with m >= SamplesPerSide x 3 x leg / side equal parameter steps
+  // consecutive samples are at most 1/16 of a side apart along the curve, and a sample lies
+  // within 1/32 of a side of every curve point. (A fixed 16 per segment put samples up to about
+  // 19 grid spacings apart on the 2000 x 2000 terrain's 1-cells, whose control legs reach 100
+  // spacings: points next to a curve were counted as far from it.)
+  static constexpr int SamplesPerSegment = 16;
+  static constexpr double SamplesPerSide = 16;
   template <typename Visit>
   void ForEachSampleInBuckets(const OneCellSmoothingResult& smoothed, Index begin, Index end, const Visit& visit) const
   {
-    constexpr int perSegment = 16;
     for (Index p = begin; p < end; ++p)
     {
       const SmoothedPiece& piece = smoothed.Pieces[p];
       for (int j = 0; j < piece.Curve.Segments; ++j)
       {
-        if (!this->MayHoldItems(piece.Curve.Segment(j)))
+        const double* control = piece.Curve.Segment(j);
+        if (!this->MayHoldItems(control))
         {
           continue;
         }
+        double leg = 0;
+        for (int c = 0; c < 3; ++c)
+        {
+          leg = std::max(leg, std::hypot(control[2 * c + 2] - control[2 * c], control[2 * c + 3] - control[2 * c + 1]));
+        }
+        // (The curves lie in the domain: at most about 50 samples per side of its diameter.)
+        const int perSegment = static_cast<int>(
+          std::clamp(std::ceil(SamplesPerSide * 3 * leg / this->Side), static_cast<double>(SamplesPerSegment), 1e8));
         for (int m = 0; m <= perSegment; ++m)
         {
           const double s = static_cast<double>(m) / perSegment;
@@ -358,9 +373,10 @@ private:
 };
 } // namespace
 
-// The smoothed curves, sampled finely enough that the nearest sample is within a few percent of
-// `side` of the nearest curve point, with their heights, in square buckets of side `side`: the
-// samples within `side` of a point lie in its bucket or the 8 around it.
+// The smoothed curves, sampled finely enough that the nearest sample is within 1/32 of `side` of
+// the nearest curve point (BucketIndex::ForEachSampleInBuckets), with their heights, in square
+// buckets of side `side`: the samples within `side` of a point lie in its bucket or the 8 around
+// it.
 OneCellSamples::OneCellSamples(const OneCellSmoothingResult& smoothed, double side, const std::vector<double>& around)
   : Side(side > 0 ? side : 1.0)
 {

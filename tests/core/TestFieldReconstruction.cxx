@@ -730,8 +730,8 @@ TEST_CASE(SpuriousPointsAreCountedNearAndFarFromTheOneCells)
   piece.Curve.ControlPoints = { 0, 0, 10, 0, 20, 0, 30, 0 };
   smoothed.Pieces.push_back(piece);
   std::vector<CriticalPointLocation> points;
-  // (The curve is sampled 16 times per Bezier segment: the test distances stay clear of 2 by more
-  // than the sampling error.)
+  // (The curve is sampled at most 1/8 apart, 16 samples per side 2 of the buckets: the test
+  // distances stay clear of 2 by more than the sampling error.)
   for (const auto& xy : { std::array<double, 2>{ 5, 0.5 }, { 12, -1.5 }, { 29, 2.5 }, { 15, 5 }, { -1.5, 0 },
          { 33, 0 }, { -40, 7 } })
   {
@@ -751,9 +751,11 @@ TEST_CASE(SpuriousPointsAreCountedNearAndFarFromTheOneCells)
 TEST_CASE(CountsNearOneCellsMatchExactDistancesOnManySegments)
 {
   // A random walk of 200 straight segments of length 1.6 (16 samples each: 0.1 apart) and one
-  // diagonal segment 18 x 18 (its bounding box spans more than 64 buckets of side 2; samples
-  // 1.6 apart, the nearest within 0.8 of the curve), against the exact distance to the
-  // segments computed here; points within 0.85 of the threshold 2 are left out.
+  // diagonal segment 18 x 18 (its bounding box spans more than 64 buckets of side 2; 16 samples
+  // would be 1.6 apart, the nearest up to 0.8 from the curve: it gets 16 per side 2 along it),
+  // against the exact distance to the segments computed here; points within 0.01 of the
+  // threshold 2 are left out (the nearest sample within 1/16 of the nearest curve point moves a
+  // distance of 2 by at most 0.001).
   std::mt19937 random(20261203);
   std::uniform_real_distribution<double> angle(0, 2 * 3.14159265358979), coordinate(0, 1);
   OneCellSmoothingResult smoothed;
@@ -806,7 +808,7 @@ TEST_CASE(CountsNearOneCellsMatchExactDistancesOnManySegments)
       point.Position[1] = y - 40 + 80 * coordinate(random);
     }
     const double d = exactDistance(point.Position[0], point.Position[1]);
-    if (std::abs(d - 2) < 0.85)
+    if (std::abs(d - 2) < 0.01)
     {
       continue;
     }
@@ -836,6 +838,43 @@ TEST_CASE(CountsNearOneCellsMatchExactDistancesOnManySegments)
     CountByDistanceToOneCells(points, smoothed, 2.0, near, far, parallel);
     CHECK_EQ(near, expectedNear);
     CHECK_EQ(far, static_cast<Index>(points.size()) - expectedNear);
+  }
+}
+
+TEST_CASE(LongSegmentsAreSampledFinelyEnoughForTheirNeighbours)
+{
+  // One straight Bezier segment 300 long (a large terrain's 1-cell), its height rising from 0 to
+  // 3 along it, and points within one side (1) of it between where 16 samples per segment would
+  // lie (18.75 apart): each is counted near, and the nearest sample found for it is within 1/32
+  // of the nearest curve point, so its height within 3 / 300 / 32 of that point's.
+  OneCellSmoothingResult smoothed;
+  SmoothedPiece piece;
+  piece.Curve.Segments = piece.Height.Segments = 1;
+  piece.Curve.Dimension = 2;
+  piece.Height.Dimension = 1;
+  piece.Curve.ControlPoints = { 0, 0, 100, 0, 200, 0, 300, 0 };
+  piece.Height.ControlPoints = { 0, 1, 2, 3 };
+  smoothed.Pieces.push_back(piece);
+  std::vector<CriticalPointLocation> points;
+  std::vector<double> around;
+  for (int i = 0; i < 50; ++i)
+  {
+    CriticalPointLocation point;
+    point.Position[0] = 9.375 + 18.75 * (i % 16) + 0.01 * i;
+    point.Position[1] = (i % 2 ? 0.9 : -0.9) * (1 - 0.01 * i);
+    points.push_back(point);
+    around.insert(around.end(), point.Position, point.Position + 2);
+  }
+  Index near = -1, far = -1;
+  CountByDistanceToOneCells(points, smoothed, 1.0, near, far);
+  CHECK_EQ(near, 50);
+  CHECK_EQ(far, 0);
+  const OneCellSamples samples(smoothed, 1.0, around);
+  for (const CriticalPointLocation& point : points)
+  {
+    double height = -1;
+    CHECK(samples.Nearest(point.Position[0], point.Position[1], 1.0, height));
+    CHECK(std::abs(height - point.Position[0] / 100) <= 3.0 / 300 / 32 + 1e-12);
   }
 }
 
