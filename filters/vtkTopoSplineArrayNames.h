@@ -145,6 +145,7 @@ constexpr const char* RefinedCells = "RefinedCells";
 constexpr const char* StiffenedCells = "StiffenedCells";
 constexpr const char* OrderedCells = "OrderedCells";
 constexpr const char* RemappedCells = "RemappedCells";
+constexpr const char* AxisFreeCells = "AxisFreeCells";
 constexpr const char* SnappedPoints = "SnappedPoints";
 constexpr const char* PointsOnOneCells = "PointsOnOneCells";
 constexpr const char* UnreconstructedPoints = "UnreconstructedPoints";

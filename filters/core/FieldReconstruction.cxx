@@ -531,6 +531,7 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
   this->Cells.Mesh = &mesh; // for the stiffening rounds: which vertices are neighbours
   this->Cells.StiffeningRounds = this->StiffeningRounds;
   this->Cells.OrderingRounds = this->OrderingRounds;
+  this->Cells.AxisAimTrigger = this->AxisAimTrigger;
   const bool reconstructed = this->Cells.Reconstruct(complex, smoothed, error, &field);
   this->Cells.Mesh = nullptr; // a local
   if (!reconstructed)

@@ -104,6 +104,10 @@ public:
   int StiffeningRounds = 5;
   // Then the ordering rounds of the points left (TwoCellReconstruction::OrderingRounds; 0: none).
   int OrderingRounds = 4;
+  // Fitted interiors: cells whose fit misses by more than this times SurfaceTolerance are fitted
+  // again without the aim at F rising along u and v (TwoCellReconstruction::AxisAimTrigger; <= 0:
+  // never).
+  double AxisAimTrigger = 5;
   bool TopologicalSampling = true;
   bool VerifyTopology = true;
   double MemoryBudget = 0; // bytes for the 2-cells' surfaces (TwoCellReconstruction::MemoryBudget)

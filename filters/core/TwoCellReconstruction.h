@@ -136,6 +136,7 @@ struct TwoCellReconstructionReport
   Index StiffenedCells = 0;    // of them, cells whose fit was stiffened (StiffeningRounds)
   Index OrderedCells = 0;      // of them, cells whose fit orders samples around critical points (OrderingRounds)
   Index RemappedCells = 0;     // of them, cells fitted on an alternative map (AlternativeMapStrength)
+  Index AxisFreeCells = 0;     // of them, cells whose fit no longer aims at F rising along u and v (AxisAimTrigger)
   Index MeshTriangles = 0;     // triangles of all cell meshes
   Index CrowdedTriangles = 0;  // of them, flattened in (u, v) by rounding (TwoCellMesh::CrowdedTriangles)
   Index BezierTriangles = 0;   // 4 N^2 per cell
@@ -247,6 +248,18 @@ public:
   // the cell's sample range per unit of the square (OrderWhereSamplingBreaks; 0 rounds: none).
   int OrderingRounds = 4;
   double OrderingSlope = 0.005;
+  // Fitted interiors, given the input's mesh: the fit aims at F rising along u and along v
+  // (MonotoneSurfaceFitOptions::IncreasingAlongAxes), which keeps the data's noise from putting
+  // troughs and ridges across a cell. Where the data itself falls across the square, from one
+  // side to the opposite one (a 1-cell lower than the 1-cell facing it across a narrow cell:
+  // on an integer DEM's plateaus stage 1 can route a ridge along the foot of a slope), that aim
+  // holds the whole cell above the data. A cell whose fit misses by more than this times
+  // SurfaceTolerance is fitted again without it, from the fit it has (F still rises along
+  // (1, 1), which is what the guarantee needs), and keeps that fit if its largest residual falls
+  // below AlternativeMapGain times the one before, its RMS residual does not grow, and it has no
+  // more critical vertices two rings inside the cell (those of the stiffening); the stiffening
+  // and ordering rounds then keep the aim off for that cell. <= 0: never.
+  double AxisAimTrigger = 5;
   // Bytes the Sibson surfaces and their Bezier patches may take (<= 0: no limit). Checked
   // after the parameterization, when every cell's grid size N is known and before any surface
   // is built: the patches grow with the square of a cell's busiest side (4 N^2 triangles),
@@ -330,18 +343,25 @@ private:
   // Fits the cell's interior, refining its grid (see SurfaceTolerance); returns whether refined.
   bool FitSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided,
     const std::vector<SurfaceSample>& samples) const;
-  // The stiffening rounds (see StiffeningRounds), then the ordering rounds (OrderingRounds), of
-  // a cell whose samples are those of `vertices` (ringInCell: per input vertex, whether it and
-  // its ring of neighbours lie inside its cell). Returns which kind of fit was kept (0: the
-  // first): StiffenedFit, OrderedFit or both.
+  // The fit released from the aim at F rising along u and v where it misses most
+  // (AxisAimTrigger), then the stiffening rounds (see StiffeningRounds), then the ordering
+  // rounds (OrderingRounds), of a cell whose samples are those of `vertices` (ringInCell: per
+  // input vertex, whether it and its ring of neighbours lie inside its cell). Returns which kind
+  // of fit was kept (0: the first): AxisFreeFit, StiffenedFit, OrderedFit, or several.
   enum
   {
     StiffenedFit = 1,
-    OrderedFit = 2
+    OrderedFit = 2,
+    AxisFreeFit = 4
   };
   class DeepCriticalVertices;
   int StiffenWhereSamplingBreaks(ReconstructedTwoCell& cell, const std::vector<SurfaceSample>& samples,
     const Index* vertices, const std::vector<char>& ringInCell) const;
+  // The fit of a cell that misses by more than AxisAimTrigger x SurfaceTolerance, tried again
+  // without the aim at F rising along u and v; returns whether it was kept (`options` is then
+  // without that aim).
+  bool ReleaseAxisAim(ReconstructedTwoCell& cell, const std::vector<SurfaceSample>& samples,
+    DeepCriticalVertices& deep, MonotoneSurfaceFitOptions& options) const;
   // The ordering rounds from `first` with the kept stiffening's options; returns whether an
   // ordered fit was kept.
   bool OrderWhereSamplingBreaks(ReconstructedTwoCell& cell, const MonotoneSibsonSurface& first,

@@ -10,7 +10,8 @@ must still miss). On a 48 x 48 noise field whose boundary saddle's only way into
 runs through a wanted minimum, the sampling must want that saddle one step along the boundary,
 report it, and verify at the input's vertices and at 4x. Printed for the
 record: the counts before topological sampling, how far it moved values, and the L-infinity and
-RMS errors."""
+RMS errors. Issue 15's RMS target (1.5 % of the range) is asserted on every catalog DEM at 2 and
+5 %, on a seeded random crop of each DEM shipped here and on a Maunga Whau crop that missed it."""
 import os
 
 import numpy as np
@@ -155,6 +156,9 @@ for name, source in inputs:
             print("%s: %d critical points, L-inf error %.4g (%.2f%% of range), RMS %.4g (%.3f%%), %d Bezier triangles"
                   % (label, len(c["cp_VertexId"]), linf, 100 * linf / field_range, rms, 100 * rms / field_range,
                      triangles), flush=True)
+            if name.endswith(".vti") and percent in (2, 5):
+                # Issue 15's target for every catalog DEM at 2 and 5 %: RMS within 1.5 % of the range.
+                checks.check(rms <= 0.015 * field_range, "%s: RMS %.3f %% of the range <= 1.5 %%" % (label, 100 * rms / field_range))
             Delete(reconstruct)
             Delete(smooth)
         Delete(simplified)
@@ -223,6 +227,52 @@ for seed in (7, 8):
     print("alternative maps, Shepard seed %d at 5 %%: largest miss of ReconstructedExact %.2f -> %.2f %% of the range" % (
         seed, 100 * misses[0], 100 * misses[30]), flush=True)
 checks.check(lowered >= 1, "alternative maps lower the largest miss on Shepard seed 7 or 8 (%d)" % lowered)
+
+# Terrain windows (issue 15's RMS target, 1.5 % of the range at 2 and 5 %, on crops nothing was
+# tuned on): seeded random crops of the DEMs shipped here, and the Maunga Whau crop whose integer
+# plateaus put a ridge at the foot of a slope, below the valley across a narrow cell, where the
+# fit's aim at F rising along u and v held the cell a fifth of the range above the data (RMS
+# 3.7 %) until that aim was released there (docs/Reconstruction.md, "The axis aim released").
+# The RMS is recomputed here from Reconstructed and the crop's own values.
+def crop_rms(values, percent):
+    producer = TrivialProducer()
+    producer.GetClientSideObject().SetOutput(tt.image_data(values))
+    smooth = Smooth1Cells(Input=SimplifyMorseSmaleComplex(Input=MorseSmaleComplex(Input=producer, ScalarField=["POINTS", "f"]),
+                                                          PersistenceThreshold=percent))
+    out = sm.Fetch(Reconstruct2Cells(Input=smooth))
+    reconstructed = vtk_to_numpy(out.GetPointData().GetArray("Reconstructed"))
+    rms = np.sqrt(np.mean((reconstructed - values.ravel()) ** 2)) / (values.max() - values.min())
+    return rms, out.GetFieldData()
+
+
+def dem(name):
+    reader = XMLImageDataReader(FileName=[tt.find_dataset(name)])
+    image = sm.Fetch(reader)
+    nx, ny, _ = image.GetDimensions()
+    array = image.GetPointData().GetScalars() or image.GetPointData().GetArray(0)
+    return np.array(vtk_to_numpy(array), dtype=np.float64).reshape(ny, nx)
+
+
+if tt.find_dataset("r_volcano_maunga_whau.vti"):
+    rms, fd = crop_rms(dem("r_volcano_maunga_whau.vti")[0:61, 11:86].copy(), 2)
+    checks.check(rms <= 0.015, "Maunga Whau crop i0 11 j0 0 75 x 61 at 2 %%: RMS %.3f %% of the range <= 1.5 %%" % (100 * rms))
+    checks.check((tt.field_value(fd, "AxisFreeCells") or 0) >= 1, "Maunga Whau crop: the released cell is reported")
+    checks.equal(tt.field_value(fd, "TopologyVerified"), 1, "Maunga Whau crop: verdict")
+    print("Maunga Whau crop at 2 %%: RMS %.3f %% of the range, %d cells without the axis aim" % (
+        100 * rms, tt.field_value(fd, "AxisFreeCells")), flush=True)
+random_ = np.random.default_rng(20261206)
+shipped = [n for n in ("r_volcano_maunga_whau.vti", "rainier_ned1_1970_crop458x306.vti", "sainthelens_usgs_dem_crop.vti",
+                       "msh_crater_2007_10m.vti") if tt.find_dataset(n)]
+for name in shipped:
+    values = dem(name)
+    ny, nx = values.shape
+    w, h = int(random_.integers(min(48, nx), min(160, nx) + 1)), int(random_.integers(min(48, ny), min(160, ny) + 1))
+    i0, j0 = int(random_.integers(0, nx - w + 1)), int(random_.integers(0, ny - h + 1))
+    for percent in (2, 5):
+        rms, fd = crop_rms(values[j0:j0 + h, i0:i0 + w].copy(), percent)
+        label = "%s crop i0 %d j0 %d %d x %d at %d %%" % (name, i0, j0, w, h, percent)
+        checks.check(rms <= 0.015, "%s: RMS %.3f %% of the range <= 1.5 %%" % (label, 100 * rms))
+        print("%s: RMS %.3f %% of the range, verdict %d" % (label, 100 * rms, tt.field_value(fd, "TopologyVerified")), flush=True)
 
 # The ordering rounds after the stiffening (docs/Reconstruction.md, "Critical points the
 # stiffening leaves, ordered away") are reported in field data: cells whose kept fit orders
