@@ -116,7 +116,8 @@ struct MonotoneSurfaceFitOptions
   // less.
   double MarginFraction = 0.02;
   // Also aim at p >= 0 and q >= 0 (F increasing along u and v, as its sides are), not enforced
-  // exactly (see FitToSamples).
+  // exactly (see FitToSamples); TwoCellReconstruction::AxisAimTrigger turns it off in the cells
+  // it holds off the data.
   bool IncreasingAlongAxes = true;
   // Spots of the square where an earlier fit, sampled at the input vertices, had a critical
   // point that no node of the complex explains (TwoCellReconstruction's stiffening): the
