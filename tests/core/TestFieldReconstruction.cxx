@@ -572,6 +572,26 @@ struct CellByCell
   double Largest[2] = { 0, 0 }, Reconstructed[2] = { 0, 0 };
 };
 
+// p's complex reconstructed twice, without the stiffening and ordering rounds (which would move
+// both runs' fits apart), `set` setting each run apart; each verified, and each vertex given by
+// the same cell in both.
+void ReconstructTwice(
+  const Pipeline& p, const std::function<void(FieldReconstruction&, int run)>& set, FieldReconstructionReport reports[2])
+{
+  for (int run = 0; run < 2; ++run)
+  {
+    FieldReconstruction reconstruction;
+    reconstruction.Parallel = ThreadedFor;
+    reconstruction.StiffeningRounds = 0;
+    reconstruction.OrderingRounds = 0;
+    set(reconstruction, run);
+    std::string error;
+    CHECK(reconstruction.Run(p.Field, p.Simplified.Complex, p.Smoothed, reports[run], error));
+    CHECK(reports[run].Verified);
+  }
+  CHECK(reports[0].CellOfVertex == reports[1].CellOfVertex);
+}
+
 CellByCell CompareCellByCell(const Pipeline& p, const FieldReconstructionReport reports[2])
 {
   const std::size_t cells = p.Simplified.Complex.TwoCells.size();
@@ -621,19 +641,11 @@ TEST_CASE(AlternativeMapsLowerOnlyTheLargestMisses)
     std::string error;
     CHECK(RunStages1To3(shepard, 5, 4, p, error));
     FieldReconstructionReport reports[2];
-    for (int alternative = 0; alternative < 2; ++alternative)
-    {
-      FieldReconstruction reconstruction;
-      reconstruction.Parallel = ThreadedFor;
-      reconstruction.StiffeningRounds = 0;
-      reconstruction.OrderingRounds = 0;
-      reconstruction.AlternativeMapStrength = alternative ? 30 : 0;
+    ReconstructTwice(p, [](FieldReconstruction& reconstruction, int run) {
+      reconstruction.AlternativeMapStrength = run ? 30 : 0;
       reconstruction.AxisAimTrigger = 0; // its own test below
-      CHECK(reconstruction.Run(p.Field, p.Simplified.Complex, p.Smoothed, reports[alternative], error));
-      CHECK(reports[alternative].Verified);
-    }
+    }, reports);
     CHECK(reports[0].Cells.RemappedCells == 0);
-    CHECK(reports[0].CellOfVertex == reports[1].CellOfVertex);
     const CellByCell compared = CompareCellByCell(p, reports);
     int changedCells = 0;
     bool onlyLower = true;
@@ -680,19 +692,11 @@ TEST_CASE(TheAxisAimIsReleasedOnlyWhereItHoldsACellOffTheData)
     std::string error;
     CHECK(RunStages1To3(shepard, percent, 4, p, error));
     FieldReconstructionReport reports[2];
-    for (int on = 0; on < 2; ++on)
-    {
-      FieldReconstruction reconstruction;
-      reconstruction.Parallel = ThreadedFor;
-      reconstruction.StiffeningRounds = 0;
-      reconstruction.OrderingRounds = 0;
+    ReconstructTwice(p, [](FieldReconstruction& reconstruction, int run) {
       reconstruction.AlternativeMapStrength = 0;
-      reconstruction.AxisAimTrigger = on ? 5 : 0;
-      CHECK(reconstruction.Run(p.Field, p.Simplified.Complex, p.Smoothed, reports[on], error));
-      CHECK(reports[on].Verified);
-    }
+      reconstruction.AxisAimTrigger = run ? 5 : 0;
+    }, reports);
     CHECK(reports[0].Cells.AxisFreeCells == 0);
-    CHECK(reports[0].CellOfVertex == reports[1].CellOfVertex);
     const CellByCell compared = CompareCellByCell(p, reports);
     const double* largest = compared.Largest;
     int changedCells = 0;
