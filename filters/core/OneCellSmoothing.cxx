@@ -2137,16 +2137,23 @@ bool OneCellSmoothing::FitAllPieces(
       return false;
     }
   }
+  std::vector<Index> all(static_cast<std::size_t>(count));
+  std::iota(all.begin(), all.end(), 0);
+  return this->RefineMissedHeights(result, std::move(all), domainBounds, error);
+}
+
+bool OneCellSmoothing::RefineMissedHeights(
+  OneCellSmoothingResult& result, std::vector<Index> pieces, const double domainBounds[4], std::string& error) const
+{
   // Pieces whose height misses a sample by more than the simplification's threshold get twice
   // their segments (twice at most): the user simplifies to remove features smaller than that,
   // not to move the 1-cells off the data by more (a long valley of the Shepard field that falls
   // steeply then flattens still missed its samples by 10 % of the range with knots that follow
   // the rise).
-  std::set<Index> refined;
   for (int round = 0; round < 2 && this->HeightTolerance > 0; ++round)
   {
     std::vector<Index> missing;
-    for (Index p = 0; p < count; ++p)
+    for (const Index p : pieces)
     {
       const SmoothedPiece& piece = result.Pieces[p];
       const int raised = RaisedSegments(piece.Segments, this->Segments);
@@ -2166,9 +2173,12 @@ bool OneCellSmoothing::FitAllPieces(
     {
       return false;
     }
-    refined.insert(missing.begin(), missing.end());
+    for (const Index p : missing)
+    {
+      result.Pieces[p].HeightRefined = true;
+    }
+    pieces = std::move(missing);
   }
-  result.RefinedPieces = static_cast<int>(refined.size());
   return true;
 }
 
@@ -2224,8 +2234,12 @@ bool OneCellSmoothing::RepairCrossings(
     }
     if (!even.empty())
     {
+      // Uniform knots can miss the heights that the rise knots followed (a ridge that climbs
+      // slowly, then steeply: Shepard seed 20 at 5 %, 2.3 times the threshold along 15
+      // spacings), so those pieces are refined again as in FitAllPieces.
       if (!this->FitInParallel(
-            result, even, [](const SmoothedPiece& piece) { return piece.Segments; }, domainBounds, error))
+            result, even, [](const SmoothedPiece& piece) { return piece.Segments; }, domainBounds, error) ||
+        !this->RefineMissedHeights(result, even, domainBounds, error))
       {
         return false;
       }
@@ -2276,6 +2290,8 @@ bool OneCellSmoothing::RepairCrossings(
     pairs = detector.UpdateCrossings(changed, crossing);
   }
   result.AdaptedPieces = static_cast<int>(adapted.size());
+  result.RefinedPieces = static_cast<int>(std::count_if(result.Pieces.begin(), result.Pieces.end(),
+    [](const SmoothedPiece& piece) { return piece.HeightRefined; }));
   result.RiseKnotPieces = static_cast<int>(std::count_if(result.Pieces.begin(), result.Pieces.end(),
     [](const SmoothedPiece& piece) { return piece.RiseKnots; }));
   result.CurveHeightPieces = static_cast<int>(std::count_if(result.Pieces.begin(), result.Pieces.end(),

@@ -50,6 +50,7 @@ struct SmoothedPiece
   double UnconstrainedL1Error = 0; // the same fit without monotonicity, for comparison
   bool Clamped = false;            // control points were clamped into the domain's box
   bool HeightAlongCurve = false;   // Height fits the field sampled along Curve, not Values (see FieldAt)
+  bool HeightRefined = false;      // k was raised because the height missed (HeightTolerance)
 };
 
 struct OneCellSmoothingResult
@@ -153,7 +154,12 @@ private:
     OneCellSmoothingResult& result, std::string& error) const;
   // Steps 2 and 3 on every piece with k = Segments (fewer on pieces of fewer edges).
   bool FitAllPieces(OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const;
-  // Raises k on crossing pieces and fits them again (sets AdaptedPieces, RiseKnotPieces, RemainingCrossings).
+  // Raises k (twice at most) on the listed pieces whose height misses by more than
+  // HeightTolerance, and fits them again.
+  bool RefineMissedHeights(OneCellSmoothingResult& result, std::vector<Index> pieces, const double domainBounds[4],
+    std::string& error) const;
+  // Raises k on crossing pieces and fits them again (sets AdaptedPieces, RefinedPieces,
+  // RiseKnotPieces, RemainingCrossings).
   bool RepairCrossings(OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const;
   // Fits the listed pieces in parallel, each with segmentsOf(piece) segments; false with the
   // first failing piece in list order named in `error`.
