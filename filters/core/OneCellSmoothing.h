@@ -92,8 +92,8 @@ public:
   int SamplesPerSegment = 8;
   // A piece whose height misses a sample by more than this (in the field's units; 0: never;
   // the filter passes the simplification's absolute persistence threshold) gets twice its
-  // segments, twice at most, up to MaximumHeightSegments and while it keeps 3 samples per
-  // segment.
+  // segments, twice at most, up to MaximumHeightSegments (twice that where it misses by more
+  // than twice this) and while it keeps 3 samples per segment.
   double HeightTolerance = 0;
   // A quarter of stage 4's fitted-grid limit (TwoCellReconstruction::MaximumFittedGridSize):
   // a cell's grid is a common count of its sides, each the sum of its pieces' counts, and
@@ -101,6 +101,13 @@ public:
   // doubled to 14 made grids of 84 and a cell 24 % of the range off; fitting those instead
   // took the crop from 0.87 to 1.44 s).
   int MaximumHeightSegments = 12;
+  // A piece refined past MaximumHeightSegments keeps the sum of the segments of every 1-cell
+  // through it (a side of the 2-cells that 1-cell bounds) within this: half of stage 4's
+  // fitted-grid limit (TwoCellReconstruction::MaximumFittedGridSize), since a cell's grid is a
+  // count all four sides reach by whole multiples of their pieces' counts and can lie well above
+  // its longest side (sides within 48 made grids of 66 on a Rainier crop at 0.5 %, k = 6, and two
+  // cells lost their fitted interiors).
+  int MaximumSideSegments = 24;
   // A piece's knots follow its rise as well as its length (MonotoneBSplineFit::ArcLengthAndRise)
   // where its height then fits better and its planar curve stays this close to the path
   // (working-frame units, about grid spacings) or not much farther than with knots uniform in

@@ -1409,7 +1409,8 @@ bool TwoCellReconstruction::ReleaseAxisAim(ReconstructedTwoCell& cell, const std
   if (!trial.FitToSamples(samples, message, free) || !trial.FitReport().Fitted ||
     trial.FitReport().MaximumResidual >= AlternativeMapGain * fitted.MaximumResidual ||
     trial.FitReport().RMSResidual > fitted.RMSResidual ||
-    deep.Find(trial).size() > deep.Find(cell.Surface).size())
+    (trial.FitReport().RMSResidual >= AxisAimRMSGain * fitted.RMSResidual &&
+      deep.Find(trial).size() > deep.Find(cell.Surface).size()))
   {
     return false;
   }

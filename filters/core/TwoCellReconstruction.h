@@ -257,9 +257,13 @@ public:
   // SurfaceTolerance is fitted again without it, from the fit it has (F still rises along
   // (1, 1), which is what the guarantee needs), and keeps that fit if its largest residual falls
   // below AlternativeMapGain times the one before, its RMS residual does not grow, and it has no
-  // more critical vertices two rings inside the cell (those of the stiffening); the stiffening
+  // more critical vertices two rings inside the cell (those of the stiffening) unless its RMS
+  // residual falls below AxisAimRMSGain times the one before (a cell held 16 m off the data of a
+  // Maunga Whau crop, RMS 8.7 % of the range, whose free fit has 0.7 % and 3 such points: the
+  // data is worth more than points that topological sampling settles anyway); the stiffening
   // and ordering rounds then keep the aim off for that cell. <= 0: never.
   double AxisAimTrigger = 5;
+  static constexpr double AxisAimRMSGain = 0.5;
   // Bytes the Sibson surfaces and their Bezier patches may take (<= 0: no limit). Checked
   // after the parameterization, when every cell's grid size N is known and before any surface
   // is built: the patches grow with the square of a cell's busiest side (4 N^2 triangles),

@@ -253,13 +253,18 @@ def dem(name):
     return np.array(vtk_to_numpy(array), dtype=np.float64).reshape(ny, nx)
 
 
+# At 5 % the same cell's free fit misses by a sixth as much (RMS 0.7 % of the range against 8.7 %)
+# but has 3 critical points more deep inside, which the release refused until a release that
+# halves the RMS is kept regardless ("The axis aim released").
 if tt.find_dataset("r_volcano_maunga_whau.vti"):
-    rms, fd = crop_rms(dem("r_volcano_maunga_whau.vti")[0:61, 11:86].copy(), 2)
-    checks.check(rms <= 0.015, "Maunga Whau crop i0 11 j0 0 75 x 61 at 2 %%: RMS %.3f %% of the range <= 1.5 %%" % (100 * rms))
-    checks.check((tt.field_value(fd, "AxisFreeCells") or 0) >= 1, "Maunga Whau crop: the released cell is reported")
-    checks.equal(tt.field_value(fd, "TopologyVerified"), 1, "Maunga Whau crop: verdict")
-    print("Maunga Whau crop at 2 %%: RMS %.3f %% of the range, %d cells without the axis aim" % (
-        100 * rms, tt.field_value(fd, "AxisFreeCells")), flush=True)
+    for percent in (2, 5):
+        rms, fd = crop_rms(dem("r_volcano_maunga_whau.vti")[0:61, 11:86].copy(), percent)
+        label = "Maunga Whau crop i0 11 j0 0 75 x 61 at %d %%" % percent
+        checks.check(rms <= 0.015, "%s: RMS %.3f %% of the range <= 1.5 %%" % (label, 100 * rms))
+        checks.check((tt.field_value(fd, "AxisFreeCells") or 0) >= 1, "%s: the released cell is reported" % label)
+        checks.equal(tt.field_value(fd, "TopologyVerified"), 1, "%s: verdict" % label)
+        print("%s: RMS %.3f %% of the range, %d cells without the axis aim" % (
+            label, 100 * rms, tt.field_value(fd, "AxisFreeCells")), flush=True)
 random_ = np.random.default_rng(20261206)
 shipped = [n for n in ("r_volcano_maunga_whau.vti", "rainier_ned1_1970_crop458x306.vti", "sainthelens_usgs_dem_crop.vti",
                        "msh_crater_2007_10m.vti") if tt.find_dataset(n)]
