@@ -400,6 +400,22 @@ TEST_CASE(RaisedCountsKeepACommonGridPerCell)
   CHECK(beyond == 0);
 }
 
+namespace
+{
+// The largest |height - sample| over a piece's interior samples, from its Bezier height.
+double LargestMissOfOwnSamples(const SmoothedPiece& piece)
+{
+  double miss = 0;
+  for (std::size_t i = 1; i + 1 < piece.Values.size(); ++i)
+  {
+    double h = 0;
+    piece.Height.Evaluate(piece.Parameters[i], &h);
+    miss = std::max(miss, std::abs(h - piece.Values[i]));
+  }
+  return miss;
+}
+} // namespace
+
 //------------------------------------------------------------------------------
 // Merged 1-cells share their pieces: two 1-cells that run through the same mesh cells are cut
 // at the junction where they meet, so no two pieces run along one stretch (such pieces cross
@@ -424,17 +440,11 @@ TEST_CASE(PiecesThatMissTheDataGetMoreSegments)
       int count = 0;
       for (const SmoothedPiece& piece : result.Pieces)
       {
-        double miss = 0;
-        for (std::size_t i = 1; i + 1 < piece.Values.size(); ++i)
-        {
-          double h = 0;
-          piece.Height.Evaluate(piece.Parameters[i], &h);
-          miss = std::max(miss, std::abs(h - piece.Values[i]));
-        }
+        const double miss = LargestMissOfOwnSamples(piece);
         count += miss > tolerance ? 1 : 0;
         const bool room = static_cast<int>(piece.Values.size()) > 3 * 8;
         unrefined += refined && miss > tolerance && room && piece.Segments < 8 ? 1 : 0;
-        CHECK(piece.Segments <= 12 || !refined);
+        CHECK(piece.Segments <= 24 || !refined); // 12, or 24 where it missed by more than 2 eps
       }
       return count;
     };
@@ -555,13 +565,7 @@ TEST_CASE(PiecesStillMissingAfterTheCrossingRepairGetMoreSegments)
     CHECK(smoothing.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, result, error));
     for (const SmoothedPiece& piece : result.Pieces)
     {
-      double miss = 0;
-      for (std::size_t i = 1; i + 1 < piece.Values.size(); ++i)
-      {
-        double h = 0;
-        piece.Height.Evaluate(piece.Parameters[i], &h);
-        miss = std::max(miss, std::abs(h - piece.Values[i]));
-      }
+      const double miss = LargestMissOfOwnSamples(piece);
       if (miss <= eps || piece.HeightAlongCurve)
       {
         continue;
