@@ -499,6 +499,28 @@ DeepCriticalPoints CountDeepCriticalPoints(const GridField& field, const Pipelin
   count.OrderedCells = report.Cells.OrderedCells;
   return count;
 }
+
+// Shepard 150^2 fields (40 sites, mu = 2) of seeds [first, last) through stages 1-3 (k = 4), each
+// at percentOf(seed): body(seed, percent, field, pipeline).
+void ForShepardFields150(std::uint64_t first, std::uint64_t last, const std::function<int(std::uint64_t)>& percentOf,
+  const std::function<void(std::uint64_t, int, const GridField&, Pipeline&)>& body)
+{
+  for (std::uint64_t seed = first; seed < last; ++seed)
+  {
+    const GridField shepard = ShepardField(40, 2.0, 150, seed);
+    const int percent = percentOf(seed);
+    Pipeline p;
+    std::string error;
+    CHECK(RunStages1To3(shepard, percent, 4, p, error));
+    body(seed, percent, shepard, p);
+  }
+}
+
+// Odd seeds at 5 %, even ones at 25 %.
+int FiveOrTwentyFive(std::uint64_t seed)
+{
+  return seed % 2 ? 5 : 25;
+}
 } // namespace
 
 TEST_CASE(StiffeningTakesCrestsOutOfTheCells)
@@ -508,12 +530,7 @@ TEST_CASE(StiffeningTakesCrestsOutOfTheCells)
   // critical points deep inside the cell. The stiffening rounds widen such crests: F o Phi at
   // the vertices has far fewer critical points deep inside the cells, at a small cost in RMS.
   int before = 0, after = 0;
-  for (std::uint64_t seed : { 0, 1, 2, 3 })
-  {
-    const GridField shepard = ShepardField(40, 2.0, 150, seed);
-    Pipeline p;
-    std::string error;
-    CHECK(RunStages1To3(shepard, 25, 4, p, error));
+  ForShepardFields150(0, 4, [](std::uint64_t) { return 25; }, [&](std::uint64_t seed, int, const GridField& shepard, Pipeline& p) {
     const DeepCriticalPoints plain = CountDeepCriticalPoints(shepard, p, 0, 0);
     const DeepCriticalPoints stiffened = CountDeepCriticalPoints(shepard, p, 5, 0);
     CHECK(plain.StiffenedCells == 0);
@@ -525,7 +542,7 @@ TEST_CASE(StiffeningTakesCrestsOutOfTheCells)
     CHECK(stiffened.RMS <= 1.15 * plain.RMS);
     before += plain.Deep;
     after += stiffened.Deep;
-  }
+  });
   CHECK(before > 0);
   CHECK(2 * after <= before);
 }
@@ -537,13 +554,7 @@ TEST_CASE(OrderingTakesOutWhatStiffeningLeaves)
   // critical points deep inside the cells, none more on any field, for about the same RMS.
   // Shepard fields nothing was tuned on (seeds 40-43), at 25 % and 5 %.
   int before = 0, after = 0;
-  for (std::uint64_t seed = 40; seed < 44; ++seed)
-  {
-    const GridField shepard = ShepardField(40, 2.0, 150, seed);
-    const int percent = seed % 2 ? 5 : 25;
-    Pipeline p;
-    std::string error;
-    CHECK(RunStages1To3(shepard, percent, 4, p, error));
+  ForShepardFields150(40, 44, FiveOrTwentyFive, [&](std::uint64_t seed, int percent, const GridField& shepard, Pipeline& p) {
     const DeepCriticalPoints stiffened = CountDeepCriticalPoints(shepard, p, 5, 0);
     const DeepCriticalPoints ordered = CountDeepCriticalPoints(shepard, p, 5, 4);
     CHECK(stiffened.OrderedCells == 0);
@@ -555,7 +566,7 @@ TEST_CASE(OrderingTakesOutWhatStiffeningLeaves)
     CHECK(ordered.RMS <= 1.05 * stiffened.RMS);
     before += stiffened.Deep;
     after += ordered.Deep;
-  }
+  });
   CHECK(before > 0);
   CHECK(after < before);
 }
@@ -684,13 +695,7 @@ TEST_CASE(TheAxisAimIsReleasedOnlyWhereItHoldsACellOffTheData)
   // cells (this test's own count) do not grow in all. Shepard fields nothing was tuned on
   // (seeds 80-91) at 5 and 25 %.
   int released = 0, lowered = 0, deepBefore = 0, deepAfter = 0;
-  for (std::uint64_t seed = 80; seed < 92; ++seed)
-  {
-    const GridField shepard = ShepardField(40, 2.0, 150, seed);
-    const int percent = seed % 2 ? 5 : 25;
-    Pipeline p;
-    std::string error;
-    CHECK(RunStages1To3(shepard, percent, 4, p, error));
+  ForShepardFields150(80, 92, FiveOrTwentyFive, [&](std::uint64_t seed, int percent, const GridField& shepard, Pipeline& p) {
     FieldReconstructionReport reports[2];
     ReconstructTwice(p, [](FieldReconstruction& reconstruction, int run) {
       reconstruction.AlternativeMapStrength = 0;
@@ -724,7 +729,7 @@ TEST_CASE(TheAxisAimIsReleasedOnlyWhereItHoldsACellOffTheData)
     lowered += largest[1] < largest[0] ? 1 : 0;
     deepBefore += deep[0];
     deepAfter += deep[1];
-  }
+  });
   std::printf("  %d cells released, the largest miss lowered on %d of 12 fields, deep critical points %d -> %d\n",
     released, lowered, deepBefore, deepAfter);
   CHECK(released > 0);
