@@ -92,6 +92,33 @@ void CubicBezierSpline::Subdivide(
 }
 
 //------------------------------------------------------------------------------
+void CubicBezierSpline::SplitEvenly(const double* control, int dimension, int parts, double* pieces, DeCasteljauStep step)
+{
+  // Peel off pieces of equal length of the original parameter: the k-th cut of the remainder
+  // [k/m, 1] is at its local parameter 1/(m - k).
+  std::vector<double> remainder(control, control + 4 * dimension), right(4 * dimension);
+  for (int k = 0; k + 1 < parts; ++k)
+  {
+    Subdivide(remainder.data(), dimension, 1.0 / (parts - k), pieces + 4 * k * dimension, right.data(), step);
+    remainder.swap(right);
+  }
+  std::copy(remainder.begin(), remainder.end(), pieces + 4 * (parts - 1) * dimension);
+}
+
+CubicBezierSpline CubicBezierSpline::SplitEvenly(int parts, DeCasteljauStep step) const
+{
+  CubicBezierSpline split;
+  split.Segments = this->Segments * parts;
+  split.Dimension = this->Dimension;
+  split.ControlPoints.resize(this->ControlPoints.size() * static_cast<std::size_t>(parts));
+  for (int j = 0; j < this->Segments; ++j)
+  {
+    SplitEvenly(this->Segment(j), this->Dimension, parts, split.ControlPoints.data() + 4 * j * parts * this->Dimension, step);
+  }
+  return split;
+}
+
+//------------------------------------------------------------------------------
 void CubicBezierSpline::Evaluate(double t, double* value) const
 {
   double s = 0;

@@ -52,6 +52,13 @@ struct CubicBezierSpline
   // read, so `left` or `right` may be `control` itself.
   static void Subdivide(const double* control, int dimension, double s, double* left, double* right,
     DeCasteljauStep step = DeCasteljauStep::FromStart);
+  // One cubic cut into `parts` cubics of equal parameter length, written one after the other
+  // to `pieces` (4 * parts points); the same curve.
+  static void SplitEvenly(const double* control, int dimension, int parts, double* pieces,
+    DeCasteljauStep step = DeCasteljauStep::FromStart);
+  // The same curve with every segment cut into `parts` of equal parameter length: Segments *
+  // parts segments, still uniform in t.
+  CubicBezierSpline SplitEvenly(int parts, DeCasteljauStep step = DeCasteljauStep::FromStart) const;
 };
 
 // A clamped uniform quadratic B-spline on [0, 1] with k segments (see the conventions above).

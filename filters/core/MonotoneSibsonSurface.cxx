@@ -27,21 +27,11 @@ bool SubdivideSide(const BezierSide& side, int targetCount, BezierSide& result)
     return false;
   }
   const int pieces = targetCount / count;
-  result.reserve(targetCount);
-  for (const CubicHeightSegment& segment : side)
+  result.resize(targetCount);
+  for (int j = 0; j < count; ++j)
   {
-    // Peel off pieces of equal length of the original parameter: the k-th cut of the
-    // remainder [k/m, 1] is at local parameter 1/(m - k).
-    CubicHeightSegment remainder = segment;
-    for (int k = 0; k < pieces - 1; ++k)
-    {
-      CubicHeightSegment left, right;
-      CubicBezierSpline::Subdivide(
-        remainder.data(), 1, 1.0 / (pieces - k), left.data(), right.data(), DeCasteljauStep::Weighted);
-      result.push_back(left);
-      remainder = right;
-    }
-    result.push_back(remainder);
+    // CubicHeightSegment is 4 contiguous doubles, and a vector of them is contiguous too.
+    CubicBezierSpline::SplitEvenly(side[j].data(), 1, pieces, result[j * pieces].data(), DeCasteljauStep::Weighted);
   }
   return true;
 }

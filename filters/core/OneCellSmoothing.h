@@ -93,7 +93,9 @@ public:
   // A piece whose height misses a sample by more than this (in the field's units; 0: never;
   // the filter passes the simplification's absolute persistence threshold) gets twice its
   // segments, twice at most, up to MaximumHeightSegments (twice that where it misses by more
-  // than twice this) and while it keeps 3 samples per segment.
+  // than twice this); a piece with fewer than 3 samples per new segment keeps its curve and only
+  // its height gets them (RefitHeightOnCurve), where it has a sample per segment and every
+  // 2-cell beside it keeps its grid or gets a multiple that stage 4's refinement could choose.
   double HeightTolerance = 0;
   // A quarter of stage 4's fitted-grid limit (TwoCellReconstruction::MaximumFittedGridSize):
   // a cell's grid is a common count of its sides, each the sum of its pieces' counts, and
@@ -160,26 +162,34 @@ private:
     const std::vector<Index>& junctionNode, const double domainBounds[4], const std::vector<double>& boundaryPoints,
     OneCellSmoothingResult& result, std::string& error) const;
   // Steps 2 and 3 on every piece with k = Segments (fewer on pieces of fewer edges).
-  bool FitAllPieces(OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const;
+  bool FitAllPieces(const MorseSmaleComplex& complex, OneCellSmoothingResult& result, const double domainBounds[4],
+    std::string& error) const;
   // Raises k (twice at most) on the listed pieces whose height misses by more than
   // HeightTolerance, and fits them again.
-  bool RefineMissedHeights(OneCellSmoothingResult& result, std::vector<Index> pieces, const double domainBounds[4],
-    std::string& error) const;
+  bool RefineMissedHeights(const MorseSmaleComplex& complex, OneCellSmoothingResult& result, std::vector<Index> pieces,
+    const double domainBounds[4], std::string& error) const;
   // Raises k on crossing pieces and fits them again (sets AdaptedPieces, RefinedPieces,
   // RiseKnotPieces, RemainingCrossings).
-  bool RepairCrossings(OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const;
-  // Fits the listed pieces in parallel, each with segmentsOf(piece) segments; false with the
+  bool RepairCrossings(const MorseSmaleComplex& complex, OneCellSmoothingResult& result, const double domainBounds[4],
+    std::string& error) const;
+  // Fits the listed pieces in parallel, each with segmentsOf(piece) segments (only the height,
+  // on the curve as it is, where keepCurve(piece) says so: RefitHeightOnCurve); false with the
   // first failing piece in list order named in `error`.
   bool FitInParallel(OneCellSmoothingResult& result, const std::vector<Index>& pieces,
     const std::function<int(const SmoothedPiece&)>& segmentsOf, const double domainBounds[4],
-    std::string& error) const;
+    std::string& error, const std::function<bool(const SmoothedPiece&)>& keepCurve = {}) const;
   // One piece (its arc-length parameters are derived from its samples on the first fit).
   bool FitPiece(SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments, const double bounds[4],
     std::string& error) const;
+  // The height of a fitted piece again with `segments` (a multiple of its count) on the same
+  // parameters; its curve stays the same curve, each segment cut evenly.
+  bool RefitHeightOnCurve(
+    SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, int segments, std::string& error) const;
   // FieldAt at curve(t_i) for the piece's interior samples (its ends keep their values);
-  // false if a point lies outside the domain.
-  bool SampledAlongCurve(const SmoothedPiece& piece, const UniformQuadraticBSpline& curve,
-    std::vector<double>& values) const;
+  // false if a point lies outside the domain. Spline: a UniformQuadraticBSpline or a
+  // CubicBezierSpline of dimension 2.
+  template <class Spline>
+  bool SampledAlongCurve(const SmoothedPiece& piece, const Spline& curve, std::vector<double>& values) const;
 };
 // Applies `map` (an (x, y) in place: a PlanarFrame's ToFrame or ToWorld) to every position of
 // a smoothing: its nodes, the pieces' samples and curves. Heights stay as they are.

@@ -497,30 +497,12 @@ int ChooseGridLayout(const std::array<SideSegments, 4>& sides, int maximum, std:
   return 0;
 }
 
-std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed,
-  bool exactHalves, int cutOffset, const std::vector<int>* samplesPerPiece)
+namespace
 {
-  std::array<SideSegments, 4> result;
-  for (int s = 0; s < 4; ++s)
-  {
-    for (Index p : sides.Pieces[s])
-    {
-      const SmoothedPiece& piece = smoothed.Pieces[p];
-      result[s].Pieces.push_back(piece.Curve.Segments);
-      if (samplesPerPiece != nullptr)
-      {
-        result[s].Samples.push_back((*samplesPerPiece)[p]);
-      }
-      for (int j = 0; j < piece.Curve.Segments; ++j)
-      {
-        std::array<double, 8> curve;
-        std::copy(piece.Curve.Segment(j), piece.Curve.Segment(j) + 8, curve.begin());
-        result[s].Curve.push_back(curve);
-        const double* h = piece.Height.Segment(j);
-        result[s].Height.push_back({ { h[0], h[1], h[2], h[3] } });
-      }
-    }
-  }
+// The empty sides of `result` (TwoCellSides::SplitSides) made up from half of their partners
+// (see TwoCellSideSegments).
+void SplitEmptySides(const TwoCellSides& sides, std::array<SideSegments, 4>& result, bool exactHalves, int cutOffset)
+{
   // The lower half of a Right or Top side goes to its empty partner (Bottom or Left); the
   // upper half of a Bottom or Left side goes to its empty partner (Right or Top).
   // Split at the segment boundary nearest the middle: the samples stay those of the
@@ -592,6 +574,50 @@ std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const
     result[bottomPair ? TwoCellSides::Bottom : TwoCellSides::Left] = std::move(lower);
     result[bottomPair ? TwoCellSides::Right : TwoCellSides::Top] = std::move(upper);
   }
+}
+} // namespace
+
+std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed,
+  bool exactHalves, int cutOffset, const std::vector<int>* samplesPerPiece)
+{
+  std::array<SideSegments, 4> result;
+  for (int s = 0; s < 4; ++s)
+  {
+    for (Index p : sides.Pieces[s])
+    {
+      const SmoothedPiece& piece = smoothed.Pieces[p];
+      result[s].Pieces.push_back(piece.Curve.Segments);
+      if (samplesPerPiece != nullptr)
+      {
+        result[s].Samples.push_back((*samplesPerPiece)[p]);
+      }
+      for (int j = 0; j < piece.Curve.Segments; ++j)
+      {
+        std::array<double, 8> curve;
+        std::copy(piece.Curve.Segment(j), piece.Curve.Segment(j) + 8, curve.begin());
+        result[s].Curve.push_back(curve);
+        const double* h = piece.Height.Segment(j);
+        result[s].Height.push_back({ { h[0], h[1], h[2], h[3] } });
+      }
+    }
+  }
+  SplitEmptySides(sides, result, exactHalves, cutOffset);
+  return result;
+}
+
+std::array<SideSegments, 4> TwoCellSideCounts(const TwoCellSides& sides, const std::function<int(Index)>& countOf)
+{
+  std::array<SideSegments, 4> result;
+  for (int s = 0; s < 4; ++s)
+  {
+    for (Index p : sides.Pieces[s])
+    {
+      result[s].Pieces.push_back(countOf(p));
+      result[s].Curve.resize(result[s].Curve.size() + result[s].Pieces.back());
+      result[s].Height.resize(result[s].Curve.size());
+    }
+  }
+  SplitEmptySides(sides, result, false, 0);
   return result;
 }
 
@@ -1569,11 +1595,8 @@ bool TwoCellReconstruction::OrderWhereSamplingBreaks(ReconstructedTwoCell& cell,
 
 int TwoCellReconstruction::FinestRefinedGridSize(int gridSize, std::size_t samples) const
 {
-  // Every grid cell keeps this many of the cell's samples.
-  constexpr double minimumSamplesPerGridCell = 4;
   int n = gridSize;
-  while (this->SurfaceTolerance > 0 && n > 0 && 2 * n <= this->MaximumRefinedGridSize &&
-    static_cast<double>(samples) >= minimumSamplesPerGridCell * (2.0 * n) * (2.0 * n))
+  while (this->SurfaceTolerance > 0 && n > 0 && this->GridHasSamplesFor(2 * n, samples))
   {
     n *= 2;
   }

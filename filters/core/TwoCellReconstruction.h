@@ -24,6 +24,7 @@
 #include "TwoCellParameterization.h"
 
 #include <array>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -93,6 +94,12 @@ int ChooseGridLayout(const std::array<SideSegments, 4>& sides, int maximum, std:
 // piece; null: none) gives each piece its own boundary samples per Bezier segment.
 std::array<SideSegments, 4> TwoCellSideSegments(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed,
   bool exactHalves = false, int cutOffset = 0, const std::vector<int>* samplesPerPiece = nullptr);
+
+// The piece counts of the four sides as TwoCellSideSegments lays them out (an empty side made up
+// from half of its partner, cut at the segment boundary nearest the middle), each piece with
+// countOf(piece) segments, and no geometry (zero control points): what ChooseGridLayout reads.
+// Stage 3 asks it what grid a 2-cell would get if a piece had another count.
+std::array<SideSegments, 4> TwoCellSideCounts(const TwoCellSides& sides, const std::function<int(Index)>& countOf);
 
 // Boundary samples per Bezier segment of each smoothed piece: c (the paper's), or, on a piece
 // whose 1-cells bound only 2-cells of fewer than `fewerVerticesThan` input vertices
@@ -225,6 +232,14 @@ public:
   // at least 10 %; the best grid is kept (the spaces are not nested).
   double SurfaceTolerance = 0;
   int MaximumRefinedGridSize = 32;
+  // Whether a fitted cell with this many samples may have this grid: every grid cell keeps 4 of
+  // them, within MaximumRefinedGridSize (the refinement's rule; stage 3 asks it too before a
+  // 1-cell's new count grows a cell's grid).
+  bool GridHasSamplesFor(int gridSize, std::size_t samples) const
+  {
+    return gridSize <= this->MaximumRefinedGridSize &&
+      static_cast<double>(samples) >= 4.0 * static_cast<double>(gridSize) * static_cast<double>(gridSize);
+  }
   // Cells whose sides alone need a finer grid than this keep the paper's interior: their fit
   // has tens of thousands of unknowns (seconds per cell), and such grids come from long sides
   // around few samples, where the boundary curves already carry the data. So do cells with

@@ -179,6 +179,53 @@ TEST_CASE(DeCasteljauSubdivision)
 }
 
 //------------------------------------------------------------------------------
+// A spline whose segments are cut evenly is the same curve, still uniform in t: at every t the
+// split spline (m k segments) and the whole one (k segments) agree, and the split one's
+// segment boundaries are the whole one's points at j / (m k).
+TEST_CASE(EvenSplitKeepsTheCurve)
+{
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  double worst = 0;
+  for (int segments : { 1, 3, 4 })
+  {
+    for (int parts : { 1, 2, 3, 5 })
+    {
+      CubicBezierSpline whole;
+      whole.Segments = segments;
+      whole.Dimension = 2;
+      for (int j = 0; j < segments; ++j)
+      {
+        for (int m = 0; m < 8; ++m)
+        {
+          whole.ControlPoints.push_back(unit(random));
+        }
+      }
+      const CubicBezierSpline split = whole.SplitEvenly(parts);
+      CHECK(split.Segments == segments * parts && split.Dimension == 2 &&
+        split.ControlPoints.size() == whole.ControlPoints.size() * parts);
+      for (int i = 0; i <= 600; ++i)
+      {
+        const double t = i / 600.0;
+        double a[2], b[2];
+        whole.Evaluate(t, a);
+        split.Evaluate(t, b);
+        worst = std::max({ worst, std::abs(a[0] - b[0]), std::abs(a[1] - b[1]) });
+      }
+      for (int j = 0; j < segments * parts; ++j)
+      {
+        double a[2];
+        whole.Evaluate(static_cast<double>(j) / (segments * parts), a);
+        const double* start = split.Segment(j);
+        worst = std::max({ worst, std::abs(a[0] - start[0]), std::abs(a[1] - start[1]) });
+      }
+    }
+  }
+  std::printf("  even split: max |split - whole| = %.2e\n", worst);
+  CHECK(worst < 1e-13);
+}
+
+//------------------------------------------------------------------------------
 // The two arithmetics of a de Casteljau step, bit for bit: callers rely on them to reproduce
 // earlier results exactly.
 TEST_CASE(DeCasteljauStepArithmetic)

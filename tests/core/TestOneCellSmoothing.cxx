@@ -549,6 +549,7 @@ void ForFortyShepardFieldsAtFivePercent(
 // then steeply, 2.3 eps above the data over 15 spacings with 4 segments). The misses and the
 // next count are the test's own (k = 4: 1 -> 2 -> 4 -> 8 -> 16; at most 12, 3 samples each; at
 // most 24 for a miss beyond 2 eps while every 1-cell through the piece keeps 24 segments).
+// Pieces with fewer samples: ShortPiecesGetAFinerHeightOnTheSameCurve.
 TEST_CASE(PiecesStillMissingAfterTheCrossingRepairGetMoreSegments)
 {
   int missing = 0, unrefined = 0;
@@ -596,6 +597,77 @@ TEST_CASE(PiecesStillMissingAfterTheCrossingRepairGetMoreSegments)
   std::printf("  Shepard 250^2, 2 and 5 %%, seeds 20-59: pieces missing their samples by more than eps %d, of which "
               "could have more segments %d\n", missing, unrefined);
   CHECK(unrefined == 0);
+}
+
+// A piece with too few samples for a finer curve (3 per segment) that misses its samples gets
+// the segments on its height alone: its curve is the one it had without refinement, point for
+// point, and its height fits its samples no worse in the L1 sense the fit minimizes (the
+// spline space with twice the segments holds the old one; up to the fit's tie-break), and
+// better in total. On Shepard seed 13 at 5 % such a piece leaves a steep minimum (the height
+// starts with zero slope; the reconstruction's largest error 2.0 eps at k = 4, 1.3 with it);
+// seeds 34 and 20-59 have more. The curves are compared at 201 parameters.
+TEST_CASE(ShortPiecesGetAFinerHeightOnTheSameCurve)
+{
+  int refined = 0, worseL1 = 0;
+  double largestShift = 0, missesBefore = 0, missesAfter = 0;
+  const auto l1 = [](const SmoothedPiece& piece) {
+    double sum = 0;
+    for (std::size_t i = 1; i + 1 < piece.Values.size(); ++i)
+    {
+      double h = 0;
+      piece.Height.Evaluate(piece.Parameters[i], &h);
+      sum += std::abs(h - piece.Values[i]);
+    }
+    return sum;
+  };
+  std::vector<std::uint64_t> seeds = { 13, 34 };
+  for (std::uint64_t seed = 20; seed < 60; ++seed)
+  {
+    seeds.push_back(seed);
+  }
+  for (const std::uint64_t seed : seeds)
+  {
+    Stage3Input input;
+    std::string error;
+    CHECK(RunStages1And2(ShepardField(50, 2.0, 250, seed), 5.0, input, error));
+    OneCellSmoothing plain, refining;
+    refining.HeightTolerance = 0.05 * input.Range;
+    OneCellSmoothingResult a, b;
+    CHECK(plain.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, a, error));
+    CHECK(refining.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, b, error));
+    CHECK(a.Pieces.size() == b.Pieces.size());
+    for (std::size_t p = 0; p < a.Pieces.size() && p < b.Pieces.size(); ++p)
+    {
+      const SmoothedPiece &before = a.Pieces[p], &after = b.Pieces[p];
+      // Short pieces the refinement reached, fitted along their path both times, and that no
+      // crossing refitted in either run (k = 4 is the most a piece starts with).
+      if (!after.HeightRefined || static_cast<int>(after.Values.size()) > 3 * after.Segments || before.Segments > 4 ||
+        after.Segments % before.Segments != 0 || after.RiseKnots != before.RiseKnots || before.HeightAlongCurve ||
+        after.HeightAlongCurve)
+      {
+        continue;
+      }
+      ++refined;
+      for (int i = 0; i <= 200; ++i)
+      {
+        double x[2], y[2];
+        before.Curve.Evaluate(i / 200.0, x);
+        after.Curve.Evaluate(i / 200.0, y);
+        largestShift = std::max(largestShift, std::hypot(x[0] - y[0], x[1] - y[1]));
+      }
+      const double rise = input.Range;
+      worseL1 += l1(after) > l1(before) + 1e-4 * rise ? 1 : 0;
+      missesBefore += LargestMissOfOwnSamples(before) / refining.HeightTolerance;
+      missesAfter += LargestMissOfOwnSamples(after) / refining.HeightTolerance;
+    }
+  }
+  std::printf("  Shepard 250^2 at 5 %%, seeds 13, 34, 20-59: %d short pieces refined, their largest misses %.1f -> %.1f "
+              "eps in all, %d fitting worse, curves moved by at most %.2e\n",
+    refined, missesBefore, missesAfter, worseL1, largestShift);
+  CHECK(refined > 0);
+  CHECK(worseL1 == 0);
+  CHECK(missesAfter < missesBefore);
+  CHECK(largestShift < 1e-9);
 }
 
 // Heights fitted along the jagged paths miss the field along the smoothed curves where a curve

@@ -440,6 +440,16 @@ TEST_CASE(SplitSidesAreCutWhereAGridLayoutFits)
   // Offsets beyond the side are clamped: at least one segment stays on each half.
   const auto far = TwoCellSideSegments(sides, smoothed, false, -1000);
   CHECK(far[TwoCellSides::Bottom].Pieces == std::vector<int>({ 1 }));
+  // The counts alone (what stage 3 asks before it refines a piece) are the layout's own, and
+  // follow a changed count: the piece of 2 doubled to 4 makes the halves 66 and 62 + 4.
+  const auto countsOnly = TwoCellSideCounts(sides, [&](Index p) { return smoothed.Pieces[p].Curve.Segments; });
+  for (int s = 0; s < 4; ++s)
+  {
+    CHECK(countsOnly[s].Pieces == middle[s].Pieces && countsOnly[s].Curve.size() == middle[s].Curve.size());
+  }
+  const auto doubled = TwoCellSideCounts(sides, [&](Index p) { return p == 1 ? 4 : smoothed.Pieces[p].Curve.Segments; });
+  CHECK(doubled[TwoCellSides::Bottom].Pieces == std::vector<int>({ 66 }));
+  CHECK(doubled[TwoCellSides::Right].Pieces == std::vector<int>({ 62, 4 }));
 }
 
 // Where no grid layout within MaximumGridSize exists, with the split sides cut at their middle
