@@ -1741,15 +1741,16 @@ constexpr double SevereMissFactor = 2;
 // The grids stage 4 will give the 2-cells beside a piece (AssembleTwoCellSides, then
 // ChooseGridLayout: the smallest count all four sides reach by whole multiples of their pieces'
 // counts), asked before a piece is refined on its height alone. A cell's grid may change only to
-// a multiple of itself that its refinement could choose (TwoCellReconstruction::
-// GridHasSamplesFor: 4 samples per grid cell). A grid that grows past that costs a small cell
-// its fit: short pieces doubled on a ttk_happi crop at 2 % took its largest grid from 30 to 56
-// and a cell from 12 to 19 % of the range off, and on a msh_crater crop at 1 % (stress seed 97
-// #182) a cell of 64 vertices went from a grid of 8 to 16 and from 0.7 to 2.2 % of the range
-// RMS. A grid that is not a multiple does not hold the coarser fit: from 16 to 20 a Maunga Whau
-// crop's largest cell at 2 % went from 1.0 to 1.6 % RMS; and where the sides of a cell with
-// three corners are cut in their middle, a count can shrink the grid (9 -> 6 on #299, a cell's
-// RMS 3.1 -> 7.4 %), so such cells are left as they are.
+// a multiple of itself that its own refinement could choose (TwoCellReconstruction::
+// GridHasSamplesFor: 4 samples per grid cell). A grid that grows past what a cell's samples
+// carry costs the cell its fit: short pieces doubled on a ttk_happi crop at 2 % took its
+// largest grid from 30 to 56 and a cell from 12 to 19 % of the range off. A grid that is not a
+// multiple does not hold the coarser fit: from 16 to 20 a Maunga Whau crop's largest cell at 2 %
+// went from 1.0 to 1.6 % RMS. A count can also shrink a grid where a cell with three corners has
+// a side cut in its middle (9 -> 6 on stress seed 97 #299, a cell's RMS 3.1 -> 7.4 %), and stage
+// 4 may fall back on another cut of such sides: on #182 (a msh_crater crop at 1 %) a cell with
+// two of them got a grid of 40 where the first cut gives 8, lost its fit and went from 0.7 to
+// 2.2 % of the range RMS. Such cells are left as they are.
 class CellGrids
 {
 public:
