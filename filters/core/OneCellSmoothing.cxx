@@ -1771,19 +1771,28 @@ public:
     }
   }
 
-  // Whether `piece` may have `segments` segments, the others their current or `planned` counts.
-  bool KeepGrids(Index piece, int segments, const std::unordered_map<Index, int>& planned) const
+  // Whether `piece` may have `segments` segments, every other piece q count(q).
+  bool KeepGrids(Index piece, int segments, const std::function<int(Index)>& count) const
   {
-    const auto count = [&](Index q) {
-      const auto raise = planned.find(q);
-      return raise != planned.end() ? raise->second : this->Result.Pieces[q].Segments;
-    };
     for (const Index o : this->Result.Pieces[piece].OneCells)
     {
       for (const Index c : this->CellsOfOneCell[o])
       {
-        const int before = this->GridCount(c, count);
-        const int after = this->GridCount(c, [&](Index q) { return q == piece ? segments : count(q); });
+        // A cell with three corners is left alone: where stage 4 cuts a side in two it may fall
+        // back on other cuts, whose grids differ (a msh_crater crop's cell with two such sides
+        // got 40 where the first cut gives 8).
+        TwoCellSides sides;
+        std::string ignored;
+        if (!AssembleTwoCellSides(this->Complex.TwoCells[c], this->Result, sides, ignored) ||
+          sides.SplitSides[0] >= 0 || sides.SplitSides[1] >= 0)
+        {
+          return false;
+        }
+        std::array<std::vector<int>, 4> multipliers;
+        const int before = ChooseGridLayout(TwoCellSideCounts(sides, count), this->Stage4.MaximumGridSize, multipliers);
+        const int after = ChooseGridLayout(
+          TwoCellSideCounts(sides, [&](Index q) { return q == piece ? segments : count(q); }),
+          this->Stage4.MaximumGridSize, multipliers);
         const auto samples = static_cast<std::size_t>(this->Complex.TwoCells[c].NumberOfVertices);
         if (after == 0 || before == 0 ||
           (after != before && (after % before != 0 || !this->Stage4.GridHasSamplesFor(after, samples))))
@@ -1796,19 +1805,6 @@ public:
   }
 
 private:
-  // The cell's grid with these counts (0: none within stage 4's limit, no sides, or a cell with
-  // three corners: where stage 4 cuts a side in two it may fall back on other cuts, whose grids
-  // differ; a msh_crater crop's cell with two such sides got 40 where the first cut gives 8).
-  int GridCount(Index c, const std::function<int(Index)>& count) const
-  {
-    TwoCellSides sides;
-    std::string ignored;
-    std::array<std::vector<int>, 4> multipliers;
-    return AssembleTwoCellSides(this->Complex.TwoCells[c], this->Result, sides, ignored) && sides.SplitSides[0] < 0 &&
-        sides.SplitSides[1] < 0
-      ? ChooseGridLayout(TwoCellSideCounts(sides, count), this->Stage4.MaximumGridSize, multipliers)
-      : 0;
-  }
 
   const MorseSmaleComplex& Complex;
   const OneCellSmoothingResult& Result;
@@ -2018,6 +2014,15 @@ PathDeviation DeviationFromPath(const UniformQuadraticBSpline& curve, const std:
   }
   return deviation;
 }
+// A piece's height and its fits' errors, with `segments` segments (its curve is set apart).
+void KeepHeight(SmoothedPiece& piece, int segments, const HeightFit& height, const HeightFit& free)
+{
+  piece.Segments = segments;
+  piece.Height = height.Spline.ToCubicBezier();
+  piece.L1Error = height.L1Error;
+  piece.LargestMiss = height.MaximumError;
+  piece.UnconstrainedL1Error = free.L1Error;
+}
 } // namespace
 
 template <class Spline>
@@ -2140,13 +2145,9 @@ bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<Smoothin
   {
     return false;
   }
-  piece.Segments = segments;
-  piece.Height = height.Spline.ToCubicBezier();
   piece.Curve = curve.Spline.ToCubicBezier();
   ClampCurveIntoDomain(piece, bounds);
-  piece.L1Error = height.L1Error;
-  piece.LargestMiss = height.MaximumError;
-  piece.UnconstrainedL1Error = free.L1Error;
+  KeepHeight(piece, segments, height, free);
   return true;
 }
 
@@ -2159,28 +2160,21 @@ bool OneCellSmoothing::RefitHeightOnCurve(
   piece.HeightAlongCurve = piece.HeightAlongCurve && this->FieldAt && this->SampledAlongCurve(piece, piece.Curve, alongCurve);
   const std::vector<double>& fitted = piece.HeightAlongCurve ? alongCurve : piece.Values;
   const double a = nodes[piece.StartNode].Value, b = nodes[piece.EndNode].Value;
+  if (piece.Segments <= 0 || segments % piece.Segments != 0)
+  {
+    error = "a height refitted on its curve needs a multiple of the curve's segments";
+    return false;
+  }
   MonotoneBSplineFit fitter;
   fitter.Segments = segments;
   HeightFit height, free;
-  if (piece.Segments <= 0 || segments % piece.Segments != 0 ||
-    !fitter.FitHeight(piece.Parameters, fitted, a, b, true, height, error))
-  {
-    if (error.empty())
-    {
-      error = "a height refitted on its curve needs a multiple of the curve's segments";
-    }
-    return false;
-  }
-  if (!fitter.FitHeight(piece.Parameters, fitted, a, b, false, free, error))
+  if (!fitter.FitHeight(piece.Parameters, fitted, a, b, true, height, error) ||
+    !fitter.FitHeight(piece.Parameters, fitted, a, b, false, free, error))
   {
     return false;
   }
   piece.Curve = piece.Curve.SplitEvenly(segments / piece.Segments);
-  piece.Segments = segments;
-  piece.Height = height.Spline.ToCubicBezier();
-  piece.L1Error = height.L1Error;
-  piece.LargestMiss = height.MaximumError;
-  piece.UnconstrainedL1Error = free.L1Error;
+  KeepHeight(piece, segments, height, free);
   return true;
 }
 
@@ -2273,15 +2267,18 @@ bool OneCellSmoothing::RefineMissedHeights(const MorseSmaleComplex& complex, One
   // cell's interior only on grids up to its limit, which the sides' segments push up (without
   // this, on a Rainier crop at 0.5 %, k = 10, a cell kept the paper's interior and missed by
   // 12.7 % of the range instead of 1.6 %).
-  std::unordered_map<Index, int> planned; // this round's raised counts, for the sums
+  std::unordered_map<Index, int> planned; // this round's raised counts
+  const auto count = [&](Index q) {
+    const auto raise = planned.find(q);
+    return raise != planned.end() ? raise->second : result.Pieces[q].Segments;
+  };
   const auto sidesAllow = [&](const SmoothedPiece& piece, Index p, int raised) {
     for (const Index o : piece.OneCells)
     {
       int sum = 0;
       for (const Index q : result.PiecesOfOneCell[o])
       {
-        const auto raise = planned.find(q);
-        sum += q == p ? raised : (raise != planned.end() ? raise->second : result.Pieces[q].Segments);
+        sum += q == p ? raised : count(q);
       }
       if (sum > this->MaximumSideSegments)
       {
@@ -2318,7 +2315,7 @@ bool OneCellSmoothing::RefineMissedHeights(const MorseSmaleComplex& complex, One
       const int raised = RaisedSegments(piece.Segments, this->Segments);
       if (piece.LargestMiss <= this->HeightTolerance ||
         (keepCurve(piece) && (raised % piece.Segments != 0 || static_cast<int>(piece.Values.size()) <= raised ||
-                               !grids().KeepGrids(p, raised, planned))))
+                               !grids().KeepGrids(p, raised, count))))
       {
         continue;
       }
