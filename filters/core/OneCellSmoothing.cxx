@@ -1778,16 +1778,12 @@ public:
     {
       for (const Index c : this->CellsOfOneCell[o])
       {
-        // A cell with three corners is left alone: where stage 4 cuts a side in two it may fall
-        // back on other cuts, whose grids differ (a msh_crater crop's cell with two such sides
-        // got 40 where the first cut gives 8).
-        TwoCellSides sides;
-        std::string ignored;
-        if (!AssembleTwoCellSides(this->Complex.TwoCells[c], this->Result, sides, ignored) ||
-          sides.SplitSides[0] >= 0 || sides.SplitSides[1] >= 0)
+        const TwoCellSides* assembled = this->SidesOf(c);
+        if (!assembled)
         {
           return false;
         }
+        const TwoCellSides& sides = *assembled;
         std::array<std::vector<int>, 4> multipliers;
         const int before = ChooseGridLayout(TwoCellSideCounts(sides, count), this->Stage4.MaximumGridSize, multipliers);
         const int after = ChooseGridLayout(
@@ -1805,10 +1801,31 @@ public:
   }
 
 private:
+  // The cell's sides, assembled once per cell (the refinement changes counts and curves, not
+  // which pieces bound a cell); null where the guard leaves the cell alone: sides that do not
+  // assemble, or a cell with three corners, where stage 4 cuts a side in two and may fall back
+  // on other cuts, whose grids differ (a msh_crater crop's cell with two such sides got 40 where
+  // the first cut gives 8).
+  const TwoCellSides* SidesOf(Index c) const
+  {
+    auto [entry, added] = this->Sides.try_emplace(c);
+    if (added)
+    {
+      TwoCellSides sides;
+      std::string ignored;
+      if (AssembleTwoCellSides(this->Complex.TwoCells[c], this->Result, sides, ignored) && sides.SplitSides[0] < 0 &&
+        sides.SplitSides[1] < 0)
+      {
+        entry->second = std::make_unique<TwoCellSides>(std::move(sides));
+      }
+    }
+    return entry->second.get();
+  }
 
   const MorseSmaleComplex& Complex;
   const OneCellSmoothingResult& Result;
   std::vector<std::vector<Index>> CellsOfOneCell;
+  mutable std::unordered_map<Index, std::unique_ptr<TwoCellSides>> Sides; // SidesOf; one thread asks
   const TwoCellReconstruction Stage4; // its grid limits (the filter keeps the defaults)
 };
 
