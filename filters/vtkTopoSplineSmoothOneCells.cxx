@@ -58,6 +58,8 @@ void WriteSmoothingReport(const topospline::OneCellSmoothingResult& result, int 
   AddFieldNumbers(fd, names::CurveSegments, { static_cast<double>(curveSegments) });
   AddFieldNumbers(fd, names::NumberOfPieces, { static_cast<double>(result.Pieces.size()) });
   AddFieldNumbers(fd, names::ShortPieces, { static_cast<double>(result.ShortPieces) });
+  AddFieldNumbers(fd, names::OversegmentedPieces, { static_cast<double>(result.OversegmentedPieces) });
+  AddFieldNumbers(fd, names::SuggestedCurveSegments, { static_cast<double>(result.SuggestedSegments) });
   AddFieldNumbers(fd, names::ErasedLoops, { static_cast<double>(result.ErasedLoops) });
   AddFieldNumbers(fd, names::DroppedCuts, { static_cast<double>(result.DroppedCuts) });
   AddFieldNumbers(fd, names::AdaptedPieces, { static_cast<double>(result.AdaptedPieces) });
@@ -218,6 +220,16 @@ void vtkTopoSplineSmoothOneCells::ReportAdjustments(
                                                                       : vtkLogger::VERBOSITY_TRACE,
       "Smooth 1-Cells: " << result.SpreadCriticalValues << " critical value(s) raised by at most "
                          << result.MaximumSpread << " so that values strictly increase along every 1-cell.");
+  }
+  if (result.SuggestedSegments > 0)
+  {
+    vtkWarningMacro("Smooth 1-Cells: " << result.OversegmentedPieces << " of " << result.Pieces.size()
+                    << " pieces of 1-cells have more than twice as many segments as jagged edges, most of all "
+                       "segments (Curve Segments "
+                    << this->CurveSegments
+                    << " has no divisor to give them fewer), and Reconstruct 2-Cells' grids grow with the square "
+                       "of a side's segments; Curve Segments "
+                    << result.SuggestedSegments << " gives nearly every piece at most twice its edges.");
   }
   if (result.RemainingCrossings > 0)
   {

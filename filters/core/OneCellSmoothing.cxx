@@ -1684,11 +1684,8 @@ bool OneCellSmoothing::FollowPolyline(SmoothedPiece& piece, const std::vector<Sm
 // grid count that every side's pieces reach by whole multiples (ChooseGridLayout): counts that
 // divide k keep every grid at most as fine as with k everywhere, while counts such as 13 and 19
 // on one cell need a grid of 247.
-namespace
+int OneCellSmoothing::SegmentsForEdges(int edges, int asked)
 {
-int SegmentsOfPiece(const SmoothedPiece& piece, int asked)
-{
-  const int edges = static_cast<int>(piece.Points.size() / 2) - 1;
   for (int d = std::max(2, edges); d < asked; ++d)
   {
     if (asked % d == 0)
@@ -1697,6 +1694,76 @@ int SegmentsOfPiece(const SmoothedPiece& piece, int asked)
     }
   }
   return asked;
+}
+
+// A prime k has no divisor to give a short piece: on 200^2 uniform noise at 2 %, where 46 818 of
+// 57 718 pieces have 2 edges, k = 11 gave every piece 11 segments and stage 4 was refused for
+// 534 million Bezier triangles (12.8 GB), while k = 12 (2, 3, 4 or 6 on short pieces) took 4.3
+// million and 0.6 GB, and k = 23 took 170 million, k = 24 4.2 million. Giving such pieces
+// fewer segments than a divisor was tried three ways and dropped (docs/Reconstruction.md,
+// "Fewer segments on short pieces"), so the filter names a better k instead.
+int OneCellSmoothing::SuggestCurveSegments(const std::vector<int>& edges, int asked, int* oversegmented)
+{
+  // Segments on pieces given more than twice their edges, all segments, and their squares.
+  struct Spend
+  {
+    long long Wasted = 0, Total = 0, Squares = 0;
+    int Pieces = 0;
+  };
+  const auto spend = [&](int k) {
+    Spend s;
+    for (const int e : edges)
+    {
+      const long long n = SegmentsForEdges(e, k);
+      s.Total += n;
+      s.Squares += n * n;
+      if (n > 2 * std::max(2, e))
+      {
+        s.Wasted += n;
+        ++s.Pieces;
+      }
+    }
+    return s;
+  };
+  const Spend now = spend(asked);
+  if (oversegmented)
+  {
+    *oversegmented = now.Pieces;
+  }
+  if (2 * now.Wasted <= now.Total)
+  {
+    return 0;
+  }
+  for (int distance = 1; distance < MaximumCurveSegments; ++distance)
+  {
+    int best = 0;
+    long long bestSquares = 0;
+    for (const int k : { asked - distance, asked + distance })
+    {
+      if (k < 2 || k > MaximumCurveSegments)
+      {
+        continue;
+      }
+      const Spend s = spend(k);
+      if (10 * s.Wasted <= s.Total && (best == 0 || s.Squares < bestSquares))
+      {
+        best = k;
+        bestSquares = s.Squares;
+      }
+    }
+    if (best != 0)
+    {
+      return best;
+    }
+  }
+  return 0;
+}
+
+namespace
+{
+int SegmentsOfPiece(const SmoothedPiece& piece, int asked)
+{
+  return OneCellSmoothing::SegmentsForEdges(static_cast<int>(piece.Points.size() / 2) - 1, asked);
 }
 
 // The count a piece's k rises to where it crosses another piece or misses its heights: the
@@ -2265,6 +2332,10 @@ bool OneCellSmoothing::FitAllPieces(const MorseSmaleComplex& complex,
       return false;
     }
   }
+  std::vector<int> edges(result.Pieces.size());
+  std::transform(result.Pieces.begin(), result.Pieces.end(), edges.begin(),
+    [](const SmoothedPiece& piece) { return static_cast<int>(piece.Points.size() / 2) - 1; });
+  result.SuggestedSegments = SuggestCurveSegments(edges, this->Segments, &result.OversegmentedPieces);
   std::vector<Index> all(static_cast<std::size_t>(count));
   std::iota(all.begin(), all.end(), 0);
   return this->RefineMissedHeights(complex, result, std::move(all), domainBounds, error);

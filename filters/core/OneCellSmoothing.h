@@ -59,6 +59,11 @@ struct OneCellSmoothingResult
   std::vector<SmoothedPiece> Pieces;
   std::vector<std::vector<Index>> PiecesOfOneCell; // per 1-cell, its pieces in order
   int ShortPieces = 0;         // pieces of fewer edges than k, fitted with fewer segments (a divisor of k)
+  // Pieces first given more than twice as many segments as edges (k has no divisor between),
+  // and, where those hold most of the segments, a k near the asked one whose divisors serve
+  // nearly every piece (SuggestCurveSegments; 0: none needed or found).
+  int OversegmentedPieces = 0;
+  int SuggestedSegments = 0;
   int AdaptedPieces = 0;       // pieces whose k was raised to remove crossings
   int RiseKnotPieces = 0;      // pieces whose knots follow their rise (MonotoneBSplineFit::ArcLengthAndRise)
   int CurveHeightPieces = 0;   // pieces whose height fits the field along their curve (FieldAt)
@@ -83,6 +88,15 @@ public:
   // The range of k a user may ask for (the GUI's range): beyond 30 the pieces have more
   // segments than most 1-cells have samples, and the fits become long and fail.
   static constexpr int MaximumCurveSegments = 30;
+  // The segments a piece of `edges` jagged edges starts with at k = `asked`: k, or on a piece of
+  // fewer edges the smallest divisor of k that gives each edge a segment (at least 2).
+  static int SegmentsForEdges(int edges, int asked);
+  // Where the pieces first given more than twice as many segments as edges hold most of the
+  // segments (a prime k on noise, whose pieces mostly have 2 edges: stage 4's grids grow with
+  // the square of a side's segments), the k nearest `asked` in [2, MaximumCurveSegments] at
+  // which such pieces hold at most a tenth of them (of two as near, the one with the smaller sum
+  // of squared counts); 0 where nothing needs it or no k does. `edges`: each piece's edges.
+  static int SuggestCurveSegments(const std::vector<int>& edges, int asked, int* oversegmented = nullptr);
   // k: cubic segments per piece (the paper's "Curve Segments": 4 or 7), in [2, MaximumCurveSegments].
   int Segments = 4;
   // Crossings are removed by raising k on the pieces involved, up to this many segments (or

@@ -300,6 +300,81 @@ TEST_CASE(ShortPiecesGetNoMoreSegmentsThanEdges)
 }
 
 //------------------------------------------------------------------------------
+// A prime k has no divisor to give short pieces: on noise they keep k segments each, and stage
+// 4's grids grow with the square of a side's segments. The result names the nearest k whose
+// divisors serve nearly every piece, checked here with the test's own count of the segments a
+// piece of e edges starts with.
+TEST_CASE(APrimeKOnNoiseIsToldABetterOne)
+{
+  const GridField noise = UniformNoise(40, 62);
+  Stage3Input input;
+  std::string error;
+  CHECK(RunStages1And2(noise, 2.0, input, error));
+  const auto startCount = [](int edges, int k) {
+    for (int d = std::max(2, edges); d < k; ++d)
+    {
+      if (k % d == 0)
+      {
+        return d;
+      }
+    }
+    return k;
+  };
+  // Segments on pieces with more than twice their edges, and all segments, at k.
+  const auto spend = [&](const std::vector<int>& edges, int k) {
+    long wasted = 0, total = 0;
+    for (const int e : edges)
+    {
+      const int n = startCount(e, k);
+      total += n;
+      wasted += n > 2 * std::max(2, e) ? n : 0;
+    }
+    return std::make_pair(wasted, total);
+  };
+  for (const int k : { 11, 12, 4 })
+  {
+    OneCellSmoothing smoothing;
+    smoothing.Segments = k;
+    OneCellSmoothingResult result;
+    CHECK(smoothing.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, result, error));
+    std::vector<int> edges;
+    int oversegmented = 0;
+    for (const SmoothedPiece& piece : result.Pieces)
+    {
+      edges.push_back(static_cast<int>(piece.Points.size() / 2) - 1);
+      oversegmented += startCount(edges.back(), k) > 2 * std::max(2, edges.back()) ? 1 : 0;
+    }
+    CHECK(result.OversegmentedPieces == oversegmented);
+    const auto [wasted, total] = spend(edges, k);
+    const int suggested = result.SuggestedSegments;
+    std::printf("  40^2 noise, 2%%, k %d: %d of %zu pieces oversegmented (%ld of %ld segments), suggested %d\n", k,
+      oversegmented, result.Pieces.size(), wasted, total, suggested);
+    if (2 * wasted <= total)
+    {
+      CHECK(suggested == 0);
+      continue;
+    }
+    // A prime k on noise: a suggestion, within the GUI's range, that serves nearly every piece,
+    // and none nearer does.
+    CHECK(k == 11 && suggested >= 2 && suggested <= OneCellSmoothing::MaximumCurveSegments && suggested != k);
+    const auto [w, t] = spend(edges, suggested);
+    CHECK(10 * w <= t);
+    for (int other = 2; other <= OneCellSmoothing::MaximumCurveSegments; ++other)
+    {
+      if (std::abs(other - k) < std::abs(suggested - k))
+      {
+        const auto [ow, ot] = spend(edges, other);
+        CHECK(10 * ow > ot);
+      }
+    }
+  }
+  // Nothing to suggest without pieces; pieces of 2 edges alone at a prime k: an even k beside it.
+  CHECK(OneCellSmoothing::SuggestCurveSegments({}, 11) == 0);
+  const int twoEdges = OneCellSmoothing::SuggestCurveSegments(std::vector<int>(50, 2), 23);
+  CHECK(twoEdges == 22 || twoEdges == 24);
+}
+
+//------------------------------------------------------------------------------
 // Counts raised by crossings or height misses still give every 2-cell a common grid. Stage 4
 // subdivides each piece of a cell's four sides by a whole factor to one count N per side (at
 // most 512, TwoCellReconstruction::MaximumGridSize). Short pieces start at a divisor of k; when

@@ -2,7 +2,7 @@
 exact end values and zero end slopes, one value per junction point shared by all 1-cells
 through it, L1 errors, no crossings, on the synthetic fields and every catalog data set at
 2, 5 and 25 % with k = 4 and 7; the display block's point budget (coarser samples, or an empty
-block, with stage 4 unaffected)."""
+block, with stage 4 unaffected); a better k named where a prime k oversegments noise."""
 import numpy as np
 from paraview.simple import *
 from paraview import servermanager as sm
@@ -123,4 +123,35 @@ for budget, expect_empty in ((full_points // 3, False), (10, True)):
     checks.equal(int(verdict), 1, "budget %d: stage 4 verifies on the coarser display block" % budget)
     Delete(recon)
     Delete(small)
+
+# A prime k on noise: short pieces keep k segments (no divisor to give them fewer), the filter
+# names a better k in field data (and a warning), and that k does take far fewer segments.
+from vtkmodules.util.numpy_support import numpy_to_vtk
+from vtkmodules.vtkCommonDataModel import vtkImageData
+image = vtkImageData()
+image.SetDimensions(60, 60, 1)
+noise_values = numpy_to_vtk(np.random.default_rng(49).uniform(0, 1, 3600), deep=1)
+noise_values.SetName("f")
+image.GetPointData().AddArray(noise_values)
+noise = TrivialProducer()
+noise.GetClientSideObject().SetOutput(image)
+noise_complex = MorseSmaleComplex(Input=noise)
+noise_complex.ScalarField = ["POINTS", "f"]
+noise_simplified = SimplifyMorseSmaleComplex(Input=noise_complex, PersistenceThreshold=2)
+segments_at = {}
+for k in (11, 12):
+    smooth = Smooth1Cells(Input=noise_simplified, CurveSegments=k)
+    data = sm.Fetch(smooth)
+    fd = data.GetFieldData()
+    segments_at[k] = (data.GetBlock(5).GetNumberOfCells(), int(fd.GetArray("SuggestedCurveSegments").GetValue(0)),
+                      int(fd.GetArray("OversegmentedPieces").GetValue(0)), int(fd.GetArray("NumberOfPieces").GetValue(0)))
+    Delete(smooth)
+checks.check(segments_at[11][1] not in (0, 11) and segments_at[11][2] > segments_at[11][3] // 2,
+             "60^2 noise at 2 %%, k = 11: most pieces oversegmented (%d of %d), k = %d suggested"
+             % (segments_at[11][2], segments_at[11][3], segments_at[11][1]))
+print("60^2 noise at 2 %%: k = 11: %d Bezier segments, %d of %d pieces oversegmented, k = %d suggested; k = 12: %d segments"
+      % (segments_at[11][0], segments_at[11][2], segments_at[11][3], segments_at[11][1], segments_at[12][0]), flush=True)
+checks.equal(segments_at[12][1], 0, "60^2 noise at 2 %, k = 12: nothing to suggest")
+checks.check(segments_at[12][0] * 3 < segments_at[11][0],
+             "60^2 noise at 2 %%: %d Bezier segments at k = 12, %d at k = 11" % (segments_at[12][0], segments_at[11][0]))
 checks.finish()
