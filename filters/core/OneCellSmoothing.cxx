@@ -1761,9 +1761,15 @@ int OneCellSmoothing::SuggestCurveSegments(const std::vector<int>& edges, int as
 
 namespace
 {
+// The jagged edges of a piece's path (its samples less one).
+int EdgesOf(const SmoothedPiece& piece)
+{
+  return static_cast<int>(piece.Points.size() / 2) - 1;
+}
+
 int SegmentsOfPiece(const SmoothedPiece& piece, int asked)
 {
-  return OneCellSmoothing::SegmentsForEdges(static_cast<int>(piece.Points.size() / 2) - 1, asked);
+  return OneCellSmoothing::SegmentsForEdges(EdgesOf(piece), asked);
 }
 
 // The count a piece's k rises to where it crosses another piece or misses its heights: the
@@ -2333,8 +2339,7 @@ bool OneCellSmoothing::FitAllPieces(const MorseSmaleComplex& complex,
     }
   }
   std::vector<int> edges(result.Pieces.size());
-  std::transform(result.Pieces.begin(), result.Pieces.end(), edges.begin(),
-    [](const SmoothedPiece& piece) { return static_cast<int>(piece.Points.size() / 2) - 1; });
+  std::transform(result.Pieces.begin(), result.Pieces.end(), edges.begin(), EdgesOf);
   result.SuggestedSegments = SuggestCurveSegments(edges, this->Segments, &result.OversegmentedPieces);
   std::vector<Index> all(static_cast<std::size_t>(count));
   std::iota(all.begin(), all.end(), 0);
