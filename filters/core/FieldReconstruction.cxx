@@ -2,6 +2,7 @@
 
 #include "CompressedGraph.h"
 #include "MorseSmaleComplexExtraction.h"
+#include "PlanarGeometry.h"
 
 #include <algorithm>
 #include <array>
@@ -174,13 +175,8 @@ topospline::TopologicalSampling FieldReconstruction::SamplingOf(const MorseSmale
 
 namespace
 {
-// The square bucket of side `side` that holds (x, y): the one rule by which BucketIndex
-// registers points and OneCellSamples keeps and looks up its samples (they must agree, see
-// BucketIndex).
-std::pair<long long, long long> SquareBucket(double x, double y, double side)
-{
-  return { static_cast<long long>(std::floor(x / side)), static_cast<long long>(std::floor(y / side)) };
-}
+// SquareBucket (PlanarGeometry.h) is the one rule by which BucketIndex registers points and
+// OneCellSamples keeps and looks up its samples (they must agree, see BucketIndex).
 
 // The square buckets of side `side` that hold points (x, y) at (floor(x / side), floor(y / side)),
 // and which items are registered in each. Items register in the buckets as OneCellSamples::
@@ -405,7 +401,7 @@ long long OneCellSamples::Key(double x, double y) const
 
 long long OneCellSamples::KeyOf(long long i, long long j) const
 {
-  return (i << 32) ^ (j & 0xffffffffLL);
+  return SquareBucketKey(i, j);
 }
 
 bool OneCellSamples::Nearest(double x, double y, double distance, double& height) const
@@ -531,6 +527,7 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
   this->Cells.Mesh = &mesh; // for the stiffening rounds: which vertices are neighbours
   this->Cells.StiffeningRounds = this->StiffeningRounds;
   this->Cells.OrderingRounds = this->OrderingRounds;
+  this->Cells.FarFromOneCells = this->FarFromOneCellsSpacings * GridSpacing(field);
   this->Cells.AxisAimTrigger = this->AxisAimTrigger;
   const bool reconstructed = this->Cells.Reconstruct(complex, smoothed, error, &field);
   this->Cells.Mesh = nullptr; // a local

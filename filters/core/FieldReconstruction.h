@@ -104,6 +104,10 @@ public:
   int StiffeningRounds = 5;
   // Then the ordering rounds of the points left (TwoCellReconstruction::OrderingRounds; 0: none).
   int OrderingRounds = 4;
+  // Both also treat critical points farther than this many grid spacings from the smoothed
+  // 1-cells where two rings of neighbours reach past a 1-cell (TwoCellReconstruction::
+  // FarFromOneCells; 2: where Verify's count calls them far; 0: the two rings only).
+  double FarFromOneCellsSpacings = 2;
   // Fitted interiors: cells whose fit misses by more than this times SurfaceTolerance are fitted
   // again without the aim at F rising along u and v (TwoCellReconstruction::AxisAimTrigger; <= 0:
   // never).

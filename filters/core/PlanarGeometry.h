@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 namespace topospline
@@ -16,6 +17,19 @@ inline double SegmentDistance2(const double* a, const double* b, double x, doubl
   fraction = length2 > 0 ? std::clamp(((x - a[0]) * dx + (y - a[1]) * dy) / length2, 0.0, 1.0) : 0.0;
   const double ex = a[0] + fraction * dx - x, ey = a[1] + fraction * dy - y;
   return ex * ex + ey * ey;
+}
+
+// The square bucket of side `side` that holds (x, y), and one key for a bucket (i, j): the rule
+// by which the bucketed searches of stage 4 register points and look them up (a point and
+// the buckets around it must be found by the same rounding).
+inline std::pair<long long, long long> SquareBucket(double x, double y, double side)
+{
+  return { static_cast<long long>(std::floor(x / side)), static_cast<long long>(std::floor(y / side)) };
+}
+
+inline long long SquareBucketKey(long long i, long long j)
+{
+  return (i << 32) ^ (j & 0xffffffffLL);
 }
 
 // Twice the signed area of the triangle (o, a, b): positive when it turns counter-clockwise.

@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <numeric>
 #include <sstream>
@@ -762,12 +763,77 @@ std::vector<char> RingsInTheirCells(
   return ringInCell;
 }
 
+// Whether points lie within `distance` of a closed polyline (a cell's boundary samples, which
+// follow its smoothed 1-cells): each segment is listed in the squares of side `distance` its
+// box touches, and a point asks the 3 x 3 squares around its own (a segment within reach has
+// its box in them).
+class PolylineProximity
+{
+public:
+  PolylineProximity(const std::vector<double>& points, Index count, double distance)
+    : Points(points)
+    , Count(count)
+    , Distance(distance)
+  {
+    for (Index s = 0; s < count; ++s)
+    {
+      const double* a = &points[2 * static_cast<std::size_t>(s)];
+      const double* b = &points[2 * static_cast<std::size_t>((s + 1) % count)];
+      const auto [i0, j0] = SquareBucket(std::min(a[0], b[0]), std::min(a[1], b[1]), distance);
+      const auto [i1, j1] = SquareBucket(std::max(a[0], b[0]), std::max(a[1], b[1]), distance);
+      for (long long i = i0; i <= i1; ++i)
+      {
+        for (long long j = j0; j <= j1; ++j)
+        {
+          this->Segments[SquareBucketKey(i, j)].push_back(s);
+        }
+      }
+    }
+  }
+
+  bool Within(const double* p) const
+  {
+    const auto [pi, pj] = SquareBucket(p[0], p[1], this->Distance);
+    for (long long i = pi - 1; i <= pi + 1; ++i)
+    {
+      for (long long j = pj - 1; j <= pj + 1; ++j)
+      {
+        const auto found = this->Segments.find(SquareBucketKey(i, j));
+        if (found == this->Segments.end())
+        {
+          continue;
+        }
+        for (Index s : found->second)
+        {
+          double fraction;
+          const double* a = &this->Points[2 * static_cast<std::size_t>(s)];
+          const double* b = &this->Points[2 * static_cast<std::size_t>((s + 1) % this->Count)];
+          if (SegmentDistance2(a, b, p[0], p[1], fraction) <= this->Distance * this->Distance)
+          {
+            return true;
+          }
+        }
+      }
+    }
+    return false;
+  }
+
+private:
+  const std::vector<double>& Points;
+  const Index Count;
+  const double Distance;
+  std::unordered_map<long long, std::vector<Index>> Segments;
+};
+
 // Of a cell's vertices, those two rings of vertices or more inside it (its ring and the rings
 // of its neighbours in the cell, RingsInTheirCells): no smoothed 1-cell passes next to them.
-std::vector<Index> DeepVertices(
-  const TriangleMeshTopology& mesh, const Index* vertices, Index count, const std::vector<char>& ringInCell)
+// With `farFromBoundary` (may be empty), also those whose ring alone is in the cell and that it
+// calls far from the cell's boundary; byRings[k] says which kind sample k is (1: two rings).
+std::vector<Index> DeepVertices(const TriangleMeshTopology& mesh, const Index* vertices, Index count,
+  const std::vector<char>& ringInCell, const std::function<bool(Index)>& farFromBoundary, std::vector<char>& byRings)
 {
   std::vector<Index> deep;
+  byRings.assign(count, 0);
   for (Index k = 0; k < count; ++k)
   {
     const Index v = vertices[k];
@@ -779,9 +845,10 @@ std::vector<Index> DeepVertices(
         all = all && ringInCell[w] != 0;
       }
     }
-    if (all)
+    if (all || (ringInCell[v] != 0 && farFromBoundary && farFromBoundary(v)))
     {
       deep.push_back(k);
+      byRings[k] = all ? 1 : 0;
     }
   }
   return deep;
@@ -922,7 +989,8 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
     if (stiffen && cell.Valid && cell.Surface.FitReport().Fitted)
     {
       const std::vector<SurfaceSample> samples = remapped[c] ? std::move(remappedSamples[c]) : samplesOf(c);
-      const int outcome = this->StiffenWhereSamplingBreaks(cell, samples, vertices.data() + firstVertex[c], ringInCell);
+      const int outcome =
+        this->StiffenWhereSamplingBreaks(cell, samples, vertices.data() + firstVertex[c], ringInCell, data->Points);
       stiffened[c] = (outcome & StiffenedFit) != 0 ? 1 : 0;
       ordered[c] = (outcome & OrderedFit) != 0 ? 1 : 0;
       axisFree[c] = (outcome & AxisFreeFit) != 0 ? 1 : 0;
@@ -1288,18 +1356,19 @@ bool TwoCellReconstruction::FitOnAlternativeMaps(ReconstructedTwoCell& cell, con
   return kept;
 }
 
-// The vertices of one cell two rings or more inside it (DeepVertices: no smoothed 1-cell passes
-// next to them, so no node of the complex can explain a critical point there) and, for a
-// surface, those of them critical for F sampled at the cell's vertices.
+// The vertices of one cell two rings or more inside it, or one ring and farther than
+// FarFromOneCells from its boundary (DeepVertices: no smoothed 1-cell passes next to them, so no
+// node of the complex can explain a critical point there) and, for a surface, those of them
+// critical for F sampled at the cell's vertices.
 class TwoCellReconstruction::DeepCriticalVertices
 {
 public:
   DeepCriticalVertices(const TriangleMeshTopology& mesh, const std::vector<SurfaceSample>& samples,
-    const Index* vertices, const std::vector<char>& ringInCell)
+    const Index* vertices, const std::vector<char>& ringInCell, const std::function<bool(Index)>& farFromBoundary)
     : Mesh(mesh)
     , Samples(samples)
     , Vertices(vertices)
-    , Deep(DeepVertices(mesh, vertices, static_cast<Index>(samples.size()), ringInCell))
+    , Deep(DeepVertices(mesh, vertices, static_cast<Index>(samples.size()), ringInCell, farFromBoundary, this->ByRings))
   {
     // Each vertex's slot among the samples, found once for every round.
     this->SlotOf.reserve(2 * samples.size());
@@ -1310,6 +1379,40 @@ public:
   }
 
   bool Empty() const { return this->Deep.empty(); }
+
+  // How good a fit with these critical samples (Find) is, compared lexicographically: those two
+  // rings inside first, then those only far from the boundary (the band of 2-3 spacings along
+  // the 1-cells comes second: counted together, a fit that cleared the band could win with a
+  // new crest deep inside).
+  using Score = std::pair<std::size_t, std::size_t>;
+  Score ScoreOf(const std::vector<Index>& critical) const
+  {
+    Score score(0, 0);
+    for (Index k : critical)
+    {
+      ++(this->ByRings[k] ? score.first : score.second);
+    }
+    return score;
+  }
+
+  // Whether a fit with `score` and largest residual `residual` is better than the best so far
+  // (`fewest`): a lower score, but one lower in the band alone only within BandResidualGrowth
+  // of the first fit's largest residual (`firstResidual`): stiffened there without that bound,
+  // a Rainier crop's cell missed the data by 29 % more.
+  static bool Better(const Score& score, const Score& fewest, double residual, double firstResidual)
+  {
+    return score < fewest && (score.first < fewest.first || residual <= BandResidualGrowth * firstResidual);
+  }
+
+  // Of `critical`, those the rounds treat now: the ones two rings inside while there are any
+  // (spots and orders in the band too made the rounds' fits miss the data by more than they
+  // allow, and left crests deep inside), then the others.
+  std::vector<Index> FirstConcern(const std::vector<Index>& critical) const
+  {
+    std::vector<Index> first;
+    std::copy_if(critical.begin(), critical.end(), std::back_inserter(first), [this](Index k) { return this->ByRings[k] != 0; });
+    return first.empty() ? critical : first;
+  }
 
   // The samples (slots) of the deep vertices critical for `surface`; its values at every sample
   // are kept (Values) for RiseDirection.
@@ -1328,8 +1431,9 @@ public:
     return critical;
   }
 
-  // The samples of the vertices within `rings` rings of deep sample k's vertex (all in the
-  // cell: the two rings of a deep vertex are), k excepted.
+  // The samples of the vertices within `rings` rings of deep sample k's vertex that lie in the
+  // cell (the first ring always does; the second of a vertex deep by its distance to the
+  // boundary need not), k excepted.
   std::vector<Index> Around(Index k, int rings) const
   {
     std::vector<Index> around = { this->Vertices[k] };
@@ -1355,7 +1459,11 @@ public:
     std::vector<Index> slots;
     for (std::size_t a = 1; a < around.size(); ++a)
     {
-      slots.push_back(this->SlotOf.at(around[a]));
+      const auto slot = this->SlotOf.find(around[a]);
+      if (slot != this->SlotOf.end())
+      {
+        slots.push_back(slot->second);
+      }
     }
     return slots;
   }
@@ -1409,6 +1517,7 @@ private:
   const TriangleMeshTopology& Mesh;
   const std::vector<SurfaceSample>& Samples;
   const Index* Vertices;
+  std::vector<char> ByRings; // before Deep, which DeepVertices fills it with
   const std::vector<Index> Deep;
   std::unordered_map<Index, Index> SlotOf;
   std::vector<double> Values;
@@ -1436,7 +1545,7 @@ bool TwoCellReconstruction::ReleaseAxisAim(ReconstructedTwoCell& cell, const std
     trial.FitReport().MaximumResidual >= AlternativeMapGain * fitted.MaximumResidual ||
     trial.FitReport().RMSResidual > fitted.RMSResidual ||
     (trial.FitReport().RMSResidual >= AxisAimRMSGain * fitted.RMSResidual &&
-      deep.Find(trial).size() > deep.Find(cell.Surface).size()))
+      deep.ScoreOf(deep.Find(cell.Surface)) < deep.ScoreOf(deep.Find(trial))))
   {
     return false;
   }
@@ -1452,9 +1561,24 @@ bool TwoCellReconstruction::ReleaseAxisAim(ReconstructedTwoCell& cell, const std
 // vertices see the rise; where that is not enough, the samples around the points left are
 // ordered (OrderWhereSamplingBreaks).
 int TwoCellReconstruction::StiffenWhereSamplingBreaks(ReconstructedTwoCell& cell,
-  const std::vector<SurfaceSample>& samples, const Index* vertices, const std::vector<char>& ringInCell) const
+  const std::vector<SurfaceSample>& samples, const Index* vertices, const std::vector<char>& ringInCell,
+  const std::vector<double>& points) const
 {
-  DeepCriticalVertices deep(*this->Mesh, samples, vertices, ringInCell);
+  // Made only if some vertex of the cell asks (its ring in the cell, its second ring not).
+  std::unique_ptr<PolylineProximity> boundary;
+  std::function<bool(Index)> farFromBoundary;
+  const TwoCellMesh& mesh = cell.Parameterization.GetMesh();
+  if (this->FarFromOneCells > 0 && mesh.BoundaryCount > 1)
+  {
+    farFromBoundary = [&](Index v) {
+      if (!boundary)
+      {
+        boundary = std::make_unique<PolylineProximity>(mesh.Points, mesh.BoundaryCount, this->FarFromOneCells);
+      }
+      return !boundary->Within(&points[2 * static_cast<std::size_t>(v)]);
+    };
+  }
+  DeepCriticalVertices deep(*this->Mesh, samples, vertices, ringInCell, farFromBoundary);
   MonotoneSurfaceFitOptions options = this->Fit;
   int outcome = this->ReleaseAxisAim(cell, samples, deep, options) ? AxisFreeFit : 0;
   if (deep.Empty() || this->StiffeningRounds + this->OrderingRounds <= 0)
@@ -1462,7 +1586,7 @@ int TwoCellReconstruction::StiffenWhereSamplingBreaks(ReconstructedTwoCell& cell
     return outcome;
   }
   std::vector<Index> critical = deep.Find(cell.Surface);
-  std::size_t fewest = critical.size();
+  DeepCriticalVertices::Score fewest = deep.ScoreOf(critical);
   options.AcceptedResidualGrowth = this->StiffeningResidualGrowth;
   MonotoneSurfaceFitOptions kept = options;
   const MonotoneSibsonSurface first = cell.Surface;
@@ -1476,7 +1600,7 @@ int TwoCellReconstruction::StiffenWhereSamplingBreaks(ReconstructedTwoCell& cell
     {
       spot.Factor *= step;
     }
-    for (Index k : critical)
+    for (Index k : deep.FirstConcern(critical))
     {
       options.StiffSpots.push_back({ samples[k].U, samples[k].V, step });
     }
@@ -1496,9 +1620,10 @@ int TwoCellReconstruction::StiffenWhereSamplingBreaks(ReconstructedTwoCell& cell
       continue;
     }
     critical = deep.Find(trial);
-    if (critical.size() < fewest)
+    if (DeepCriticalVertices::Better(deep.ScoreOf(critical), fewest, trial.FitReport().MaximumResidual,
+          first.FitReport().MaximumResidual))
     {
-      fewest = critical.size();
+      fewest = deep.ScoreOf(critical);
       cell.Surface = std::move(trial);
       kept = options;
       outcome |= StiffenedFit;
@@ -1509,7 +1634,8 @@ int TwoCellReconstruction::StiffenWhereSamplingBreaks(ReconstructedTwoCell& cell
       break; // points that stiffening does not move (a kink of Phi, a crest the rows force)
     }
   }
-  if (fewest > 0 && this->OrderingRounds > 0 && this->OrderWhereSamplingBreaks(cell, first, kept, deep, samples))
+  if (fewest != DeepCriticalVertices::Score(0, 0) && this->OrderingRounds > 0 &&
+    this->OrderWhereSamplingBreaks(cell, first, kept, deep, samples))
   {
     outcome |= OrderedFit;
   }
@@ -1538,7 +1664,7 @@ bool TwoCellReconstruction::OrderWhereSamplingBreaks(ReconstructedTwoCell& cell,
   // The rows need not hold at the start, so the fit may end above the first fit's objective.
   options.Solver.KeepStartIfLower = false;
   std::vector<Index> critical = deep.Find(cell.Surface);
-  std::size_t fewest = critical.size();
+  DeepCriticalVertices::Score fewest = deep.ScoreOf(critical);
   std::unordered_map<Index, std::vector<MonotoneSurfaceFitOptions::SampleOrder>> ordersAt;
   bool ordered = false;
   for (int round = 0, stale = 0; round < this->OrderingRounds && stale < 2; ++round)
@@ -1551,7 +1677,7 @@ bool TwoCellReconstruction::OrderWhereSamplingBreaks(ReconstructedTwoCell& cell,
     {
       break;
     }
-    for (Index k : critical)
+    for (Index k : deep.FirstConcern(critical))
     {
       double direction[2];
       deep.RiseDirection(k, direction);
@@ -1578,9 +1704,10 @@ bool TwoCellReconstruction::OrderWhereSamplingBreaks(ReconstructedTwoCell& cell,
       break;
     }
     critical = deep.Find(trial);
-    if (critical.size() < fewest)
+    if (DeepCriticalVertices::Better(deep.ScoreOf(critical), fewest, trial.FitReport().MaximumResidual,
+          first.FitReport().MaximumResidual))
     {
-      fewest = critical.size();
+      fewest = deep.ScoreOf(critical);
       cell.Surface = std::move(trial);
       ordered = true;
       stale = 0;

@@ -61,6 +61,19 @@ std::array<bool, 6> LowerLink(const std::vector<double>& f, int nx, int i, int j
   return below;
 }
 
+// How often interior vertex (i, j)'s link changes between lower and upper neighbours (LowerLink):
+// 2 at a regular vertex, 0 at an extremum, 2 + 2m at a saddle of multiplicity m.
+int LinkChanges(const std::vector<double>& f, int nx, int i, int j)
+{
+  const std::array<bool, 6> below = LowerLink(f, nx, i, j);
+  int changes = 0;
+  for (int k = 0; k < 6; ++k)
+  {
+    changes += below[k] != below[(k + 1) % 6] ? 1 : 0;
+  }
+  return changes;
+}
+
 // Interior PL minima and maxima of a grid field (LowerLink).
 std::array<int, 2> InteriorExtrema(const PlanarScalarField& field)
 {
@@ -454,13 +467,7 @@ int CriticalDeepInsideCells(const std::vector<double>& f, const std::vector<Inde
       {
         continue;
       }
-      const std::array<bool, 6> below = LowerLink(f, nx, i, j);
-      int changes = 0;
-      for (int k = 0; k < 6; ++k)
-      {
-        changes += below[k] != below[(k + 1) % 6] ? 1 : 0;
-      }
-      count += changes != 2 ? 1 : 0;
+      count += LinkChanges(f, nx, i, j) != 2 ? 1 : 0;
     }
   }
   return count;
@@ -566,6 +573,93 @@ TEST_CASE(OrderingTakesOutWhatStiffeningLeaves)
     CHECK(ordered.RMS <= 1.05 * stiffened.RMS);
     before += stiffened.Deep;
     after += ordered.Deep;
+  });
+  CHECK(before > 0);
+  CHECK(after < before);
+}
+
+namespace
+{
+// Interior PL critical vertices of `f` (LowerLink) farther than two spacings of grid `p.Field`
+// from every smoothed 1-cell, each curve sampled 32 times per Bezier segment (the distance by
+// brute force: the test's own, not the reconstruction's count).
+int CriticalFarFromOneCells(const std::vector<double>& f, const Pipeline& p, int nx, int ny)
+{
+  std::vector<double> curve;
+  for (const SmoothedPiece& piece : p.Smoothed.Pieces)
+  {
+    for (int s = 0; s <= 32 * piece.Curve.Segments; ++s)
+    {
+      double xy[2];
+      piece.Curve.Evaluate(static_cast<double>(s) / (32 * piece.Curve.Segments), xy);
+      curve.insert(curve.end(), xy, xy + 2);
+    }
+  }
+  const double reach = 2 * std::max(p.Field.GridSpacing[0], p.Field.GridSpacing[1]);
+  int count = 0;
+  for (int j = 1; j + 1 < ny; ++j)
+  {
+    for (int i = 1; i + 1 < nx; ++i)
+    {
+      if (LinkChanges(f, nx, i, j) == 2)
+      {
+        continue;
+      }
+      const double* at = &p.Field.Points[2 * static_cast<std::size_t>(j * nx + i)];
+      bool far = true;
+      for (std::size_t c = 0; far && c < curve.size(); c += 2)
+      {
+        far = std::hypot(curve[c] - at[0], curve[c + 1] - at[1]) > reach;
+      }
+      count += far ? 1 : 0;
+    }
+  }
+  return count;
+}
+} // namespace
+
+TEST_CASE(CriticalPointsTwoSpacingsFromTheOneCellsAreTreatedToo)
+{
+  // Two rings of grid neighbours reach only two spacings along the axes: a critical point of
+  // F o Phi 2-3 spacings from a 1-cell, which no node explains either, was left to topological
+  // sampling. With FarFromOneCellsSpacings the stiffening and ordering rounds treat it too,
+  // after the points two rings inside and only within 10 % of the largest residual of the
+  // cell's first fit.
+  // Shepard fields nothing was tuned on (seeds 52-59), odd at 5 %, even at 25 %.
+  int before = 0, after = 0;
+  ForShepardFields150(52, 60, FiveOrTwentyFive, [&](std::uint64_t seed, int percent, const GridField& shepard, Pipeline& p) {
+    FieldReconstructionReport reports[2];
+    for (int run = 0; run < 2; ++run)
+    {
+      FieldReconstruction reconstruction;
+      reconstruction.Parallel = ThreadedFor;
+      reconstruction.FarFromOneCellsSpacings = run == 0 ? 0 : 2;
+      std::string error;
+      CHECK(reconstruction.Run(p.Field, p.Simplified.Complex, p.Smoothed, reports[run], error));
+      CHECK(reports[run].Verified);
+    }
+    const int nx = shepard.Dimensions[0], ny = shepard.Dimensions[1];
+    const int far[2] = { CriticalFarFromOneCells(reports[0].Exact, p, nx, ny),
+      CriticalFarFromOneCells(reports[1].Exact, p, nx, ny) };
+    double rms[2] = { 0, 0 }, largest[2] = { 0, 0 };
+    for (int run = 0; run < 2; ++run)
+    {
+      for (std::size_t v = 0; v < p.Field.Values.size(); ++v)
+      {
+        const double d = std::abs(reports[run].Values[v] - p.Field.Values[v]);
+        rms[run] += d * d;
+        largest[run] = std::max(largest[run], d);
+      }
+      rms[run] = std::sqrt(rms[run] / p.Field.Values.size()) / p.Range;
+      largest[run] /= p.Range;
+    }
+    std::printf("  shepard 150^2 seed %d at %d %%: %d -> %d critical points of F o Phi over two spacings from the "
+                "1-cells, RMS %.3f -> %.3f %%, largest error %.2f -> %.2f %% of the range\n",
+      static_cast<int>(seed), percent, far[0], far[1], 100 * rms[0], 100 * rms[1], 100 * largest[0], 100 * largest[1]);
+    CHECK(rms[1] <= 1.02 * rms[0]);
+    CHECK(largest[1] <= 1.05 * largest[0]);
+    before += far[0];
+    after += far[1];
   });
   CHECK(before > 0);
   CHECK(after < before);
@@ -991,13 +1085,7 @@ std::vector<int> InteriorSaddleMultiplicity(const std::vector<double>& f, int nx
   {
     for (int i = 1; i + 1 < nx; ++i)
     {
-      const std::array<bool, 6> below = LowerLink(f, nx, i, j);
-      int changes = 0;
-      for (int k = 0; k < 6; ++k)
-      {
-        changes += below[k] != below[(k + 1) % 6] ? 1 : 0;
-      }
-      multiplicity[j * nx + i] = std::max(0, changes / 2 - 1);
+      multiplicity[j * nx + i] = std::max(0, LinkChanges(f, nx, i, j) / 2 - 1);
     }
   }
   return multiplicity;
