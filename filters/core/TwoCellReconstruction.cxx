@@ -1368,8 +1368,9 @@ public:
     : Mesh(mesh)
     , Samples(samples)
     , Vertices(vertices)
-    , Deep(DeepVertices(mesh, vertices, static_cast<Index>(samples.size()), ringInCell, farFromBoundary, this->ByRings))
   {
+    this->Deep =
+      DeepVertices(mesh, vertices, static_cast<Index>(samples.size()), ringInCell, farFromBoundary, this->ByRings);
     // Each vertex's slot among the samples, found once for every round.
     this->SlotOf.reserve(2 * samples.size());
     for (Index k = 0; k < static_cast<Index>(samples.size()); ++k)
@@ -1517,8 +1518,8 @@ private:
   const TriangleMeshTopology& Mesh;
   const std::vector<SurfaceSample>& Samples;
   const Index* Vertices;
-  std::vector<char> ByRings; // before Deep, which DeepVertices fills it with
-  const std::vector<Index> Deep;
+  std::vector<Index> Deep;
+  std::vector<char> ByRings; // per sample: 1 if deep by its two rings, 0 by its distance alone
   std::unordered_map<Index, Index> SlotOf;
   std::vector<double> Values;
 };
@@ -1620,10 +1621,10 @@ int TwoCellReconstruction::StiffenWhereSamplingBreaks(ReconstructedTwoCell& cell
       continue;
     }
     critical = deep.Find(trial);
-    if (DeepCriticalVertices::Better(deep.ScoreOf(critical), fewest, trial.FitReport().MaximumResidual,
-          first.FitReport().MaximumResidual))
+    const DeepCriticalVertices::Score score = deep.ScoreOf(critical);
+    if (DeepCriticalVertices::Better(score, fewest, trial.FitReport().MaximumResidual, first.FitReport().MaximumResidual))
     {
-      fewest = deep.ScoreOf(critical);
+      fewest = score;
       cell.Surface = std::move(trial);
       kept = options;
       outcome |= StiffenedFit;
@@ -1704,10 +1705,10 @@ bool TwoCellReconstruction::OrderWhereSamplingBreaks(ReconstructedTwoCell& cell,
       break;
     }
     critical = deep.Find(trial);
-    if (DeepCriticalVertices::Better(deep.ScoreOf(critical), fewest, trial.FitReport().MaximumResidual,
-          first.FitReport().MaximumResidual))
+    const DeepCriticalVertices::Score score = deep.ScoreOf(critical);
+    if (DeepCriticalVertices::Better(score, fewest, trial.FitReport().MaximumResidual, first.FitReport().MaximumResidual))
     {
-      fewest = deep.ScoreOf(critical);
+      fewest = score;
       cell.Surface = std::move(trial);
       ordered = true;
       stale = 0;
