@@ -231,18 +231,26 @@ checks.check(lowered >= 1, "alternative maps lower the largest miss on Shepard s
 # Terrain windows (issue 15's RMS target, 1.5 % of the range at 2 and 5 %, on crops nothing was
 # tuned on): seeded random crops of the DEMs shipped here, and the Maunga Whau crop whose integer
 # plateaus put a ridge at the foot of a slope, below the valley across a narrow cell, where the
-# fit's aim at F rising along u and v held the cell a fifth of the range above the data (RMS
-# 3.7 %) until that aim was released there (docs/Reconstruction.md, "The axis aim released").
+# fit held the cell a fifth of the range above the data (RMS 3.7 %) until the fit's aim at F
+# rising along u and v was released there (docs/Reconstruction.md, "The axis aim released"); the
+# cause was the solver's pull back towards the paper's surface, and the first fit now stays on
+# the data at 2 % without the release ("Fits no longer pulled back to the paper's surface").
 # The RMS is recomputed here from Reconstructed and the crop's own values.
-def crop_rms(values, percent):
+def crop_errors(values, percent):
+    """RMS and largest error of Reconstructed in units of the crop's range, and the field data."""
     producer = TrivialProducer()
     producer.GetClientSideObject().SetOutput(tt.image_data(values))
     smooth = Smooth1Cells(Input=SimplifyMorseSmaleComplex(Input=MorseSmaleComplex(Input=producer, ScalarField=["POINTS", "f"]),
                                                           PersistenceThreshold=percent))
     out = sm.Fetch(Reconstruct2Cells(Input=smooth))
-    reconstructed = vtk_to_numpy(out.GetPointData().GetArray("Reconstructed"))
-    rms = np.sqrt(np.mean((reconstructed - values.ravel()) ** 2)) / (values.max() - values.min())
-    return rms, out.GetFieldData()
+    difference = vtk_to_numpy(out.GetPointData().GetArray("Reconstructed")) - values.ravel()
+    span = values.max() - values.min()
+    return np.sqrt(np.mean(difference ** 2)) / span, np.abs(difference).max() / span, out.GetFieldData()
+
+
+def crop_rms(values, percent):
+    rms, _, fd = crop_errors(values, percent)
+    return rms, fd
 
 
 def dem(name):
@@ -261,10 +269,24 @@ if tt.find_dataset("r_volcano_maunga_whau.vti"):
         rms, fd = crop_rms(dem("r_volcano_maunga_whau.vti")[0:61, 11:86].copy(), percent)
         label = "Maunga Whau crop i0 11 j0 0 75 x 61 at %d %%" % percent
         checks.check(rms <= 0.015, "%s: RMS %.3f %% of the range <= 1.5 %%" % (label, 100 * rms))
-        checks.check((tt.field_value(fd, "AxisFreeCells") or 0) >= 1, "%s: the released cell is reported" % label)
         checks.equal(tt.field_value(fd, "TopologyVerified"), 1, "%s: verdict" % label)
         print("%s: RMS %.3f %% of the range, %d cells without the axis aim" % (
             label, 100 * rms, tt.field_value(fd, "AxisFreeCells")), flush=True)
+
+# A Saint Helens window (a benchmark crop, docs/Reconstruction.md, "Fits no longer pulled back to
+# the paper's surface") whose fits the solver's pull back towards the paper's surface undid:
+# its rows mix heights of a thousand metres with millimetre margins, and the largest error was
+# 14.3 eps at 2 % and 4.5 eps at 5 % (RMS 2.70 and 2.26 % of the range). L_inf and RMS from
+# Reconstructed and the window's own values.
+if tt.find_dataset("sainthelens_usgs_dem_crop.vti"):
+    window = dem("sainthelens_usgs_dem_crop.vti")[110:380, 102:288].copy()
+    for percent in (2, 5):
+        rms, largest, fd = crop_errors(window, percent)
+        largest /= percent / 100.0
+        label = "Saint Helens window i0 102 j0 110 186 x 270 at %d %%" % percent
+        checks.check(rms <= 0.015, "%s: RMS %.3f %% of the range <= 1.5 %%" % (label, 100 * rms))
+        checks.check(largest <= 3, "%s: largest error %.2f eps <= 3" % (label, largest))
+        print("%s: RMS %.3f %% of the range, largest error %.2f eps" % (label, 100 * rms, largest), flush=True)
 random_ = np.random.default_rng(20261206)
 shipped = [n for n in ("r_volcano_maunga_whau.vti", "rainier_ned1_1970_crop458x306.vti", "sainthelens_usgs_dem_crop.vti",
                        "msh_crater_2007_10m.vti") if tt.find_dataset(n)]
