@@ -30,12 +30,17 @@ double LargestFeasibleStep(const Eigen::VectorXd& atStart, const Eigen::VectorXd
   return t;
 }
 
-// Whether every row of the scaled values `at` (C x, each row times rowScale) meets its bound.
+// Whether row r of the scaled values `at` (C x, each row times rowScale) is below its bound.
+bool BelowBound(const Eigen::VectorXd& at, const Eigen::VectorXd& rowScale, const Eigen::VectorXd& bounds, Eigen::Index r)
+{
+  return rowScale[r] > 0 && at[r] < rowScale[r] * bounds[r];
+}
+
 bool MeetsBounds(const Eigen::VectorXd& at, const Eigen::VectorXd& rowScale, const Eigen::VectorXd& bounds)
 {
   for (Eigen::Index r = 0; r < at.size(); ++r)
   {
-    if (rowScale[r] > 0 && at[r] < rowScale[r] * bounds[r])
+    if (BelowBound(at, rowScale, bounds, r))
     {
       return false;
     }
@@ -221,15 +226,21 @@ bool SolveConstrainedLeastSquares(const Eigen::SparseMatrix<double>& hessian, co
     // where they stopped until every row meets its bound too, a few rounds at most. (Aiming
     // such rows higher instead cut the start off where many rows bind, and the fit fell back on
     // it: 7 of 100 small programs of TestConstrainedLeastSquares's kind.)
-    for (int repair = 0; repair < options.BoundRepairs && !MeetsBounds(c * x, rowScale, bounds); ++repair)
+    for (int repair = 0; repair < options.BoundRepairs; ++repair)
     {
       const Eigen::VectorXd at = c * x;
+      bool missed = false;
       for (Eigen::Index r = 0; r < m; ++r)
       {
-        if (rowScale[r] > 0 && at[r] < rowScale[r] * bounds[r])
+        if (BelowBound(at, rowScale, bounds, r))
         {
           weight[r] *= options.BoundRepairWeight;
+          missed = true;
         }
+      }
+      if (!missed)
+      {
+        break;
       }
       ctc = ct * weight.asDiagonal() * c;
       if (!factor())

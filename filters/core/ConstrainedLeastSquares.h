@@ -55,7 +55,7 @@ struct ConstrainedLeastSquaresReport
   int Iterations = 0;
   bool Converged = false;       // the ADMM tolerances were met
   bool UnconstrainedFeasible = false; // the unconstrained minimizer met every row: it is the answer
-  int BoundRepairs = 3;         // rounds that aimed rows left below their bounds higher
+  int BoundRepairs = 0;         // rounds that weighted rows left below their bounds (options' BoundRepairs)
   double PulledBack = 0;        // 1 - t: how far the answer was pulled towards x_f
   double Objective = 0;         // at the returned x
   double FeasibleObjective = 0; // at x_f
