@@ -103,7 +103,7 @@ public:
   // critical points deep inside its cell (TwoCellReconstruction::StiffeningRounds; 0: none).
   int StiffeningRounds = 5;
   // Then the ordering rounds of the points left (TwoCellReconstruction::OrderingRounds; 0: none).
-  int OrderingRounds = 4;
+  int OrderingRounds = 8;
   // Both also treat critical points farther than this many grid spacings from the smoothed
   // 1-cells where two rings of neighbours reach past a 1-cell (TwoCellReconstruction::
   // FarFromOneCells; 2: where Verify's count calls them far; 0: the two rings only).

@@ -261,7 +261,7 @@ public:
   // (from the first fit, with the kept stiffening) ask each such vertex's neighbours to be above
   // or below it by a linear order along the local rise, with a slope of OrderingSlope times
   // the cell's sample range per unit of the square (OrderWhereSamplingBreaks; 0 rounds: none).
-  int OrderingRounds = 4;
+  int OrderingRounds = 8;
   double OrderingSlope = 0.005;
   // A vertex whose ring lies in its cell but whose second ring does not also counts as inside
   // the cell for the stiffening and ordering rounds when it lies farther than this from the

@@ -563,7 +563,7 @@ TEST_CASE(OrderingTakesOutWhatStiffeningLeaves)
   int before = 0, after = 0;
   ForShepardFields150(40, 44, FiveOrTwentyFive, [&](std::uint64_t seed, int percent, const GridField& shepard, Pipeline& p) {
     const DeepCriticalPoints stiffened = CountDeepCriticalPoints(shepard, p, 5, 0);
-    const DeepCriticalPoints ordered = CountDeepCriticalPoints(shepard, p, 5, 4);
+    const DeepCriticalPoints ordered = CountDeepCriticalPoints(shepard, p, 5, FieldReconstruction().OrderingRounds);
     CHECK(stiffened.OrderedCells == 0);
     CHECK(ordered.Deep == stiffened.Deep || ordered.OrderedCells > 0);
     std::printf("  shepard 150^2 seed %d at %d %%: %d -> %d critical points of F o Phi deep inside the cells, "
