@@ -115,6 +115,7 @@ constexpr const char* ErasedLoops = "ErasedLoops";
 constexpr const char* DroppedCuts = "DroppedCuts";
 constexpr const char* AdaptedPieces = "AdaptedPieces";
 constexpr const char* RiseKnotPieces = "RiseKnotPieces";
+constexpr const char* ContactKnotPieces = "ContactKnotPieces";
 constexpr const char* CurveHeightPieces = "CurveHeightPieces";
 constexpr const char* RefinedPieces = "RefinedPieces";
 constexpr const char* PolylinePieces = "PolylinePieces";

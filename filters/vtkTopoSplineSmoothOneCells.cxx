@@ -64,6 +64,7 @@ void WriteSmoothingReport(const topospline::OneCellSmoothingResult& result, int 
   AddFieldNumbers(fd, names::DroppedCuts, { static_cast<double>(result.DroppedCuts) });
   AddFieldNumbers(fd, names::AdaptedPieces, { static_cast<double>(result.AdaptedPieces) });
   AddFieldNumbers(fd, names::RiseKnotPieces, { static_cast<double>(result.RiseKnotPieces) });
+  AddFieldNumbers(fd, names::ContactKnotPieces, { static_cast<double>(result.ContactKnotPieces) });
   AddFieldNumbers(fd, names::CurveHeightPieces, { static_cast<double>(result.CurveHeightPieces) });
   AddFieldNumbers(fd, names::RefinedPieces, { static_cast<double>(result.RefinedPieces) });
   AddFieldNumbers(fd, names::PolylinePieces, { static_cast<double>(result.PolylinePieces) });

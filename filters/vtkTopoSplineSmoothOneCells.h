@@ -10,13 +10,14 @@
  * plane with the same CurveSegments knots, both converted to CurveSegments cubic Beziers.
  * Pieces of fewer jagged edges than CurveSegments get the smallest divisor of it that gives
  * each edge a segment (at least 2).
- * Where smoothed curves would cross, the pieces involved get more segments.
+ * Where smoothed curves would cross, the pieces involved get more segments (on long pieces,
+ * crowded where the other piece comes near).
  *
  * Output: the input blocks, plus "SmoothedOneCells" (one VTK_BEZIER_CURVE cell of degree 3
  * per Bezier segment, control points in the plane of the input, point data "Height": the
  * height's Bezier ordinates) and "SampledOneCells" (every 1-cell densely sampled as a
  * polyline with "Height"). Field data: CurveSegments, ShortPieces, AdaptedPieces,
- * RiseKnotPieces, CurveHeightPieces, RefinedPieces, RemainingCrossings, PiecesOutsideDomain, L1Error and
+ * RiseKnotPieces, ContactKnotPieces, CurveHeightPieces, RefinedPieces, RemainingCrossings, PiecesOutsideDomain, L1Error and
  * UnconstrainedL1Error (sums over the pieces).
  */
 #pragma once

@@ -1141,6 +1141,9 @@ public:
     return this->Report(crossing);
   }
 
+  // The pairs found (a piece paired with itself: it passes a node not its own too closely).
+  const std::set<std::pair<Index, Index>>& CrossingPairs() const { return this->Pairs; }
+
 private:
   struct SegmentRef
   {
@@ -1632,11 +1635,15 @@ bool OneCellSmoothing::FollowPolyline(SmoothedPiece& piece, const std::vector<Sm
   p[1] = nodes[piece.StartNode].Position[1];
   p[2 * edges] = nodes[piece.EndNode].Position[0];
   p[2 * edges + 1] = nodes[piece.EndNode].Position[1];
+  // Each edge's share of the parameter: its length, or its parameter step where the knots
+  // crowd near contacts (the height keeps those parameters).
+  const bool contactKnots = piece.ContactKnots && piece.Parameters.size() == piece.Points.size() / 2;
   std::vector<double> length(edges);
   double total = 0;
   for (int e = 0; e < edges; ++e)
   {
-    length[e] = std::hypot(p[2 * e + 2] - p[2 * e], p[2 * e + 3] - p[2 * e + 1]);
+    length[e] = contactKnots ? piece.Parameters[e + 1] - piece.Parameters[e]
+                             : std::hypot(p[2 * e + 2] - p[2 * e], p[2 * e + 3] - p[2 * e + 1]);
     total += length[e];
   }
   // Largest remainders of the length shares of the segments beyond one per edge.
@@ -1794,6 +1801,139 @@ int RaisedSegments(int current, int asked)
   }
   return asked;
 }
+
+// Contact knots (RepairCrossings): a path sample of a crossing piece is in contact where it
+// lies within ContactPathReach of the other piece's jagged path, or where the piece's curve at
+// its parameter lies within ContactCurveReach of the other's curve (working-frame units, about
+// grid spacings; paths never cross, so where curves do, each has strayed from its path).
+constexpr double ContactPathReach = 2;
+constexpr double ContactCurveReach = 1;
+// Each raise multiplies the density of a crossing piece's knots on its contacts by this.
+constexpr double ContactDensityGrowth = 4;
+// Knots crowd at contacts only on pieces with at least this many edges per segment.
+constexpr int ContactSamplesPerSegment = 4;
+
+// Marks in `contact` (one flag per path sample) the samples of `piece` in contact with another
+// piece or with nodes: `otherPath` and `otherCurve` (x y pairs) are that piece's jagged path
+// and its sampled curve, or the nodes' positions for both. Where the curves come near, the
+// samples a segment of the piece's curve either side count too: the crossing lies between.
+void MarkContacts(const SmoothedPiece& piece, const std::vector<double>& otherPath,
+  const std::vector<double>& otherCurve, std::vector<char>& contact)
+{
+  const auto nearAny = [](const double* x, const std::vector<double>& points, double reach) {
+    for (std::size_t j = 0; j + 1 < points.size(); j += 2)
+    {
+      const double dx = points[j] - x[0], dy = points[j + 1] - x[1];
+      if (dx * dx + dy * dy < reach * reach)
+      {
+        return true;
+      }
+    }
+    return false;
+  };
+  std::vector<double> near;
+  const std::size_t count = piece.Values.size();
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    contact[i] = contact[i] || nearAny(&piece.Points[2 * i], otherPath, ContactPathReach);
+    double xy[2];
+    piece.Curve.Evaluate(piece.Parameters[i], xy);
+    if (nearAny(xy, otherCurve, ContactCurveReach))
+    {
+      near.push_back(piece.Parameters[i]);
+    }
+  }
+  const double reach = 1.0 / piece.Segments;
+  for (std::size_t i = 0, h = 0; i < count && !near.empty(); ++i)
+  {
+    while (h + 1 < near.size() && near[h] < piece.Parameters[i] - reach)
+    {
+      ++h;
+    }
+    contact[i] = contact[i] || std::abs(near[h] - piece.Parameters[i]) <= reach;
+  }
+}
+
+// The positions (x y pairs) of the nodes within `reach` of the bounding box of a piece's path
+// and control points, but for its own ends.
+std::vector<double> NodesNear(const SmoothedPiece& piece, const std::vector<SmoothingNode>& nodes, double reach)
+{
+  double box[4] = { 1e300, -1e300, 1e300, -1e300 };
+  for (const std::vector<double>* points : { &piece.Points, &piece.Curve.ControlPoints })
+  {
+    for (std::size_t i = 0; i + 1 < points->size(); i += 2)
+    {
+      box[0] = std::min(box[0], (*points)[i]);
+      box[1] = std::max(box[1], (*points)[i]);
+      box[2] = std::min(box[2], (*points)[i + 1]);
+      box[3] = std::max(box[3], (*points)[i + 1]);
+    }
+  }
+  const double* ends[2] = { nodes[piece.StartNode].Position, nodes[piece.EndNode].Position };
+  std::vector<double> near;
+  for (const SmoothingNode& node : nodes)
+  {
+    const double* x = node.Position;
+    if (x[0] >= box[0] - reach && x[0] <= box[1] + reach && x[1] >= box[2] - reach && x[1] <= box[3] + reach &&
+      !(x[0] == ends[0][0] && x[1] == ends[0][1]) && !(x[0] == ends[1][0] && x[1] == ends[1][1]))
+    {
+      near.insert(near.end(), { x[0], x[1] });
+    }
+  }
+  return near;
+}
+
+// Parameters of a crossing piece about to get `segments` segments (see PieceContacts): arc
+// length, but the edges with a sample in contact (see MarkContacts) weigh more, so that the
+// contacts get ContactDensityGrowth times the density of knots they had (at most one segment
+// per edge in contact) and the rest of the piece what is left, never less than the density it
+// had before the repair. The curve then follows its path where another piece or a node comes
+// near, and stays as smooth elsewhere: raising k evenly took a msh_crater piece of 300
+// samples to 256 segments for two contacts, and the 2-cell beside it past the grids stage 4
+// fits. (All of the new knots on the contacts at once made the curve follow a staircase
+// there, which crossed the smooth pieces meeting it at its node: Shepard seed 5, 150^2.)
+// Plain arc length where no edge, or every edge, is in contact, or where the contacts would
+// get no more than an even share.
+std::vector<double> ArcLengthWithContacts(const std::vector<double>& points, int segments, PieceContacts& contacts)
+{
+  std::vector<double> parameters = MonotoneBSplineFit::NormalizedArcLength(points);
+  const std::size_t count = parameters.size();
+  const std::vector<char>& near = contacts.Near;
+  const auto inContact = [&near](std::size_t i) { return near[i - 1] || near[i]; };
+  double length = 0;
+  std::size_t edges = 0;
+  for (std::size_t i = 1; i < count; ++i)
+  {
+    length += inContact(i) ? parameters[i] - parameters[i - 1] : 0;
+    edges += inContact(i) ? 1 : 0;
+  }
+  if (!(length > 0) || !(length < 1))
+  {
+    return parameters;
+  }
+  // Knots on the contacts: segments per unit of the whole piece's parameter, times length.
+  const double onContacts = std::min({ ContactDensityGrowth * contacts.Density * length, static_cast<double>(edges),
+    segments - contacts.BaseSegments * (1.0 - length) });
+  const double share = onContacts / segments;
+  if (share <= length)
+  {
+    contacts.Density = segments;
+    return parameters;
+  }
+  contacts.Density = onContacts / length;
+  const double weight = share * (1.0 - length) / ((1.0 - share) * length);
+  std::vector<double> warped(count, 0.0);
+  for (std::size_t i = 1; i < count; ++i)
+  {
+    warped[i] = warped[i - 1] + (parameters[i] - parameters[i - 1]) * (inContact(i) ? weight : 1.0);
+  }
+  for (std::size_t i = 1; i + 1 < count; ++i)
+  {
+    warped[i] /= warped.back();
+  }
+  warped.back() = 1.0;
+  return warped;
+}
 } // namespace
 
 namespace
@@ -1871,6 +2011,28 @@ public:
       }
     }
     return true;
+  }
+
+  // Whether a 2-cell beside `piece` has, with every piece q at count(q) segments, a grid that
+  // stage 4 fits (TwoCellReconstruction::MaximumFittedGridSize). A cell left alone by SidesOf
+  // counts as one.
+  bool BesideAFittedCell(Index piece, const std::function<int(Index)>& count) const
+  {
+    for (const Index o : this->Result.Pieces[piece].OneCells)
+    {
+      for (const Index c : this->CellsOfOneCell[o])
+      {
+        const TwoCellSides* sides = this->SidesOf(c);
+        std::array<std::vector<int>, 4> multipliers;
+        const int grid =
+          sides ? ChooseGridLayout(TwoCellSideCounts(*sides, count), this->Stage4.MaximumGridSize, multipliers) : 0;
+        if (!sides || (grid > 0 && grid <= this->Stage4.MaximumFittedGridSize))
+        {
+          return true;
+        }
+      }
+    }
+    return false;
   }
 
 private:
@@ -2467,6 +2629,89 @@ bool OneCellSmoothing::FitInParallel(OneCellSmoothingResult& result, const std::
 }
 
 //------------------------------------------------------------------------------
+void OneCellSmoothing::PlaceContactKnots(OneCellSmoothingResult& result,
+  const std::set<std::pair<Index, Index>>& pairs, const std::vector<Index>& raise,
+  const std::function<bool(Index)>& besideAFittedCell, std::map<Index, PieceContacts>& contacts) const
+{
+  std::map<Index, std::vector<Index>> partners; // InvalidIndex: a node not its own
+  for (const auto& pair : pairs)
+  {
+    partners[pair.first].push_back(pair.second == pair.first ? InvalidIndex : pair.second);
+    if (pair.second != pair.first)
+    {
+      partners[pair.second].push_back(pair.first);
+    }
+  }
+  const auto sampledCurve = [this](const SmoothedPiece& piece) {
+    const int count = piece.Segments * this->SamplesPerSegment + 1;
+    std::vector<double> samples(2 * count);
+    for (int s = 0; s < count; ++s)
+    {
+      piece.Curve.Evaluate(static_cast<double>(s) / (count - 1), &samples[2 * s]);
+    }
+    return samples;
+  };
+  for (Index p : raise)
+  {
+    SmoothedPiece& piece = result.Pieces[p];
+    const int raised = RaisedSegments(piece.Segments, this->Segments);
+    PieceContacts& contactsOfPiece =
+      contacts.emplace(p, PieceContacts{ piece.Segments, static_cast<double>(piece.Segments), {}, {}, false })
+        .first->second;
+    // Only on pieces with ContactSamplesPerSegment samples per segment and more: on shorter
+    // ones the knots between the contacts are too few to follow the path, and even knots
+    // soon reach a segment per edge anyway. And only beside a 2-cell whose grid stage 4 still
+    // fits with the round's raised counts: what the crowded knots save is a fitted interior; a cell that
+    // keeps the paper's interior follows its boundary, which even knots fit more closely (a
+    // Saint Helens crop at 25 %, k = 17, whose three cells got grids of 68 from the raise:
+    // 1.31 -> 1.67 eps with crowded knots).
+    const bool longPiece = static_cast<int>(piece.Values.size()) - 1 >= ContactSamplesPerSegment * raised;
+    contactsOfPiece.Even = contactsOfPiece.Even || (longPiece && !besideAFittedCell(p));
+    const std::vector<Index>& now = partners[p];
+    if (!contactsOfPiece.Even && longPiece && !now.empty())
+    {
+      contactsOfPiece.Near.resize(piece.Values.size(), 0);
+      for (Index q : now)
+      {
+        std::vector<char> near(piece.Values.size(), 0);
+        if (q != InvalidIndex)
+        {
+          MarkContacts(piece, result.Pieces[q].Points, sampledCurve(result.Pieces[q]), near);
+        }
+        else
+        {
+          const std::vector<double> nodes = NodesNear(piece, result.Nodes, ContactPathReach);
+          MarkContacts(piece, nodes, nodes, near);
+        }
+        // A piece whose crowded knots made it cross a piece or node it did not cross before,
+        // away from its contacts, goes back to even knots for good: the sparser knots between
+        // its contacts, or the switch between dense and sparse, made it hook there.
+        bool touches = false;
+        for (std::size_t i = 0; i < near.size(); ++i)
+        {
+          touches = touches || (near[i] && contactsOfPiece.Near[i]);
+          contactsOfPiece.Near[i] = contactsOfPiece.Near[i] || near[i];
+        }
+        contactsOfPiece.Even = contactsOfPiece.Even ||
+          (piece.ContactKnots && !touches && contactsOfPiece.Partners.count(q) == 0);
+        contactsOfPiece.Partners.insert(q);
+      }
+    }
+    if (contactsOfPiece.Even || !longPiece || now.empty())
+    {
+      if (piece.ContactKnots)
+      {
+        piece.Parameters = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
+        piece.ContactKnots = false;
+      }
+      continue;
+    }
+    std::vector<double> parameters = ArcLengthWithContacts(piece.Points, raised, contactsOfPiece);
+    piece.ContactKnots = piece.ContactKnots || parameters != piece.Parameters;
+    piece.Parameters = std::move(parameters);
+  }
+}
+
 bool OneCellSmoothing::RepairCrossings(const MorseSmaleComplex& complex,
   OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const
 {
@@ -2475,6 +2720,8 @@ bool OneCellSmoothing::RepairCrossings(const MorseSmaleComplex& complex,
   std::set<Index> crossing;
   int pairs = detector.FindCrossings(crossing);
   std::set<Index> adapted, followsPolyline;
+  std::map<Index, PieceContacts> contacts;
+  std::unique_ptr<CellGrids> cellGrids; // made for the first raise with crowded knots
   while (pairs > 0)
   {
     // Up to MaximumSegments, or to the piece's number of samples for long pieces: with about
@@ -2522,6 +2769,22 @@ bool OneCellSmoothing::RepairCrossings(const MorseSmaleComplex& complex,
         raise.push_back(p);
       }
     }
+    if (this->CrowdKnotsAtContacts)
+    {
+      if (!cellGrids)
+      {
+        cellGrids = std::make_unique<CellGrids>(complex, result);
+      }
+      // With every piece of this round at its raised count.
+      const std::set<Index> raised(raise.begin(), raise.end());
+      const auto besideAFittedCell = [&](Index p) {
+        return cellGrids->BesideAFittedCell(p, [&](Index q) {
+          const int segments = result.Pieces[q].Segments;
+          return raised.count(q) ? RaisedSegments(segments, this->Segments) : segments;
+        });
+      };
+      this->PlaceContactKnots(result, detector.CrossingPairs(), raise, besideAFittedCell, contacts);
+    }
     if (!this->FitInParallel(
           result, raise, [this](const SmoothedPiece& piece) { return RaisedSegments(piece.Segments, this->Segments); },
           domainBounds, error))
@@ -2557,6 +2820,8 @@ bool OneCellSmoothing::RepairCrossings(const MorseSmaleComplex& complex,
     [](const SmoothedPiece& piece) { return piece.RiseKnots; }));
   result.CurveHeightPieces = static_cast<int>(std::count_if(result.Pieces.begin(), result.Pieces.end(),
     [](const SmoothedPiece& piece) { return piece.HeightAlongCurve; }));
+  result.ContactKnotPieces = static_cast<int>(std::count_if(result.Pieces.begin(), result.Pieces.end(),
+    [](const SmoothedPiece& piece) { return piece.ContactKnots; }));
   result.RemainingCrossings = pairs;
   return true;
 }

@@ -10,11 +10,26 @@
 #include "MorseSmaleComplex.h"
 
 #include <functional>
+#include <map>
+#include <set>
 #include <string>
 #include <vector>
 
 namespace topospline
 {
+// A crossing piece during RepairCrossings: its segments before its first raise, the density
+// of its knots on its contacts (segments per unit of its whole parameter range), its path
+// samples near other pieces or nodes and the pieces it crossed (both accumulated over the
+// repair's rounds), and whether it went back to even knots.
+struct PieceContacts
+{
+  int BaseSegments = 0;
+  double Density = 0;
+  std::vector<char> Near;
+  std::set<Index> Partners; // the pieces it crossed (InvalidIndex: a node)
+  bool Even = false;        // back to even knots for good
+};
+
 // A critical point, a junction point or a corner of the domain: where pieces start and end.
 struct SmoothingNode
 {
@@ -43,6 +58,7 @@ struct SmoothedPiece
   std::vector<double> Parameters;  // arc length and rise (MonotoneBSplineFit::ArcLengthAndRise)
   int Segments = 0;                // k used (more than asked where crossings forced it)
   bool RiseKnots = false;          // Parameters follow the rise too (else arc length only)
+  bool ContactKnots = false;       // Parameters crowd the knots where other pieces came near (RepairCrossings)
   CubicBezierSpline Curve;         // Dimension 2
   CubicBezierSpline Height;        // Dimension 1, strictly increasing
   double L1Error = 0;              // monotone fit, over the interior samples
@@ -66,6 +82,7 @@ struct OneCellSmoothingResult
   int SuggestedSegments = 0;
   int AdaptedPieces = 0;       // pieces whose k was raised to remove crossings
   int RiseKnotPieces = 0;      // pieces whose knots follow their rise (MonotoneBSplineFit::ArcLengthAndRise)
+  int ContactKnotPieces = 0;   // pieces whose knots crowd where other pieces came near (RepairCrossings)
   int CurveHeightPieces = 0;   // pieces whose height fits the field along their curve (FieldAt)
   int RefinedPieces = 0;       // pieces whose k was doubled because the height missed (HeightTolerance)
   int PolylinePieces = 0;      // of them, pieces that still crossed at their largest k and follow
@@ -129,6 +146,9 @@ public:
   // (working-frame units, about grid spacings) or not much farther than with knots uniform in
   // arc length (see FitPiece).
   double RiseCurveTolerance = 0.25;
+  // The crossing repair crowds a long piece's new knots where the other piece (or a node)
+  // comes near, keeping the density of the rest (ContactKnots; false: k rises evenly).
+  bool CrowdKnotsAtContacts = true;
 
   // x, y (the complex's coordinates) of the domain's boundary vertices, for a mesh whose
   // corners need not be the corners of domainBounds (a jittered grid: a 1-cell's curve along
@@ -186,6 +206,13 @@ private:
   // RiseKnotPieces, RemainingCrossings).
   bool RepairCrossings(const MorseSmaleComplex& complex, OneCellSmoothingResult& result, const double domainBounds[4],
     std::string& error) const;
+  // Before the pieces in `raise` get more segments: on those with several edges per new
+  // segment and beside a 2-cell that stage 4 fits with the raised counts (besideAFittedCell),
+  // the knots crowd where their crossing partners in `pairs` (a piece with itself: a node) come
+  // near, instead of spreading evenly (sets ContactKnots; see ArcLengthWithContacts).
+  void PlaceContactKnots(OneCellSmoothingResult& result, const std::set<std::pair<Index, Index>>& pairs,
+    const std::vector<Index>& raise, const std::function<bool(Index)>& besideAFittedCell,
+    std::map<Index, PieceContacts>& contacts) const;
   // Fits the listed pieces in parallel, each with segmentsOf(piece) segments (only the height,
   // on the curve as it is, where keepCurve(piece) says so: RefitHeightOnCurve); false with the
   // first failing piece in list order named in `error`.
