@@ -420,6 +420,33 @@ bool SidesReachOneGrid(const std::array<std::vector<int>, 4>& sides, int limit, 
   }
   return false;
 }
+
+// For every 2-cell whose sides assemble (AssembleTwoCellSides): whether its pieces' counts
+// reach a common grid within `limit` (SidesReachOneGrid) and the grid reached.
+void ForEachCellGrid(const Stage3Input& input, const OneCellSmoothingResult& result, int limit,
+  const std::function<void(bool, int)>& visit)
+{
+  std::string error;
+  for (const TwoCell& cell : input.Simplified.Complex.TwoCells)
+  {
+    TwoCellSides sides;
+    if (!AssembleTwoCellSides(cell, result, sides, error))
+    {
+      continue;
+    }
+    std::array<std::vector<int>, 4> counts;
+    for (int s = 0; s < 4; ++s)
+    {
+      for (Index p : sides.Pieces[s])
+      {
+        counts[s].push_back(result.Pieces[p].Segments);
+      }
+    }
+    int reached = 0;
+    const bool within = SidesReachOneGrid(counts, limit, reached);
+    visit(within, reached);
+  }
+}
 } // namespace
 
 TEST_CASE(RaisedCountsKeepACommonGridPerCell)
@@ -442,31 +469,16 @@ TEST_CASE(RaisedCountsKeepACommonGridPerCell)
         OneCellSmoothingResult result;
         CHECK(smoothing.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, result, error));
         ++runs;
-        for (const TwoCell& cell : input.Simplified.Complex.TwoCells)
-        {
-          TwoCellSides sides;
-          if (!AssembleTwoCellSides(cell, result, sides, error))
-          {
-            continue;
-          }
-          std::array<std::vector<int>, 4> counts;
-          for (int s = 0; s < 4; ++s)
-          {
-            for (Index p : sides.Pieces[s])
-            {
-              counts[s].push_back(result.Pieces[p].Segments);
-            }
-          }
-          int reached = 0;
+        ForEachCellGrid(input, result, limit, [&](bool within, int reached) {
           ++cells;
-          if (!SidesReachOneGrid(counts, limit, reached))
+          if (!within)
           {
             ++beyond;
             std::printf("  k %d, %.0f %%, seed %llu: a cell's sides reach no common grid up to %d\n", k, percent,
               static_cast<unsigned long long>(seed), limit);
           }
           largest = std::max(largest, reached);
-        }
+        });
       }
     }
   }
@@ -1198,25 +1210,10 @@ TEST_CASE(CrossingRepairsCrowdKnotsWhereThePiecesMeet)
             segments[crowd] += piece.Segments;
             pieceSegments[crowd] = std::max(pieceSegments[crowd], piece.Segments);
           }
-          for (const TwoCell& cell : input.Simplified.Complex.TwoCells)
-          {
-            TwoCellSides sides;
-            if (!AssembleTwoCellSides(cell, result, sides, error))
-            {
-              continue;
-            }
-            std::array<std::vector<int>, 4> counts;
-            for (int s = 0; s < 4; ++s)
-            {
-              for (Index p : sides.Pieces[s])
-              {
-                counts[s].push_back(result.Pieces[p].Segments);
-              }
-            }
-            int reached = 0;
-            beyond[crowd] += SidesReachOneGrid(counts, limit, reached) ? 0 : 1;
+          ForEachCellGrid(input, result, limit, [&](bool within, int reached) {
+            beyond[crowd] += within ? 0 : 1;
             largest[crowd] = std::max(largest[crowd], reached);
-          }
+          });
         }
         ++runs;
         newContacts += std::max(0, contacts[1] + throughNodes[1] - contacts[0] - throughNodes[0]);
