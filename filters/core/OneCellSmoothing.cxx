@@ -1144,6 +1144,19 @@ public:
   // The pairs found (a piece paired with itself: it passes a node not its own too closely).
   const std::set<std::pair<Index, Index>>& CrossingPairs() const { return this->Pairs; }
 
+  // The piece's current samples (x y pairs) and their number.
+  const double* Samples(Index p, std::size_t& count) const
+  {
+    if (this->Moved[p])
+    {
+      const std::vector<double>& samples = this->Resampled.at(p);
+      count = samples.size() / 2;
+      return samples.data();
+    }
+    count = this->Offset[p + 1] - this->Offset[p];
+    return this->Flat.data() + 2 * this->Offset[p];
+  }
+
 private:
   struct SegmentRef
   {
@@ -1190,19 +1203,6 @@ private:
     {
       this->Result.Pieces[p].Curve.Evaluate(static_cast<double>(s) / (count - 1), samples + 2 * s);
     }
-  }
-
-  // The piece's current samples (x y pairs) and their number.
-  const double* Samples(Index p, std::size_t& count) const
-  {
-    if (this->Moved[p])
-    {
-      const std::vector<double>& samples = this->Resampled.at(p);
-      count = samples.size() / 2;
-      return samples.data();
-    }
-    count = this->Offset[p + 1] - this->Offset[p];
-    return this->Flat.data() + 2 * this->Offset[p];
   }
 
   std::size_t SegmentCount(Index p) const
@@ -1814,16 +1814,17 @@ constexpr double ContactDensityGrowth = 4;
 constexpr int ContactSamplesPerSegment = 4;
 
 // Marks in `contact` (one flag per path sample) the samples of `piece` in contact with another
-// piece or with nodes: `otherPath` and `otherCurve` (x y pairs) are that piece's jagged path
-// and its sampled curve, or the nodes' positions for both. Where the curves come near, the
-// samples a segment of the piece's curve either side count too: the crossing lies between.
-void MarkContacts(const SmoothedPiece& piece, const std::vector<double>& otherPath,
-  const std::vector<double>& otherCurve, std::vector<char>& contact)
+// piece or with nodes: `otherPath` and the `curveCount` points of `otherCurve` (x y pairs) are
+// that piece's jagged path and its sampled curve, or the nodes' positions for both. Where the
+// curves come near, the samples a segment of the piece's curve either side count too: the
+// crossing lies between.
+void MarkContacts(const SmoothedPiece& piece, const std::vector<double>& otherPath, const double* otherCurve,
+  std::size_t curveCount, std::vector<char>& contact)
 {
-  const auto nearAny = [](const double* x, const std::vector<double>& points, double reach) {
-    for (std::size_t j = 0; j + 1 < points.size(); j += 2)
+  const auto nearAny = [](const double* x, const double* points, std::size_t count, double reach) {
+    for (std::size_t j = 0; j < count; ++j)
     {
-      const double dx = points[j] - x[0], dy = points[j + 1] - x[1];
+      const double dx = points[2 * j] - x[0], dy = points[2 * j + 1] - x[1];
       if (dx * dx + dy * dy < reach * reach)
       {
         return true;
@@ -1835,10 +1836,10 @@ void MarkContacts(const SmoothedPiece& piece, const std::vector<double>& otherPa
   const std::size_t count = piece.Values.size();
   for (std::size_t i = 0; i < count; ++i)
   {
-    contact[i] = contact[i] || nearAny(&piece.Points[2 * i], otherPath, ContactPathReach);
+    contact[i] = contact[i] || nearAny(&piece.Points[2 * i], otherPath.data(), otherPath.size() / 2, ContactPathReach);
     double xy[2];
     piece.Curve.Evaluate(piece.Parameters[i], xy);
-    if (nearAny(xy, otherCurve, ContactCurveReach))
+    if (nearAny(xy, otherCurve, curveCount, ContactCurveReach))
     {
       near.push_back(piece.Parameters[i]);
     }
@@ -1882,6 +1883,19 @@ std::vector<double> NodesNear(const SmoothedPiece& piece, const std::vector<Smoo
   }
   return near;
 }
+
+// A crossing piece during RepairCrossings: its segments before its first raise, the density
+// of its knots on its contacts (segments per unit of its whole parameter range), its path
+// samples near other pieces or nodes and the pieces it crossed (both accumulated over the
+// repair's rounds), and whether it went back to even knots.
+struct PieceContacts
+{
+  int BaseSegments = 0;
+  double Density = 0;
+  std::vector<char> Near;
+  std::set<Index> Partners; // the pieces it crossed (InvalidIndex: a node)
+  bool Even = false;        // back to even knots for good
+};
 
 // Parameters of a crossing piece about to get `segments` segments (see PieceContacts): arc
 // length, but the edges with a sample in contact (see MarkContacts) weigh more, so that the
@@ -2629,12 +2643,19 @@ bool OneCellSmoothing::FitInParallel(OneCellSmoothingResult& result, const std::
 }
 
 //------------------------------------------------------------------------------
-void OneCellSmoothing::PlaceContactKnots(OneCellSmoothingResult& result,
-  const std::set<std::pair<Index, Index>>& pairs, const std::vector<Index>& raise,
-  const std::function<bool(Index)>& besideAFittedCell, std::map<Index, PieceContacts>& contacts) const
+namespace
+{
+// Before the pieces in `raise` get more segments (RaisedSegments of their count and `asked`):
+// on those with ContactSamplesPerSegment edges per new segment and beside a 2-cell that stage
+// 4 fits with the raised counts (besideAFittedCell), the knots crowd where their crossing
+// partners in the detector's pairs (a piece with itself: a node) come near, instead of
+// spreading evenly (sets ContactKnots; see ArcLengthWithContacts). The partners' curves are
+// the detector's samples of them.
+void PlaceContactKnots(OneCellSmoothingResult& result, const CrossingDetector& detector, const std::vector<Index>& raise,
+  int asked, const std::function<bool(Index)>& besideAFittedCell, std::map<Index, PieceContacts>& contacts)
 {
   std::map<Index, std::vector<Index>> partners; // InvalidIndex: a node not its own
-  for (const auto& pair : pairs)
+  for (const auto& pair : detector.CrossingPairs())
   {
     partners[pair.first].push_back(pair.second == pair.first ? InvalidIndex : pair.second);
     if (pair.second != pair.first)
@@ -2642,46 +2663,43 @@ void OneCellSmoothing::PlaceContactKnots(OneCellSmoothingResult& result,
       partners[pair.second].push_back(pair.first);
     }
   }
-  const auto sampledCurve = [this](const SmoothedPiece& piece) {
-    const int count = piece.Segments * this->SamplesPerSegment + 1;
-    std::vector<double> samples(2 * count);
-    for (int s = 0; s < count; ++s)
-    {
-      piece.Curve.Evaluate(static_cast<double>(s) / (count - 1), &samples[2 * s]);
-    }
-    return samples;
-  };
   for (Index p : raise)
   {
     SmoothedPiece& piece = result.Pieces[p];
-    const int raised = RaisedSegments(piece.Segments, this->Segments);
-    PieceContacts& contactsOfPiece =
-      contacts.emplace(p, PieceContacts{ piece.Segments, static_cast<double>(piece.Segments), {}, {}, false })
-        .first->second;
+    const int raised = RaisedSegments(piece.Segments, asked);
     // Only on pieces with ContactSamplesPerSegment samples per segment and more: on shorter
     // ones the knots between the contacts are too few to follow the path, and even knots
     // soon reach a segment per edge anyway. And only beside a 2-cell whose grid stage 4 still
-    // fits with the round's raised counts: what the crowded knots save is a fitted interior; a cell that
-    // keeps the paper's interior follows its boundary, which even knots fit more closely (a
-    // Saint Helens crop at 25 %, k = 17, whose three cells got grids of 68 from the raise:
-    // 1.31 -> 1.67 eps with crowded knots).
+    // fits with the round's raised counts: what the crowded knots save is a fitted interior; a
+    // cell that keeps the paper's interior follows its boundary, which even knots fit more
+    // closely (a Saint Helens crop at 25 %, k = 17, whose three cells got grids of 68 from the
+    // raise: 1.31 -> 1.67 eps with crowded knots).
     const bool longPiece = static_cast<int>(piece.Values.size()) - 1 >= ContactSamplesPerSegment * raised;
-    contactsOfPiece.Even = contactsOfPiece.Even || (longPiece && !besideAFittedCell(p));
-    const std::vector<Index>& now = partners[p];
-    if (!contactsOfPiece.Even && longPiece && !now.empty())
+    const auto found = partners.find(p);
+    PieceContacts* contactsOfPiece = nullptr;
+    if (longPiece && found != partners.end())
     {
-      contactsOfPiece.Near.resize(piece.Values.size(), 0);
-      for (Index q : now)
+      contactsOfPiece =
+        &contacts.emplace(p, PieceContacts{ piece.Segments, static_cast<double>(piece.Segments), {}, {}, false })
+           .first->second;
+      contactsOfPiece->Even = contactsOfPiece->Even || !besideAFittedCell(p);
+    }
+    if (contactsOfPiece && !contactsOfPiece->Even)
+    {
+      contactsOfPiece->Near.resize(piece.Values.size(), 0);
+      for (Index q : found->second)
       {
         std::vector<char> near(piece.Values.size(), 0);
         if (q != InvalidIndex)
         {
-          MarkContacts(piece, result.Pieces[q].Points, sampledCurve(result.Pieces[q]), near);
+          std::size_t count;
+          const double* curve = detector.Samples(q, count);
+          MarkContacts(piece, result.Pieces[q].Points, curve, count, near);
         }
         else
         {
           const std::vector<double> nodes = NodesNear(piece, result.Nodes, ContactPathReach);
-          MarkContacts(piece, nodes, nodes, near);
+          MarkContacts(piece, nodes, nodes.data(), nodes.size() / 2, near);
         }
         // A piece whose crowded knots made it cross a piece or node it did not cross before,
         // away from its contacts, goes back to even knots for good: the sparser knots between
@@ -2689,15 +2707,15 @@ void OneCellSmoothing::PlaceContactKnots(OneCellSmoothingResult& result,
         bool touches = false;
         for (std::size_t i = 0; i < near.size(); ++i)
         {
-          touches = touches || (near[i] && contactsOfPiece.Near[i]);
-          contactsOfPiece.Near[i] = contactsOfPiece.Near[i] || near[i];
+          touches = touches || (near[i] && contactsOfPiece->Near[i]);
+          contactsOfPiece->Near[i] = contactsOfPiece->Near[i] || near[i];
         }
-        contactsOfPiece.Even = contactsOfPiece.Even ||
-          (piece.ContactKnots && !touches && contactsOfPiece.Partners.count(q) == 0);
-        contactsOfPiece.Partners.insert(q);
+        contactsOfPiece->Even = contactsOfPiece->Even ||
+          (piece.ContactKnots && !touches && contactsOfPiece->Partners.count(q) == 0);
+        contactsOfPiece->Partners.insert(q);
       }
     }
-    if (contactsOfPiece.Even || !longPiece || now.empty())
+    if (!contactsOfPiece || contactsOfPiece->Even)
     {
       if (piece.ContactKnots)
       {
@@ -2706,11 +2724,12 @@ void OneCellSmoothing::PlaceContactKnots(OneCellSmoothingResult& result,
       }
       continue;
     }
-    std::vector<double> parameters = ArcLengthWithContacts(piece.Points, raised, contactsOfPiece);
+    std::vector<double> parameters = ArcLengthWithContacts(piece.Points, raised, *contactsOfPiece);
     piece.ContactKnots = piece.ContactKnots || parameters != piece.Parameters;
     piece.Parameters = std::move(parameters);
   }
 }
+} // namespace
 
 bool OneCellSmoothing::RepairCrossings(const MorseSmaleComplex& complex,
   OneCellSmoothingResult& result, const double domainBounds[4], std::string& error) const
@@ -2783,7 +2802,7 @@ bool OneCellSmoothing::RepairCrossings(const MorseSmaleComplex& complex,
           return raised.count(q) ? RaisedSegments(segments, this->Segments) : segments;
         });
       };
-      this->PlaceContactKnots(result, detector.CrossingPairs(), raise, besideAFittedCell, contacts);
+      PlaceContactKnots(result, detector, raise, this->Segments, besideAFittedCell, contacts);
     }
     if (!this->FitInParallel(
           result, raise, [this](const SmoothedPiece& piece) { return RaisedSegments(piece.Segments, this->Segments); },

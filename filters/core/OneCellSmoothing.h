@@ -10,26 +10,11 @@
 #include "MorseSmaleComplex.h"
 
 #include <functional>
-#include <map>
-#include <set>
 #include <string>
 #include <vector>
 
 namespace topospline
 {
-// A crossing piece during RepairCrossings: its segments before its first raise, the density
-// of its knots on its contacts (segments per unit of its whole parameter range), its path
-// samples near other pieces or nodes and the pieces it crossed (both accumulated over the
-// repair's rounds), and whether it went back to even knots.
-struct PieceContacts
-{
-  int BaseSegments = 0;
-  double Density = 0;
-  std::vector<char> Near;
-  std::set<Index> Partners; // the pieces it crossed (InvalidIndex: a node)
-  bool Even = false;        // back to even knots for good
-};
-
 // A critical point, a junction point or a corner of the domain: where pieces start and end.
 struct SmoothingNode
 {
@@ -206,13 +191,6 @@ private:
   // RiseKnotPieces, RemainingCrossings).
   bool RepairCrossings(const MorseSmaleComplex& complex, OneCellSmoothingResult& result, const double domainBounds[4],
     std::string& error) const;
-  // Before the pieces in `raise` get more segments: on those with several edges per new
-  // segment and beside a 2-cell that stage 4 fits with the raised counts (besideAFittedCell),
-  // the knots crowd where their crossing partners in `pairs` (a piece with itself: a node) come
-  // near, instead of spreading evenly (sets ContactKnots; see ArcLengthWithContacts).
-  void PlaceContactKnots(OneCellSmoothingResult& result, const std::set<std::pair<Index, Index>>& pairs,
-    const std::vector<Index>& raise, const std::function<bool(Index)>& besideAFittedCell,
-    std::map<Index, PieceContacts>& contacts) const;
   // Fits the listed pieces in parallel, each with segmentsOf(piece) segments (only the height,
   // on the curve as it is, where keepCurve(piece) says so: RefitHeightOnCurve); false with the
   // first failing piece in list order named in `error`.
