@@ -2080,7 +2080,14 @@ private:
 
 // How much the rise may count per unit of length, tried in turn (see ArcLengthAndRise): the
 // fit with the best height (BetterHeight) is kept.
-constexpr double RiseRatios[] = { 3, 10 };
+const std::vector<double> RiseRatios = { 3, 10 };
+// On a straight path with fewer than RiseSamplesPerSegment samples per segment also gentler
+// ones: there the curve must advance along the line (FitStraightCurve), and with few samples
+// the least-squares curve for a steep rise does not (a boundary piece of six samples that rises
+// by 64 % of its rise in its first edge: ratio 3 makes its curve turn back, and the parameters
+// FitStraightCurve then reads off the pooled curve miss by 0.56 of the rise where ratio 2 keeps
+// the curve advancing and misses by 0.07).
+const std::vector<double> StraightRiseRatios = { 1, 2, 3, 10 };
 
 // Whether a planar curve stays inside the domain by ClampCurveIntoDomain's margin: its
 // coefficients do (the Bezier control points are convex combinations of them). A curve that
@@ -2137,9 +2144,17 @@ bool IsStraight(const std::vector<double>& points)
 // least-squares coefficients do not advance (parameters that follow a steep rise crowd a few
 // path steps into a whole segment, and a quadratic cannot turn that sharply), their positions
 // along the chord are made to advance (the closest non-decreasing sequence, then a small strict
-// gap), and each sample gets the parameter at which that curve passes through it (the curve
-// advances, so there is one): the height fitted at those parameters then stays where its
-// samples are. The parameters still crowd where the path rises, as the least-squares curve did.
+// gap). There, and on pieces with fewer than RiseSamplesPerSegment samples per segment, each
+// sample gets the parameter at which the curve passes through it (the curve advances, so there
+// is one), so the height fitted at those parameters stays where its samples are: with few
+// samples per segment the least-squares curve passes far from them (a boundary piece of six
+// samples on four segments). With more it passes near them, and the parameters asked for are
+// kept: moving them there too (a terrace's piece of 13 samples missed a cliff by 3 eps where
+// its curve passed, 1.75 eps with them moved) changes which pieces the height refinement
+// raises, and with them stage 4's grids: a Saint Helens crop at 5 % went from 1.03 to 2.03
+// eps, its largest cell's grid 16 -> 12 (docs/Reconstruction.md, "Short boundary pieces that
+// follow a cliff").
+// The parameters still crowd where the path rises, as the least-squares curve does.
 bool FitStraightCurve(const MonotoneBSplineFit& fitter, std::vector<double>& parameters,
   const std::vector<double>& points, PlanarCurveFit& curve)
 {
@@ -2202,26 +2217,27 @@ bool FitStraightCurve(const MonotoneBSplineFit& fitter, std::vector<double>& par
     c[2 * j] = a[0] + along[j] * dx;
     c[2 * j + 1] = a[1] + along[j] * dy;
   }
-  if (!advancing)
+  if (advancing && parameters.size() >= static_cast<std::size_t>(RiseSamplesPerSegment * fitter.Segments + 1))
   {
-    // Bisection on the advancing curve's position along the chord.
-    const auto positionAt = [&](double t) {
-      double xy[2];
-      curve.Spline.Evaluate(t, xy);
-      return ((xy[0] - a[0]) * dx + (xy[1] - a[1]) * dy) / length2;
-    };
-    double previous = 0;
-    for (std::size_t i = 1; i + 1 < parameters.size(); ++i)
+    return true;
+  }
+  // Bisection on the curve's position along the chord.
+  const auto positionAt = [&](double t) {
+    double xy[2];
+    curve.Spline.Evaluate(t, xy);
+    return ((xy[0] - a[0]) * dx + (xy[1] - a[1]) * dy) / length2;
+  };
+  double previous = 0;
+  for (std::size_t i = 1; i + 1 < parameters.size(); ++i)
+  {
+    const double target = ((points[2 * i] - a[0]) * dx + (points[2 * i + 1] - a[1]) * dy) / length2;
+    double lo = previous, hi = 1;
+    for (int step = 0; step < 60 && hi - lo > 1e-15; ++step)
     {
-      const double target = ((points[2 * i] - a[0]) * dx + (points[2 * i + 1] - a[1]) * dy) / length2;
-      double lo = previous, hi = 1;
-      for (int step = 0; step < 60 && hi - lo > 1e-15; ++step)
-      {
-        const double mid = 0.5 * (lo + hi);
-        (positionAt(mid) < target ? lo : hi) = mid;
-      }
-      parameters[i] = previous = std::max(previous, 0.5 * (lo + hi));
+      const double mid = 0.5 * (lo + hi);
+      (positionAt(mid) < target ? lo : hi) = mid;
     }
+    parameters[i] = previous = std::max(previous, 0.5 * (lo + hi));
   }
   return true;
 }
@@ -2341,7 +2357,15 @@ bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<Smoothin
   {
     return false;
   }
-  if (firstFit && piece.Values.size() >= static_cast<std::size_t>(RiseSamplesPerSegment * segments + 1))
+  // RiseSamplesPerSegment keeps the least-squares curve from hooking between sparse samples; a
+  // straight path (a side of the domain) has no such curve (FitStraightCurve), so there any
+  // piece with an interior sample may follow its rise (a short boundary piece that falls by
+  // nearly its whole rise in its first edge, next to a node where its height starts flat:
+  // 8 eps on a ttk_happi crop at 2 %, four segments on six edges).
+  const bool straight = IsStraight(piece.Points);
+  if (firstFit &&
+    (piece.Values.size() >= static_cast<std::size_t>(RiseSamplesPerSegment * segments + 1) ||
+      (straight && piece.Values.size() >= 3)))
   {
     // Knots that follow the rise as well as the length (for each of RiseRatios), kept where
     // the height then misses the samples by less (a valley that falls steeply and flattens:
@@ -2351,12 +2375,12 @@ bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<Smoothin
     // curve is (a curve whose speed follows the heights bulges on long flat stretches, and
     // bulges cross: see RepairCrossings). On a straight path the curve runs along the line
     // (FitStraightCurve).
-    const bool straight = IsStraight(piece.Points);
     const int perSegment = this->SamplesPerSegment;
     const PathDeviation even =
       straight ? PathDeviation() : DeviationFromPath(curve.Spline, piece.Parameters, piece.Points, perSegment);
     const bool evenInside = straight || InsideDomain(curve.Spline, piece.Points, bounds);
-    for (const double ratio : RiseRatios)
+    const bool sparse = piece.Values.size() < static_cast<std::size_t>(RiseSamplesPerSegment * segments + 1);
+    for (const double ratio : straight && sparse ? StraightRiseRatios : RiseRatios)
     {
       std::vector<double> rise = MonotoneBSplineFit::ArcLengthAndRise(piece.Points, piece.Values, a, b, ratio);
       PlanarCurveFit riseCurve;
