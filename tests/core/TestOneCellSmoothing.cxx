@@ -890,13 +890,17 @@ double LargestMissAlongTheSide(const SmoothedPiece& piece, int axis)
   }
   return miss;
 }
-} // namespace
 
-TEST_CASE(StraightPiecesFollowSteepRises)
+// The pieces along the domain's sides with fewer than `samplesBelow` samples, smoothed with
+// the height tolerance eps: how many, how many with knots that follow their rise, and their
+// largest miss in eps (LargestMissAlongTheSide).
+struct SidePieces
 {
-  double largest = 0;
-  int straightPieces = 0, riseKnots = 0;
-  ForFortyShepardFieldsAtFivePercent([&](const GridField&, const Stage3Input& input, double eps) {
+  int Pieces = 0;
+  int RiseKnots = 0;
+  double LargestMiss = 0;
+  void Measure(const Stage3Input& input, double eps, std::size_t samplesBelow)
+  {
     std::string error;
     OneCellSmoothing smoothing;
     smoothing.HeightTolerance = eps;
@@ -905,19 +909,28 @@ TEST_CASE(StraightPiecesFollowSteepRises)
     for (const SmoothedPiece& piece : result.Pieces)
     {
       const int axis = SideOfDomain(piece, input.Bounds);
-      if (axis >= 0)
+      if (axis >= 0 && piece.Values.size() < samplesBelow)
       {
-        ++straightPieces;
-        riseKnots += piece.RiseKnots ? 1 : 0;
-        largest = std::max(largest, LargestMissAlongTheSide(piece, axis) / eps);
+        ++this->Pieces;
+        this->RiseKnots += piece.RiseKnots ? 1 : 0;
+        this->LargestMiss = std::max(this->LargestMiss, LargestMissAlongTheSide(piece, axis) / eps);
       }
     }
+  }
+};
+} // namespace
+
+TEST_CASE(StraightPiecesFollowSteepRises)
+{
+  SidePieces side;
+  ForFortyShepardFieldsAtFivePercent([&](const GridField&, const Stage3Input& input, double eps) {
+    side.Measure(input, eps, std::numeric_limits<std::size_t>::max());
   });
   std::printf("  Shepard 250^2, 5 %%, seeds 20-59: %d pieces along the boundary, %d with knots that follow "
               "their rise; heights miss their samples by up to %.2f eps\n",
-    straightPieces, riseKnots, largest);
-  CHECK(straightPieces > 0 && riseKnots > 0);
-  CHECK(largest < 2);
+    side.Pieces, side.RiseKnots, side.LargestMiss);
+  CHECK(side.Pieces > 0 && side.RiseKnots > 0);
+  CHECK(side.LargestMiss < 2);
 }
 
 // Short pieces along the domain's sides follow a cliff next to their node too. The height of a
@@ -930,8 +943,7 @@ TEST_CASE(StraightPiecesFollowSteepRises)
 // (three per segment at k = 4, where no piece got such knots before: 6.2 eps then).
 TEST_CASE(ShortPiecesAlongTheSidesFollowCliffs)
 {
-  double largest = 0;
-  int shortPieces = 0, riseKnots = 0;
+  SidePieces side;
   for (std::uint64_t seed = 60; seed < 80; ++seed)
   {
     GridField grid = ShepardField(50, 2.0, 120, seed);
@@ -946,27 +958,13 @@ TEST_CASE(ShortPiecesAlongTheSidesFollowCliffs)
     Stage3Input input;
     std::string error;
     CHECK(RunStages1And2(grid, 5.0, input, error));
-    const double eps = 0.05 * input.Range;
-    OneCellSmoothing smoothing;
-    smoothing.HeightTolerance = eps;
-    OneCellSmoothingResult result;
-    CHECK(smoothing.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, result, error));
-    for (const SmoothedPiece& piece : result.Pieces)
-    {
-      const int axis = SideOfDomain(piece, input.Bounds);
-      if (axis >= 0 && piece.Values.size() < 3 * 4 + 1)
-      {
-        ++shortPieces;
-        riseKnots += piece.RiseKnots ? 1 : 0;
-        largest = std::max(largest, LargestMissAlongTheSide(piece, axis) / eps);
-      }
-    }
+    side.Measure(input, 0.05 * input.Range, 3 * 4 + 1);
   }
   std::printf("  terraced Shepard 120^2, 5 %%, seeds 60-79: %d short pieces along the boundary, %d with knots "
               "that follow their rise; heights miss their samples by up to %.2f eps\n",
-    shortPieces, riseKnots, largest);
-  CHECK(shortPieces > 0 && riseKnots > 0);
-  CHECK(largest < 2);
+    side.Pieces, side.RiseKnots, side.LargestMiss);
+  CHECK(side.Pieces > 0 && side.RiseKnots > 0);
+  CHECK(side.LargestMiss < 2);
 }
 
 TEST_CASE(MergedOneCellsShareTheirPiecesOnNoise)
