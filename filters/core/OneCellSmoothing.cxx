@@ -1958,8 +1958,15 @@ namespace
 constexpr double RiseCurveSlack = 2.5;
 
 // Knots follow the rise only on pieces with this many samples per segment: with fewer the
-// least-squares curve nearly interpolates the samples, and uneven parameters make it hook.
+// least-squares curve nearly interpolates the samples, and uneven parameters make it hook
+// (straight pieces excepted: see FitPiece).
 constexpr int RiseSamplesPerSegment = 3;
+
+// Whether `samples` samples give `segments` segments fewer than RiseSamplesPerSegment each.
+bool FewSamplesPerSegment(std::size_t samples, int segments)
+{
+  return samples < static_cast<std::size_t>(RiseSamplesPerSegment * segments + 1);
+}
 
 // A piece whose height misses by more than this times HeightTolerance may be refined up to
 // twice MaximumHeightSegments (RefineMissedHeights).
@@ -2153,8 +2160,8 @@ bool IsStraight(const std::vector<double>& points)
 // its curve passed, 1.75 eps with them moved) changes which pieces the height refinement
 // raises, and with them stage 4's grids: a Saint Helens crop at 5 % went from 1.03 to 2.03
 // eps, its largest cell's grid 16 -> 12 (docs/Reconstruction.md, "Short boundary pieces that
-// follow a cliff").
-// The parameters still crowd where the path rises, as the least-squares curve does.
+// follow a cliff"). The parameters still crowd where the path rises, as the least-squares curve
+// does.
 bool FitStraightCurve(const MonotoneBSplineFit& fitter, std::vector<double>& parameters,
   const std::vector<double>& points, PlanarCurveFit& curve)
 {
@@ -2217,7 +2224,7 @@ bool FitStraightCurve(const MonotoneBSplineFit& fitter, std::vector<double>& par
     c[2 * j] = a[0] + along[j] * dx;
     c[2 * j + 1] = a[1] + along[j] * dy;
   }
-  if (advancing && parameters.size() >= static_cast<std::size_t>(RiseSamplesPerSegment * fitter.Segments + 1))
+  if (advancing && !FewSamplesPerSegment(parameters.size(), fitter.Segments))
   {
     return true;
   }
@@ -2363,9 +2370,8 @@ bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<Smoothin
   // nearly its whole rise in its first edge, next to a node where its height starts flat:
   // 8 eps on a ttk_happi crop at 2 %, four segments on six edges).
   const bool straight = IsStraight(piece.Points);
-  if (firstFit &&
-    (piece.Values.size() >= static_cast<std::size_t>(RiseSamplesPerSegment * segments + 1) ||
-      (straight && piece.Values.size() >= 3)))
+  const bool sparse = FewSamplesPerSegment(piece.Values.size(), segments);
+  if (firstFit && (!sparse || (straight && piece.Values.size() >= 3)))
   {
     // Knots that follow the rise as well as the length (for each of RiseRatios), kept where
     // the height then misses the samples by less (a valley that falls steeply and flattens:
@@ -2379,7 +2385,6 @@ bool OneCellSmoothing::FitPiece(SmoothedPiece& piece, const std::vector<Smoothin
     const PathDeviation even =
       straight ? PathDeviation() : DeviationFromPath(curve.Spline, piece.Parameters, piece.Points, perSegment);
     const bool evenInside = straight || InsideDomain(curve.Spline, piece.Points, bounds);
-    const bool sparse = piece.Values.size() < static_cast<std::size_t>(RiseSamplesPerSegment * segments + 1);
     for (const double ratio : straight && sparse ? StraightRiseRatios : RiseRatios)
     {
       std::vector<double> rise = MonotoneBSplineFit::ArcLengthAndRise(piece.Points, piece.Values, a, b, ratio);

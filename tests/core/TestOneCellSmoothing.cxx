@@ -823,14 +823,6 @@ TEST_CASE(HeightsFollowTheFieldAlongTheirCurves)
   CHECK(worseAfter <= worseBefore);
 }
 
-// A 1-cell along the domain's boundary that rises steeply from a minimum and then runs nearly
-// flat for a hundred spacings: knots uniform in arc length put one of k segments on the rise,
-// and a height with zero slope at its ends cannot climb that fast (Shepard field, seed 54, 5 %:
-// 3.7 eps below the data next to the minimum). Knots that follow the rise are what the
-// smoothing tries for such pieces; on a straight piece the least-squares curve for them did not
-// advance along the line and was refused. Checked here on 40 Shepard fields, for every piece
-// that runs straight along the boundary: its curve stays on the line and advances, and its
-// height misses its samples by less than 2 eps (the test's own evaluation).
 namespace
 {
 // The side of the domain a piece runs along: 0 when every sample has the first one's x on a
@@ -920,6 +912,14 @@ struct SidePieces
 };
 } // namespace
 
+// A 1-cell along the domain's boundary that rises steeply from a minimum and then runs nearly
+// flat for a hundred spacings: knots uniform in arc length put one of k segments on the rise,
+// and a height with zero slope at its ends cannot climb that fast (Shepard field, seed 54, 5 %:
+// 3.7 eps below the data next to the minimum). Knots that follow the rise are what the
+// smoothing tries for such pieces; on a straight piece the least-squares curve for them did not
+// advance along the line and was refused. Checked here on 40 Shepard fields, for every piece
+// that runs straight along the boundary: its curve stays on the line and advances, and its
+// height misses its samples by less than 2 eps (the test's own evaluation).
 TEST_CASE(StraightPiecesFollowSteepRises)
 {
   SidePieces side;
