@@ -149,6 +149,7 @@ constexpr const char* StiffenedCells = "StiffenedCells";
 constexpr const char* OrderedCells = "OrderedCells";
 constexpr const char* RemappedCells = "RemappedCells";
 constexpr const char* AxisFreeCells = "AxisFreeCells";
+constexpr const char* SmallFittedCells = "SmallFittedCells";
 constexpr const char* SnappedPoints = "SnappedPoints";
 constexpr const char* PointsOnOneCells = "PointsOnOneCells";
 constexpr const char* UnreconstructedPoints = "UnreconstructedPoints";

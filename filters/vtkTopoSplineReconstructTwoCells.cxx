@@ -285,6 +285,7 @@ void WriteReport(const topospline::FieldReconstructionReport& report, vtkFieldDa
   AddFieldNumbers(fd, names::OrderedCells, { static_cast<double>(cells.OrderedCells) });
   AddFieldNumbers(fd, names::RemappedCells, { static_cast<double>(cells.RemappedCells) });
   AddFieldNumbers(fd, names::AxisFreeCells, { static_cast<double>(cells.AxisFreeCells) });
+  AddFieldNumbers(fd, names::SmallFittedCells, { static_cast<double>(cells.SmallFittedCells) });
   AddFieldNumbers(fd, names::SnappedPoints, { static_cast<double>(report.SnappedPoints) });
   AddFieldNumbers(fd, names::PointsOnOneCells, { static_cast<double>(report.PointsOnOneCells) });
   AddFieldNumbers(fd, names::UnreconstructedPoints, { static_cast<double>(report.UnreconstructedPoints) });

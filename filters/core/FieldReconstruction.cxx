@@ -529,6 +529,7 @@ bool FieldReconstruction::RunInFrame(const PlanarScalarField& field, const Morse
   this->Cells.OrderingRounds = this->OrderingRounds;
   this->Cells.FarFromOneCells = this->FarFromOneCellsSpacings * GridSpacing(field);
   this->Cells.AxisAimTrigger = this->AxisAimTrigger;
+  this->Cells.SmallCellFitTrigger = this->SmallCellFitTrigger;
   const bool reconstructed = this->Cells.Reconstruct(complex, smoothed, error, &field);
   this->Cells.Mesh = nullptr; // a local
   if (!reconstructed)

@@ -112,6 +112,10 @@ public:
   // again without the aim at F rising along u and v (TwoCellReconstruction::AxisAimTrigger; <= 0:
   // never).
   double AxisAimTrigger = 5;
+  // Fitted interiors: small cells (few samples for their grid) are fitted where the paper's
+  // interior misses their samples by more than this times SurfaceTolerance, within a budget
+  // (TwoCellReconstruction::SmallCellFitTrigger; <= 0: never).
+  double SmallCellFitTrigger = 2;
   bool TopologicalSampling = true;
   bool VerifyTopology = true;
   double MemoryBudget = 0; // bytes for the 2-cells' surfaces (TwoCellReconstruction::MemoryBudget)

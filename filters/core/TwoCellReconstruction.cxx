@@ -933,16 +933,63 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
     }
     return samples;
   };
-  ForEachCellLargestFirst(largestFirst, this->Parallel, this->Hooks, 0.7, 0.9, [&](Index c) {
+  // Small cells (FitSizeOf) are only measured here: the paper's largest miss of each, when
+  // beyond SmallCellFitTrigger times the tolerance; they are fitted after the others.
+  std::vector<double> smallMiss(n, 0.0);
+  std::vector<char> smallFitted(n, 0);
+  ForEachCellLargestFirst(largestFirst, this->Parallel, this->Hooks, 0.7, 0.85, [&](Index c) {
     ReconstructedTwoCell& cell = *this->Cells[c];
     BuildSurface(cell, boundaries[c]);
     if (fit && cell.Valid)
     {
-      refined[c] = this->FitSurface(cell, boundaries[c], samplesOf(c));
+      const std::vector<SurfaceSample> samples = samplesOf(c);
+      const FitSize size = this->FitSizeOf(cell, samples.size());
+      if (size == FitSize::Regular)
+      {
+        refined[c] = this->FitSurface(cell, boundaries[c], samples);
+      }
+      else if (size == FitSize::Small && this->SmallCellFitTrigger > 0)
+      {
+        double maximum = 0, rms = 0;
+        cell.Surface.MeasureResiduals(samples, maximum, rms);
+        smallMiss[c] = maximum > this->SmallCellFitTrigger * this->SurfaceTolerance ? maximum : 0.0;
+      }
     }
     // Only fitted cells read their sides again (alternative maps, stiffening): on uniform
     // noise the others are nearly all, and their sides were a tenth of stage 4's peak.
-    if (!(fit && cell.Valid && cell.Surface.FitReport().Fitted))
+    if (!(fit && cell.Valid && cell.Surface.FitReport().Fitted) && smallMiss[c] == 0)
+    {
+      boundaries[c] = MonotoneSurfaceBoundary();
+    }
+  });
+  // The small cells the paper's interior misses most, fitted while their number stays within a
+  // share of the regular fits' (SmallCellFitsPerRegularFit; at least MinimumSmallCellFits): a
+  // narrow cell of a terrain between two ridges then follows its valley, and uniform noise,
+  // whose cells are nearly all small, keeps most of stage 4's time.
+  std::vector<Index> smallCells;
+  for (Index c = 0; c < n; ++c)
+  {
+    if (smallMiss[c] > 0)
+    {
+      smallCells.push_back(c);
+    }
+  }
+  std::stable_sort(
+    smallCells.begin(), smallCells.end(), [&](Index a, Index b) { return smallMiss[a] > smallMiss[b]; });
+  const std::size_t regularFits = static_cast<std::size_t>(std::count_if(this->Cells.begin(), this->Cells.end(),
+    [](const std::unique_ptr<ReconstructedTwoCell>& cell) { return cell->Surface.FitReport().Fitted; }));
+  const std::size_t smallFits = std::min(smallCells.size(),
+    std::max<std::size_t>(MinimumSmallCellFits, static_cast<std::size_t>(SmallCellFitsPerRegularFit * regularFits)));
+  for (std::size_t i = smallFits; i < smallCells.size(); ++i)
+  {
+    boundaries[smallCells[i]] = MonotoneSurfaceBoundary();
+  }
+  smallCells.resize(smallFits);
+  ForEachCellLargestFirst(smallCells, this->Parallel, this->Hooks, 0.85, 0.9, [&](Index c) {
+    ReconstructedTwoCell& cell = *this->Cells[c];
+    refined[c] = this->FitSurface(cell, boundaries[c], samplesOf(c));
+    smallFitted[c] = cell.Surface.FitReport().Fitted ? 1 : 0;
+    if (!smallFitted[c])
     {
       boundaries[c] = MonotoneSurfaceBoundary();
     }
@@ -950,7 +997,9 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
   // The largest misses get their second chance on the alternative maps (AlternativeMapStrength):
   // the cells from the one that misses most down, while each is improved (a cell that is not
   // keeps the largest miss where it is) and misses by more than AlternativeMapTrigger times
-  // the tolerance. Then the stiffening, on the maps kept.
+  // the tolerance. Then the stiffening, on the maps kept. Small cells keep the mean value map:
+  // on noise they miss most, and the first one a map does not improve would end the pass
+  // before the regular cells it helps.
   std::vector<std::vector<SurfaceSample>> remappedSamples(n);
   if (fit && this->AlternativeMapStrength > 0)
   {
@@ -958,7 +1007,7 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
     for (Index c = 0; c < n; ++c)
     {
       const ReconstructedTwoCell& cell = *this->Cells[c];
-      if (cell.Valid && cell.Surface.FitReport().Fitted &&
+      if (cell.Valid && cell.Surface.FitReport().Fitted && !smallFitted[c] &&
         cell.Surface.FitReport().MaximumResidual > AlternativeMapTrigger * this->SurfaceTolerance)
       {
         misses.emplace_back(cell.Surface.FitReport().MaximumResidual, c);
@@ -1006,6 +1055,7 @@ bool TwoCellReconstruction::Reconstruct(const MorseSmaleComplex& complex, const 
   this->Summary.OrderedCells = std::count(ordered.begin(), ordered.end(), 1);
   this->Summary.RemappedCells = std::count(remapped.begin(), remapped.end(), 1);
   this->Summary.AxisFreeCells = std::count(axisFree.begin(), axisFree.end(), 1);
+  this->Summary.SmallFittedCells = std::count(smallFitted.begin(), smallFitted.end(), 1);
   this->Summary.SurfaceSeconds = Seconds(start);
   this->Summarize();
   this->BuildCellLocator();
@@ -1251,16 +1301,26 @@ bool TwoCellReconstruction::BuildBoundaryWalkCutOffMiddle(const TwoCellSides& si
   return false;
 }
 
+// A handful of samples (tiny cells of noisy data), or far fewer samples than grid cells (a long
+// boundary around a small region), pins down little the boundary does not, at the cost of
+// thousands of unknowns: such cells keep the paper's interior, or are fitted only where it
+// misses (Small).
+TwoCellReconstruction::FitSize TwoCellReconstruction::FitSizeOf(
+  const ReconstructedTwoCell& cell, std::size_t samples) const
+{
+  const std::size_t gridCells = static_cast<std::size_t>(cell.GridSize) * static_cast<std::size_t>(cell.GridSize);
+  if (cell.GridSize > this->MaximumFittedGridSize || samples < std::max<std::size_t>(3, gridCells / 64))
+  {
+    return FitSize::None;
+  }
+  return samples < std::max<std::size_t>(8, gridCells / 16) ? FitSize::Small : FitSize::Regular;
+}
+
 bool TwoCellReconstruction::FitSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided,
   const std::vector<SurfaceSample>& samples) const
 {
   std::string message;
-  // A handful of samples (tiny cells of noisy data), or far fewer samples than grid cells (a
-  // long boundary around a small region), pins down little the boundary does not, at the cost
-  // of thousands of unknowns: such cells keep the paper's interior.
-  const std::size_t minimumSamples = std::max<std::size_t>(8, cell.GridSize * cell.GridSize / 16);
-  if (cell.GridSize > this->MaximumFittedGridSize || samples.size() < minimumSamples ||
-    !cell.Surface.FitToSamples(samples, message, this->Fit))
+  if (!cell.Surface.FitToSamples(samples, message, this->Fit))
   {
     return false;
   }

@@ -143,6 +143,7 @@ struct TwoCellReconstructionReport
   Index StiffenedCells = 0;    // of them, cells whose fit was stiffened (StiffeningRounds)
   Index OrderedCells = 0;      // of them, cells whose fit orders samples around critical points (OrderingRounds)
   Index RemappedCells = 0;     // of them, cells fitted on an alternative map (AlternativeMapStrength)
+  Index SmallFittedCells = 0;  // of them, small cells fitted where the paper's interior misses (SmallCellFitTrigger)
   Index AxisFreeCells = 0;     // of them, cells whose fit no longer aims at F rising along u and v (AxisAimTrigger)
   Index MeshTriangles = 0;     // triangles of all cell meshes
   Index CrowdedTriangles = 0;  // of them, flattened in (u, v) by rounding (TwoCellMesh::CrowdedTriangles)
@@ -243,8 +244,19 @@ public:
   // Cells whose sides alone need a finer grid than this keep the paper's interior: their fit
   // has tens of thousands of unknowns (seconds per cell), and such grids come from long sides
   // around few samples, where the boundary curves already carry the data. So do cells with
-  // fewer than 8 samples or than one per 16 grid cells.
+  // fewer than 3 samples or than one per 64 grid cells (FitSizeOf).
   int MaximumFittedGridSize = 48;
+  // Small cells (fewer than 8 samples or than one per 16 grid cells, but not too few) are
+  // fitted only where the paper's interior misses their samples by more than
+  // SmallCellFitTrigger times SurfaceTolerance (<= 0: never), the largest misses first, and no
+  // more of them than SmallCellFitsPerRegularFit times the cells fitted as regular ones (at
+  // least MinimumSmallCellFits): a fit costs about as much whatever its samples, and uniform
+  // noise has thousands of such cells (fitting all of them on 300² noise took stage 4 ten times
+  // as long, as many as the regular fits half as long again; terrains have a few: 28 on
+  // ttk_happi at 2 %, none on the Rainier crop).
+  double SmallCellFitTrigger = 2;
+  static constexpr double SmallCellFitsPerRegularFit = 0.25;
+  static constexpr std::size_t MinimumSmallCellFits = 32;
   MonotoneSurfaceFitOptions Fit;
   // Fitted interiors, given the input's mesh: a fit whose values at the cell's vertices have a
   // critical point two rings of vertices or more inside the cell (where no 1-cell passes, so
@@ -371,6 +383,15 @@ private:
   bool BuildBoundaryWalkCutOffMiddle(const TwoCellSides& sides, const OneCellSmoothingResult& smoothed,
     const std::vector<int>& samplesPerPiece, std::vector<double>& walk, std::vector<double>& parameters,
     MonotoneSurfaceBoundary& boundary) const;
+  // Whether a cell with this many samples is fitted (Regular), fitted only where the paper's
+  // interior misses them (Small, see SmallCellFitTrigger), or keeps the paper's interior.
+  enum class FitSize
+  {
+    None,
+    Small,
+    Regular
+  };
+  FitSize FitSizeOf(const ReconstructedTwoCell& cell, std::size_t samples) const;
   // Fits the cell's interior, refining its grid (see SurfaceTolerance); returns whether refined.
   bool FitSurface(ReconstructedTwoCell& cell, const MonotoneSurfaceBoundary& subdivided,
     const std::vector<SurfaceSample>& samples) const;

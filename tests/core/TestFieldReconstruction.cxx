@@ -32,6 +32,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdint>
+#include <numeric>
 #include <functional>
 #include <iterator>
 #include <limits>
@@ -831,6 +832,77 @@ TEST_CASE(TheAxisAimIsReleasedOnlyWhereItHoldsACellOffTheData)
   CHECK(released > 0);
   CHECK(lowered > 0);
   CHECK(deepAfter <= deepBefore);
+}
+
+TEST_CASE(SmallCellsAreFittedWhereThePaperMisses)
+{
+  // Cells with few samples for their grid keep the paper's interior unless it misses their
+  // samples by more than SmallCellFitTrigger x SurfaceTolerance; then the worst of them are
+  // fitted, no more than a quarter of the regular fits (at least 32). Measured here from
+  // F o Phi at the vertices and the cell that gave each value, with small fits off (trigger 0)
+  // and on: a cell either keeps every value bit for bit or is one of the small cells reported
+  // fitted and misses its vertices by no more in RMS; the number of small fits keeps to the
+  // budget. On
+  // Shepard fields of 150 sites nothing was tuned on (seeds 120-125, at 2 %: narrow cells
+  // between close bumps) and on uniform noise, whose cells are nearly all small (the budget is
+  // what holds there).
+  int fittedShepard = 0, fittedNoise = 0, lowered = 0;
+  auto compare = [&](const char* name, Pipeline& p, int& fitted) {
+    FieldReconstructionReport reports[2];
+    ReconstructTwice(p, [](FieldReconstruction& reconstruction, int run) {
+      reconstruction.SmallCellFitTrigger = run ? 2 : 0;
+    }, reports);
+    CHECK(reports[0].Cells.SmallFittedCells == 0);
+    const CellByCell compared = CompareCellByCell(p, reports);
+    int changedCells = 0;
+    bool better = true;
+    for (std::size_t c = 0; c < compared.Changed.size(); ++c)
+    {
+      if (compared.Changed[c])
+      {
+        ++changedCells;
+        better = better && compared.Squares[1][c] <= compared.Squares[0][c] * (1 + 1e-9);
+      }
+    }
+    const Index small = reports[1].Cells.SmallFittedCells;
+    const Index regular = reports[1].Cells.FittedCells - small;
+    double squares[2];
+    for (int run = 0; run < 2; ++run)
+    {
+      squares[run] = std::accumulate(compared.Squares[run].begin(), compared.Squares[run].end(), 0.0);
+    }
+    const double vertices = static_cast<double>(p.Field.Values.size());
+    std::printf("  %s: %d small cells fitted (%d regular), %d changed, RMS of F o Phi %.3f -> %.3f %% of the range\n",
+      name, static_cast<int>(small), static_cast<int>(regular), changedCells,
+      100 * std::sqrt(squares[0] / vertices) / p.Range, 100 * std::sqrt(squares[1] / vertices) / p.Range);
+    CHECK(better);
+    CHECK(changedCells <= static_cast<int>(small));
+    CHECK(small <= std::max<Index>(32, regular / 4));
+    CHECK_EQ(reports[0].Cells.FittedCells, regular);
+    fitted += changedCells;
+    lowered += squares[1] < squares[0] ? 1 : 0;
+  };
+  for (std::uint64_t seed = 120; seed < 126; ++seed)
+  {
+    Pipeline p;
+    std::string error;
+    CHECK(RunStages1To3(ShepardField(150, 2.0, 150, seed), 2, 4, p, error));
+    const std::string name = "shepard 150^2 of 150 sites, seed " + std::to_string(seed) + " at 2 %";
+    compare(name.c_str(), p, fittedShepard);
+  }
+  for (std::uint64_t seed = 5; seed < 7; ++seed)
+  {
+    Pipeline p;
+    std::string error;
+    CHECK(RunStages1To3(UniformNoise(100, seed), 5, 4, p, error));
+    const std::string name = "noise 100^2 seed " + std::to_string(seed) + " at 5 %";
+    compare(name.c_str(), p, fittedNoise);
+  }
+  std::printf("  %d small cells changed on the Shepard fields, %d on noise; RMS lower on %d of 8 fields\n",
+    fittedShepard, fittedNoise, lowered);
+  CHECK(fittedShepard > 0);
+  CHECK(fittedNoise > 0);
+  CHECK(lowered > 0);
 }
 
 TEST_CASE(AnisotropicSpacingIsReconstructedInTheComplexsFrame)
