@@ -43,6 +43,9 @@ struct SmoothedPiece
   std::vector<double> Parameters;  // arc length and rise (MonotoneBSplineFit::ArcLengthAndRise)
   int Segments = 0;                // k used (more than asked where crossings forced it)
   bool RiseKnots = false;          // Parameters follow the rise too (else arc length only)
+  // With RiseKnots: the rise ratios whose knots bettered the height in turn, the one in use
+  // last (RepairCrossings steps a crossing piece back through them before even knots).
+  std::vector<double> RiseRatios;
   bool ContactKnots = false;       // Parameters crowd the knots where other pieces came near (RepairCrossings)
   CubicBezierSpline Curve;         // Dimension 2
   CubicBezierSpline Height;        // Dimension 1, strictly increasing
