@@ -678,6 +678,23 @@ struct CellByCell
   std::vector<double> Miss[2], Squares[2];
   std::vector<char> Changed;
   double Largest[2] = { 0, 0 }, Reconstructed[2] = { 0, 0 };
+
+  // The number of cells whose values changed between the runs; `allBetter`: whether
+  // better(c) holds for each of them.
+  int CountChanged(const std::function<bool(std::size_t)>& better, bool& allBetter) const
+  {
+    int changed = 0;
+    allBetter = true;
+    for (std::size_t c = 0; c < this->Changed.size(); ++c)
+    {
+      if (this->Changed[c])
+      {
+        ++changed;
+        allBetter = allBetter && better(c);
+      }
+    }
+    return changed;
+  }
 };
 
 // p's complex reconstructed twice, without the stiffening and ordering rounds (which would move
@@ -755,16 +772,9 @@ TEST_CASE(AlternativeMapsLowerOnlyTheLargestMisses)
     }, reports);
     CHECK(reports[0].Cells.RemappedCells == 0);
     const CellByCell compared = CompareCellByCell(p, reports);
-    int changedCells = 0;
-    bool onlyLower = true;
-    for (std::size_t c = 0; c < compared.Changed.size(); ++c)
-    {
-      if (compared.Changed[c])
-      {
-        ++changedCells;
-        onlyLower = onlyLower && compared.Miss[1][c] < compared.Miss[0][c];
-      }
-    }
+    bool onlyLower;
+    const int changedCells =
+      compared.CountChanged([&](std::size_t c) { return compared.Miss[1][c] < compared.Miss[0][c]; }, onlyLower);
     std::printf("  shepard 200^2 seed %d at 5 %%: %d cells remapped, largest miss of F o Phi %.2f -> %.2f %%, of "
                 "Reconstructed %.2f -> %.2f %% of the range\n",
       static_cast<int>(seed), static_cast<int>(reports[1].Cells.RemappedCells), 100 * compared.Largest[0] / p.Range,
@@ -801,17 +811,13 @@ TEST_CASE(TheAxisAimIsReleasedOnlyWhereItHoldsACellOffTheData)
     CHECK(reports[0].Cells.AxisFreeCells == 0);
     const CellByCell compared = CompareCellByCell(p, reports);
     const double* largest = compared.Largest;
-    int changedCells = 0;
-    bool better = true;
-    for (std::size_t c = 0; c < compared.Changed.size(); ++c)
-    {
-      if (compared.Changed[c])
-      {
-        ++changedCells;
-        better = better && compared.Miss[1][c] < 0.9 * compared.Miss[0][c] &&
+    bool better;
+    const int changedCells = compared.CountChanged(
+      [&](std::size_t c) {
+        return compared.Miss[1][c] < 0.9 * compared.Miss[0][c] &&
           compared.Squares[1][c] <= compared.Squares[0][c] * (1 + 1e-9);
-      }
-    }
+      },
+      better);
     const int nx = shepard.Dimensions[0], ny = shepard.Dimensions[1];
     const int deep[2] = { CriticalDeepInsideCells(reports[0].Exact, reports[0].CellOfVertex, nx, ny),
       CriticalDeepInsideCells(reports[1].Exact, reports[1].CellOfVertex, nx, ny) };
@@ -854,16 +860,9 @@ TEST_CASE(SmallCellsAreFittedWhereThePaperMisses)
     }, reports);
     CHECK(reports[0].Cells.SmallFittedCells == 0);
     const CellByCell compared = CompareCellByCell(p, reports);
-    int changedCells = 0;
-    bool better = true;
-    for (std::size_t c = 0; c < compared.Changed.size(); ++c)
-    {
-      if (compared.Changed[c])
-      {
-        ++changedCells;
-        better = better && compared.Squares[1][c] <= compared.Squares[0][c] * (1 + 1e-9);
-      }
-    }
+    bool better;
+    const int changedCells = compared.CountChanged(
+      [&](std::size_t c) { return compared.Squares[1][c] <= compared.Squares[0][c] * (1 + 1e-9); }, better);
     const Index small = reports[1].Cells.SmallFittedCells;
     const Index regular = reports[1].Cells.FittedCells - small;
     double squares[2];

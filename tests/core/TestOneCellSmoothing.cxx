@@ -933,6 +933,22 @@ TEST_CASE(StraightPiecesFollowSteepRises)
   CHECK(side.LargestMiss < 2);
 }
 
+// A Shepard field (120^2, 50 sites) raised by half its range past a random column, or row,
+// of the seed's: a cliff its 1-cells climb.
+GridField TerracedShepardField(std::uint64_t seed, bool pastARow)
+{
+  GridField grid = ShepardField(50, 2.0, 120, seed);
+  DeterministicRandom random(seed);
+  const int line = 10 + random.Integer(100);
+  const auto [low, high] = std::minmax_element(grid.Values.begin(), grid.Values.end());
+  const double step = 0.5 * (*high - *low);
+  for (std::size_t v = 0; v < grid.Values.size(); ++v)
+  {
+    grid.Values[v] += static_cast<int>(pastARow ? v / 120 : v % 120) >= line ? step : 0.0;
+  }
+  return grid;
+}
+
 // Short pieces along the domain's sides follow a cliff next to their node too. The height of a
 // piece starts flat at its nodes, so with evenly spaced knots a piece of a few samples whose
 // data jump in the first edge missed the jump by most of its size (a ttk_happi crop at 2 %:
@@ -946,15 +962,7 @@ TEST_CASE(ShortPiecesAlongTheSidesFollowCliffs)
   SidePieces side;
   for (std::uint64_t seed = 60; seed < 80; ++seed)
   {
-    GridField grid = ShepardField(50, 2.0, 120, seed);
-    DeterministicRandom random(seed);
-    const int column = 10 + random.Integer(100);
-    const auto [low, high] = std::minmax_element(grid.Values.begin(), grid.Values.end());
-    const double step = 0.5 * (*high - *low);
-    for (std::size_t v = 0; v < grid.Values.size(); ++v)
-    {
-      grid.Values[v] += static_cast<int>(v % 120) >= column ? step : 0.0;
-    }
+    const GridField grid = TerracedShepardField(seed, false);
     Stage3Input input;
     std::string error;
     CHECK(RunStages1And2(grid, 5.0, input, error));
@@ -983,15 +991,7 @@ TEST_CASE(SparsePiecesFollowSteepRisesWithGentleKnots)
   bool noWorse = true;
   for (std::uint64_t seed = 80; seed < 100; ++seed)
   {
-    GridField grid = ShepardField(50, 2.0, 120, seed);
-    DeterministicRandom random(seed);
-    const int row = 10 + random.Integer(100);
-    const auto [low, high] = std::minmax_element(grid.Values.begin(), grid.Values.end());
-    const double step = 0.5 * (*high - *low);
-    for (std::size_t v = 0; v < grid.Values.size(); ++v)
-    {
-      grid.Values[v] += static_cast<int>(v / 120) >= row ? step : 0.0;
-    }
+    const GridField grid = TerracedShepardField(seed, true);
     Stage3Input input;
     std::string error;
     CHECK(RunStages1And2(grid, 5.0, input, error));
