@@ -42,10 +42,10 @@ struct SmoothedPiece
   std::vector<double> Values;      // the field along them
   std::vector<double> Parameters;  // arc length and rise (MonotoneBSplineFit::ArcLengthAndRise)
   int Segments = 0;                // k used (more than asked where crossings forced it)
-  bool RiseKnots = false;          // Parameters follow the rise too (else arc length only)
-  // With RiseKnots: the rise ratios whose knots bettered the height in turn, the one in use
-  // last (RepairCrossings steps a crossing piece back through them before even knots).
+  // The rise ratios whose knots bettered the height in turn, the one in use last (RepairCrossings
+  // steps a crossing piece back through them before even knots); none: arc length only.
   std::vector<double> RiseRatios;
+  bool RiseKnots() const { return !this->RiseRatios.empty(); } // Parameters follow the rise too
   bool ContactKnots = false;       // Parameters crowd the knots where other pieces came near (RepairCrossings)
   CubicBezierSpline Curve;         // Dimension 2
   CubicBezierSpline Height;        // Dimension 1, strictly increasing

@@ -61,6 +61,21 @@ bool RunStages1And2(const GridField& grid, double percent, Stage3Input& input, s
   return true;
 }
 
+// Stages 1 and 2 of `grid` at `percent`, then stage 3 with k segments, the height tolerance the
+// threshold when asked (as the filter sets it), other options default.
+bool SmoothWithSegments(const GridField& grid, double percent, int k, Stage3Input& input,
+  OneCellSmoothingResult& result, std::string& error, bool thresholdAsHeightTolerance = false)
+{
+  if (!RunStages1And2(grid, percent, input, error))
+  {
+    return false;
+  }
+  OneCellSmoothing smoothing;
+  smoothing.Segments = k;
+  smoothing.HeightTolerance = thresholdAsHeightTolerance ? percent / 100 * input.Range : 0.0;
+  return smoothing.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, result, error);
+}
+
 // The properties the paper asks of the smoothed 1-cells (section 4, steps 1-3).
 void CheckSmoothedOneCells(const Stage3Input& input, const OneCellSmoothingResult& result, int k)
 {
@@ -270,11 +285,8 @@ TEST_CASE(ShortPiecesGetNoMoreSegmentsThanEdges)
   const GridField noise = UniformNoise(40, 62);
   Stage3Input input;
   std::string error;
-  CHECK(RunStages1And2(noise, 2.0, input, error));
-  OneCellSmoothing smoothing;
-  smoothing.Segments = 21;
   OneCellSmoothingResult result;
-  CHECK(smoothing.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, result, error));
+  CHECK(SmoothWithSegments(noise, 2.0, 21, input, result, error));
   CheckSmoothedOneCells(input, result, 21);
   int shorter = 0, beyond = 0;
   long segments = 0;
@@ -729,7 +741,7 @@ TEST_CASE(ShortPiecesGetAFinerHeightOnTheSameCurve)
       // Short pieces the refinement reached, fitted along their path both times, and that no
       // crossing refitted in either run (k = 4 is the most a piece starts with).
       if (!after.HeightRefined || static_cast<int>(after.Values.size()) > 3 * after.Segments || before.Segments > 4 ||
-        after.Segments % before.Segments != 0 || after.RiseKnots != before.RiseKnots || before.HeightAlongCurve ||
+        after.Segments % before.Segments != 0 || after.RiseKnots() != before.RiseKnots() || before.HeightAlongCurve ||
         after.HeightAlongCurve)
       {
         continue;
@@ -904,7 +916,7 @@ struct SidePieces
       if (axis >= 0 && piece.Values.size() < samplesBelow)
       {
         ++this->Pieces;
-        this->RiseKnots += piece.RiseKnots ? 1 : 0;
+        this->RiseKnots += piece.RiseKnots() ? 1 : 0;
         this->LargestMiss = std::max(this->LargestMiss, LargestMissAlongTheSide(piece, axis) / eps);
       }
     }
@@ -983,57 +995,78 @@ TEST_CASE(ShortPiecesAlongTheSidesFollowCliffs)
 // raised past a random row so that 1-cells climb a cliff), over the pieces with 2 to 3 samples
 // per segment that were not refined or fitted to the field along their curve: most take rise
 // knots, none misses its samples by more, and the largest miss falls (before: 11 of 361 had
-// such knots, straight ones).
+// such knots, straight ones). With the threshold as the height tolerance (as the filter runs),
+// only pieces whose even knots miss by more than half of it take them (SparseRiseTrigger).
 TEST_CASE(SparsePiecesFollowSteepRisesWithGentleKnots)
 {
-  int sparse = 0, risen = 0;
+  int sparse = 0, risen = 0, risenWithTolerance = 0, risenWithinHalf = 0;
   double evenMiss = 0, keptMiss = 0;
   bool noWorse = true;
   for (std::uint64_t seed = 80; seed < 100; ++seed)
   {
-    const GridField grid = TerracedShepardField(seed, true);
-    Stage3Input input;
-    std::string error;
-    CHECK(RunStages1And2(grid, 5.0, input, error));
-    OneCellSmoothing smoothing;
-    smoothing.Segments = 4;
-    OneCellSmoothingResult result;
-    CHECK(smoothing.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, result, error));
-    const double eps = 0.05 * input.Range;
-    for (const SmoothedPiece& piece : result.Pieces)
+    for (const bool withTolerance : { false, true })
     {
-      const std::size_t n = piece.Values.size();
-      if (piece.Segments != 4 || n < 2 * 4 + 1 || n >= 3 * 4 + 1 || piece.HeightAlongCurve ||
-        piece.Points[0] == piece.Points[2 * n - 2] || piece.Points[1] == piece.Points[2 * n - 1])
+      const GridField grid = TerracedShepardField(seed, true);
+      Stage3Input input;
+      std::string error;
+      OneCellSmoothingResult result;
+      CHECK(SmoothWithSegments(grid, 5.0, 4, input, result, error, withTolerance));
+      const double eps = 0.05 * input.Range;
+      for (const SmoothedPiece& piece : result.Pieces)
       {
-        continue; // not sparse, refined, or possibly straight
+        const std::size_t n = piece.Values.size();
+        if (piece.Segments != 4 || n < 2 * 4 + 1 || n >= 3 * 4 + 1 || piece.HeightAlongCurve ||
+          piece.Points[0] == piece.Points[2 * n - 2] || piece.Points[1] == piece.Points[2 * n - 1])
+        {
+          continue; // not sparse, refined, or possibly straight
+        }
+        const double a = result.Nodes[piece.StartNode].Value, b = result.Nodes[piece.EndNode].Value;
+        MonotoneBSplineFit fitter;
+        fitter.Segments = 4;
+        HeightFit even;
+        const std::vector<double> arcLength = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
+        CHECK(fitter.FitHeight(arcLength, piece.Values, a, b, true, even, error));
+        double kept = 0;
+        for (std::size_t i = 1; i + 1 < n; ++i)
+        {
+          double h;
+          piece.Height.Evaluate(piece.Parameters[i], &h);
+          kept = std::max(kept, std::abs(h - piece.Values[i]));
+        }
+        if (withTolerance)
+        {
+          // Straight paths (a side, a diagonal) try every ratio whatever the miss.
+          const double dx = piece.Points[2 * n - 2] - piece.Points[0], dy = piece.Points[2 * n - 1] - piece.Points[1];
+          bool straight = true;
+          for (std::size_t i = 1; i + 1 < n && straight; ++i)
+          {
+            const double cross = dx * (piece.Points[2 * i + 1] - piece.Points[1]) - dy * (piece.Points[2 * i] - piece.Points[0]);
+            straight = std::abs(cross) <= 1e-9 * (dx * dx + dy * dy);
+          }
+          if (straight)
+          {
+            continue;
+          }
+          risenWithTolerance += piece.RiseKnots() ? 1 : 0;
+          risenWithinHalf += piece.RiseKnots() && even.MaximumError <= 0.5 * eps ? 1 : 0;
+          continue;
+        }
+        ++sparse;
+        risen += piece.RiseKnots() ? 1 : 0;
+        noWorse = noWorse && kept <= even.MaximumError + 1e-9 * input.Range;
+        evenMiss = std::max(evenMiss, even.MaximumError / eps);
+        keptMiss = std::max(keptMiss, kept / eps);
       }
-      ++sparse;
-      const double a = result.Nodes[piece.StartNode].Value, b = result.Nodes[piece.EndNode].Value;
-      MonotoneBSplineFit fitter;
-      fitter.Segments = 4;
-      HeightFit even;
-      const std::vector<double> arcLength = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
-      CHECK(fitter.FitHeight(arcLength, piece.Values, a, b, true, even, error));
-      double kept = 0;
-      for (std::size_t i = 1; i + 1 < n; ++i)
-      {
-        double h;
-        piece.Height.Evaluate(piece.Parameters[i], &h);
-        kept = std::max(kept, std::abs(h - piece.Values[i]));
-      }
-      risen += piece.RiseKnots ? 1 : 0;
-      noWorse = noWorse && kept <= even.MaximumError + 1e-9 * input.Range;
-      evenMiss = std::max(evenMiss, even.MaximumError / eps);
-      keptMiss = std::max(keptMiss, kept / eps);
     }
   }
   std::printf("  terraced Shepard 120^2, 5 %%, seeds 80-99: %d sparse pieces, %d with rise knots; largest "
-              "miss %.2f eps, %.2f with even knots\n",
-    sparse, risen, keptMiss, evenMiss);
+              "miss %.2f eps, %.2f with even knots; with the height tolerance %d with rise knots, %d of "
+              "them within half of it with even knots\n",
+    sparse, risen, keptMiss, evenMiss, risenWithTolerance, risenWithinHalf);
   CHECK(2 * risen > sparse);
   CHECK(noWorse);
   CHECK(keptMiss < evenMiss);
+  CHECK(risenWithTolerance > 0 && risenWithinHalf == 0);
 }
 
 TEST_CASE(MergedOneCellsShareTheirPiecesOnNoise)
