@@ -63,16 +63,17 @@ TEST_CASE(TopologyComparisonOnAMeshCountsEdges)
   const auto far = CompareCriticalPoints(node, { at(4, 3) }, 3.0, &mesh);
   CHECK(far.Missing.size() == 1 && far.Spurious.size() == 1);
   // An interior node one edge from the boundary, found on the boundary: the same without the
-  // mesh, not with it (CanStandFor). A boundary node may be found on the boundary or inside.
+  // mesh, not with it; and the other way round.
   CHECK(CompareCriticalPoints({ at(1, 2) }, { at(0, 2) }, 3.0).Identical());
   CHECK(!CompareCriticalPoints({ at(1, 2) }, { at(0, 2) }, 3.0, &mesh).Identical());
-  CHECK(CompareCriticalPoints({ at(0, 2) }, { at(1, 2) }, 3.0, &mesh).Identical());
+  CHECK(!CompareCriticalPoints({ at(0, 2) }, { at(1, 2) }, 3.0, &mesh).Identical());
   CHECK(CompareCriticalPoints({ at(0, 2) }, { at(0, 3) }, 3.0, &mesh).Identical());
   // A boundary junction's pair may be 3 edges away, as far as its reach allows, on the
-  // boundary or inside.
+  // boundary or inside (a saddle one vertex in from the boundary minimum).
   std::vector<CriticalPointLocation> junction{ at(0, 2) };
   junction[0].Hops = BoundaryJunctionHops;
   junction[0].Reach = BoundaryJunctionReach;
+  junction[0].EitherSide = true;
   CHECK(CompareCriticalPoints(junction, { at(0, 5) }, 3.0, &mesh).Identical());
   CHECK(!CompareCriticalPoints(junction, { at(0, 6) }, 3.0, &mesh).Identical()); // 4 edges, 4 away
   CHECK(CompareCriticalPoints(junction, { at(1, 2) }, 3.0, &mesh).Identical());
