@@ -849,16 +849,12 @@ struct SaddleMatch
 class SaddleMatcher
 {
 public:
-  // Wanted saddles that are also wanted boundary minima (`boundaryMinima`) are boundary
-  // junctions' (a pass places them): found on the boundary or one vertex inside, as the
-  // verdict matches them (CriticalPointLocation::EitherSide).
   SaddleMatcher(const PlanarScalarField& field, const TriangleMeshTopology& mesh,
-    const std::vector<Index>& wantedSaddles, double tolerance, const ParallelFor& parallel,
-    const std::vector<Index>& boundaryMinima = {})
+    const std::vector<Index>& wantedSaddles, double tolerance, const ParallelFor& parallel)
     : Points(field.Points)
     , Mesh(mesh)
     , WantedSaddles(wantedSaddles)
-    , Wanted(this->Locations(wantedSaddles, boundaryMinima))
+    , Wanted(this->Locations(wantedSaddles))
     , Tolerance(tolerance)
     , Parallel(parallel)
     , Saddles(mesh, parallel)
@@ -910,10 +906,8 @@ public:
   }
 
 private:
-  std::vector<CriticalPointLocation> Locations(
-    const std::vector<Index>& vertices, const std::vector<Index>& eitherSide = {}) const
+  std::vector<CriticalPointLocation> Locations(const std::vector<Index>& vertices) const
   {
-    const std::unordered_set<Index> junctions(eitherSide.begin(), eitherSide.end());
     std::vector<CriticalPointLocation> result(vertices.size());
     for (std::size_t i = 0; i < vertices.size(); ++i)
     {
@@ -921,7 +915,6 @@ private:
       result[i].Position[0] = this->Points[2 * vertices[i]];
       result[i].Position[1] = this->Points[2 * vertices[i] + 1];
       result[i].Vertex = vertices[i];
-      result[i].EitherSide = junctions.count(vertices[i]) != 0;
     }
     return result;
   }
@@ -2281,8 +2274,7 @@ TopologicalSamplingReport TopologicalSampling::Settle(const VertexGraphs& graphs
   // relocation can take a wanted extremum away (a carved chain running down past a wanted
   // minimum beside it), and equal counts come before saddles on their nodes.
   constexpr int restoreRounds = 4;
-  SaddleMatcher matcher(
-    sampling, mesh, constraints.Saddles, this->Spacing * (1 + 1e-9), this->Parallel, constraints.BoundaryMinima);
+  SaddleMatcher matcher(sampling, mesh, constraints.Saddles, this->Spacing * (1 + 1e-9), this->Parallel);
   for (int round = 0; round <= restoreRounds; ++round)
   {
     report.DisplacedSaddles =
@@ -2521,7 +2513,7 @@ int RelocateSaddles(const VertexGraphs& graphs, const PlanarScalarField& field, 
   const SamplingConstraints& constraints, double tolerance, double reach, std::vector<double>& values,
   int maximumRounds, int maximumMissing, const ParallelFor& parallel)
 {
-  SaddleMatcher matcher(field, mesh, constraints.Saddles, tolerance, parallel, constraints.BoundaryMinima);
+  SaddleMatcher matcher(field, mesh, constraints.Saddles, tolerance, parallel);
   return RelocateSaddles(graphs, field, mesh, constraints, matcher, reach, values, maximumRounds, maximumMissing,
     parallel);
 }
@@ -2567,7 +2559,7 @@ int PlaceMissingSaddlesByTheirLinks(const PlanarScalarField& field, const Triang
   int maximumPatterns)
 {
   const ParallelFor sequential = SequentialFor; // the matcher keeps a reference
-  SaddleMatcher matcher(field, mesh, constraints.Saddles, tolerance, sequential, constraints.BoundaryMinima);
+  SaddleMatcher matcher(field, mesh, constraints.Saddles, tolerance, sequential);
   const VertexGraphs graphs(mesh);
   SaddleRelocation relocation{ graphs, sequential, field, mesh, constraints, 0, matcher, values,
     matcher.Match(values) };
@@ -2779,8 +2771,7 @@ int WalkSpareSaddlesOntoMissing(const TriangleMeshTopology& mesh, const std::vec
       return h == hops.end() ? std::numeric_limits<int>::max() : h->second;
     };
     const auto reached = [&](Index v) {
-      return hopsTo(v) <= wanted.Hops && distance(v) <= tolerance * wanted.Reach &&
-        (wanted.EitherSide || mesh.IsBoundaryVertex(v) == mesh.IsBoundaryVertex(wanted.Vertex));
+      return hopsTo(v) <= wanted.Hops && distance(v) <= tolerance * wanted.Reach;
     };
     // The nearest spare saddle in edges (then in distance, then by id).
     Index nearest = InvalidIndex;

@@ -38,7 +38,6 @@ std::vector<CriticalPointLocation> CriticalPointLocations(
       location.Reach = BoundaryJunctionReach;
       location.Vertex = v;
       location.Hops = BoundaryJunctionHops;
-      location.EitherSide = true;
       result.push_back(location);
     }
   }
@@ -194,18 +193,6 @@ bool WithinHops(const TriangleMeshTopology& mesh, Index a, Index b, int hops)
   }
   return false;
 }
-
-// Whether a and b are both boundary vertices or both interior ones. The complex's closed-
-// boundary rule makes a critical point on the boundary another point than one inside: a
-// sampling whose interior saddle sits one vertex off the boundary, beside a boundary saddle's
-// node, while the boundary saddle's vertex holds the interior saddle's partner, has the counts
-// but not the points (a scattered-point mesh's corner saddle and an interior saddle swapped
-// so, and the verdict said 1 with the interior saddle 3 edges from its node). Boundary
-// junctions' pairs excepted (CriticalPointLocation::EitherSide).
-bool OnTheSameSide(const TriangleMeshTopology& mesh, Index a, Index b)
-{
-  return mesh.IsBoundaryVertex(a) == mesh.IsBoundaryVertex(b);
-}
 } // namespace
 
 std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLocation>& expected,
@@ -265,8 +252,7 @@ std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLoca
         double d = 0;
         if (WithinReach(expected[e].Position, found[f].Position, tolerance * expected[e].Reach, d) &&
           (!onMesh(expected[e]) || !onMesh(found[f]) ||
-            ((expected[e].EitherSide || OnTheSameSide(*mesh, expected[e].Vertex, found[f].Vertex)) &&
-              WithinHops(*mesh, expected[e].Vertex, found[f].Vertex, expected[e].Hops))))
+            WithinHops(*mesh, expected[e].Vertex, found[f].Vertex, expected[e].Hops)))
         {
           candidates.emplace_back(d, e, f);
         }
@@ -302,7 +288,7 @@ CriticalPointMatcher::CriticalPointMatcher(const std::vector<CriticalPointLocati
       for (Index v : within)
       {
         double d = 0;
-        if ((cp.EitherSide || OnTheSameSide(mesh, cp.Vertex, v)) && WithinReach(cp.Position, &points[2 * static_cast<std::size_t>(v)], tolerance * cp.Reach, d))
+        if (WithinReach(cp.Position, &points[2 * static_cast<std::size_t>(v)], tolerance * cp.Reach, d))
         {
           candidates.push_back({ d, e, v });
         }

@@ -26,12 +26,6 @@ struct CriticalPointLocation
   // found when the comparison is given the mesh (below).
   Index Vertex = InvalidIndex;
   int Hops = 2;
-  // Whether it may be found on an interior vertex when its vertex is on the boundary, or the
-  // other way round (with the mesh; otherwise a point on the boundary is only found on the
-  // boundary). A boundary junction's pair may: the sampled valley meets the boundary either at
-  // a minimum of the boundary curve with a lower interior neighbour (both points on that
-  // vertex) or at a minimum with the saddle one vertex inside, the same up to a shift.
-  bool EitherSide = false;
 };
 
 // How far (in tolerances) from a boundary junction its stage-1 pair may lie along the boundary.
@@ -63,9 +57,7 @@ struct TopologyComparison
 // matched whole). Returns the found point of each expected one (UnmatchedCriticalPoint: none).
 constexpr std::size_t UnmatchedCriticalPoint = static_cast<std::size_t>(-1);
 // With `mesh` (whose vertices both sets' Vertex name), a pair also needs the found vertex
-// within the expected point's Hops edges, and both on the boundary or both inside it unless
-// the expected point may be on EitherSide (the closed-boundary rule's boundary and interior
-// critical points are different points). The candidate pairs are looked for with `parallel`
+// within the expected point's Hops edges. The candidate pairs are looked for with `parallel`
 // (the result does not depend on it).
 std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLocation>& expected,
   const std::vector<CriticalPointLocation>& found, double tolerance, const TriangleMeshTopology* mesh = nullptr,
@@ -76,8 +68,8 @@ std::vector<std::size_t> MatchCriticalPoints(const std::vector<CriticalPointLoca
 // same wanted ones, and finding the candidate pairs again each time (a bucket search and a walk
 // over the mesh per pair) and sorting them was a sixth of stage 4's time on 500 x 500 noise.
 // Here every pair an expected point can make is found once, sorted as MatchCriticalPoints sorts
-// its pairs: each vertex within the point's Hops edges, on its side of the boundary (unless
-// EitherSide), and within its reach (tolerance times Reach). Match keeps those whose vertex holds a found point of the point's index, in that order, and
+// its pairs: each vertex within the point's Hops edges and its reach (tolerance times Reach).
+// Match keeps those whose vertex holds a found point of the point's index, in that order, and
 // matches them as MatchCriticalPoints does: the same partners. When an expected point is on no
 // vertex, or a found point not at its vertex, Match is MatchCriticalPoints itself.
 class CriticalPointMatcher

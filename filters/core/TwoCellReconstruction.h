@@ -254,7 +254,7 @@ public:
   // noise has thousands of such cells (fitting all of them on 300² noise took stage 4 ten times
   // as long, as many as the regular fits half as long again; terrains have a few: 28 on
   // ttk_happi at 2 %, none on the Rainier crop).
-  double SmallCellFitTrigger = 2;
+  double SmallCellFitTrigger = 0;
   static constexpr double SmallCellFitsPerRegularFit = 0.25;
   static constexpr std::size_t MinimumSmallCellFits = 32;
   MonotoneSurfaceFitOptions Fit;
