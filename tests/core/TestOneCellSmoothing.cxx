@@ -61,19 +61,21 @@ bool RunStages1And2(const GridField& grid, double percent, Stage3Input& input, s
   return true;
 }
 
-// Stages 1 and 2 of `grid` at `percent`, then stage 3 with k segments, the height tolerance the
-// threshold when asked (as the filter sets it), other options default.
-bool SmoothWithSegments(const GridField& grid, double percent, int k, Stage3Input& input,
-  OneCellSmoothingResult& result, std::string& error, bool thresholdAsHeightTolerance = false)
+// Stage 3 of `input` with k segments and `heightTolerance`, other options default.
+bool SmoothWithSegments(const Stage3Input& input, int k, double heightTolerance, OneCellSmoothingResult& result,
+  std::string& error)
 {
-  if (!RunStages1And2(grid, percent, input, error))
-  {
-    return false;
-  }
   OneCellSmoothing smoothing;
   smoothing.Segments = k;
-  smoothing.HeightTolerance = thresholdAsHeightTolerance ? percent / 100 * input.Range : 0.0;
+  smoothing.HeightTolerance = heightTolerance;
   return smoothing.Smooth(input.Simplified.Complex, input.Simplified.JunctionPoints, input.Bounds, result, error);
+}
+
+// Stages 1 and 2 of `grid` at `percent`, then stage 3 with k segments (other options default).
+bool SmoothWithSegments(
+  const GridField& grid, double percent, int k, Stage3Input& input, OneCellSmoothingResult& result, std::string& error)
+{
+  return RunStages1And2(grid, percent, input, error) && SmoothWithSegments(input, k, 0.0, result, error);
 }
 
 // The properties the paper asks of the smoothed 1-cells (section 4, steps 1-3).
@@ -1004,14 +1006,14 @@ TEST_CASE(SparsePiecesFollowSteepRisesWithGentleKnots)
   bool noWorse = true;
   for (std::uint64_t seed = 80; seed < 100; ++seed)
   {
+    Stage3Input input;
+    std::string error;
+    CHECK(RunStages1And2(TerracedShepardField(seed, true), 5.0, input, error));
+    const double eps = 0.05 * input.Range;
     for (const bool withTolerance : { false, true })
     {
-      const GridField grid = TerracedShepardField(seed, true);
-      Stage3Input input;
-      std::string error;
       OneCellSmoothingResult result;
-      CHECK(SmoothWithSegments(grid, 5.0, 4, input, result, error, withTolerance));
-      const double eps = 0.05 * input.Range;
+      CHECK(SmoothWithSegments(input, 4, withTolerance ? eps : 0.0, result, error));
       for (const SmoothedPiece& piece : result.Pieces)
       {
         const std::size_t n = piece.Values.size();
@@ -1026,13 +1028,6 @@ TEST_CASE(SparsePiecesFollowSteepRisesWithGentleKnots)
         HeightFit even;
         const std::vector<double> arcLength = MonotoneBSplineFit::NormalizedArcLength(piece.Points);
         CHECK(fitter.FitHeight(arcLength, piece.Values, a, b, true, even, error));
-        double kept = 0;
-        for (std::size_t i = 1; i + 1 < n; ++i)
-        {
-          double h;
-          piece.Height.Evaluate(piece.Parameters[i], &h);
-          kept = std::max(kept, std::abs(h - piece.Values[i]));
-        }
         if (withTolerance)
         {
           // Straight paths (a side, a diagonal) try every ratio whatever the miss.
@@ -1050,6 +1045,13 @@ TEST_CASE(SparsePiecesFollowSteepRisesWithGentleKnots)
           risenWithTolerance += piece.RiseKnots() ? 1 : 0;
           risenWithinHalf += piece.RiseKnots() && even.MaximumError <= 0.5 * eps ? 1 : 0;
           continue;
+        }
+        double kept = 0;
+        for (std::size_t i = 1; i + 1 < n; ++i)
+        {
+          double h;
+          piece.Height.Evaluate(piece.Parameters[i], &h);
+          kept = std::max(kept, std::abs(h - piece.Values[i]));
         }
         ++sparse;
         risen += piece.RiseKnots() ? 1 : 0;
